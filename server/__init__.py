@@ -1,0 +1,1 @@
+"""wavesph server package."""

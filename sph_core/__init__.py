@@ -1,0 +1,1 @@
+"""wavesph sph_core package."""

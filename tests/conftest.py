@@ -1,0 +1,1 @@
+"""Shared pytest setup. Long physics runs are marked ``slow`` and excluded by default."""

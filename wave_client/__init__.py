@@ -1,0 +1,1 @@
+"""wavesph wave_client package."""
