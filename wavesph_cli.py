@@ -13,7 +13,7 @@ import sys
 
 # name -> (module, one-line help)
 COMMANDS: dict[str, tuple[str, str]] = {
-    "demo": ("wave_client.demo_cli", "run the coupled demo on embedded defaults"),
+    "demo": ("sph_core.demo_cli", "run the coupled demo on embedded defaults"),
     "run": ("sph_core.cli", "run an SPH scene (TOML) standalone"),
     "serve": ("server.cli", "start the SPH coupling server (HTTP + WebSocket + TCP)"),
     "couple": ("wave_client.couple_cli", "couple a wave model to a running server"),
