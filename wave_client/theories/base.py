@@ -1,0 +1,124 @@
+"""What all analytic wave theories share: the clock, the start-up ramp, input checks and the
+policy for points above the instantaneous surface.
+
+Datum: z is measured up from the still-water level (z = 0 at rest, z = -depth at the bed).
+Waves travel towards +x; the crest is at x = 0 at t = 0 for regular waves.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import raschii
+from numpy.typing import ArrayLike
+
+G = 9.81  # gravitational acceleration [m/s^2], the value raschii uses by default
+
+
+def require_positive(name: str, value: float) -> float:
+    """Return ``value`` as float, or raise ValueError naming the parameter."""
+    v = float(value)
+    if not math.isfinite(v) or v <= 0.0:
+        raise ValueError(f"{name} must be a positive finite number, got {value!r}")
+    return v
+
+
+def check_not_breaking(height: float, period: float, depth: float, name: str = "height") -> None:
+    """Raise ValueError naming the height parameter (``name``) if the wave exceeds a breaking limit.
+
+    Uses raschii's ``check_breaking_criteria``: H <= 0.14 L (steepness, Miche's deep-water limit),
+    H <= 0.78 d (depth-limited, McCowan) and H <= 0.142 L tanh(k d) (Miche), with L from
+    linear dispersion. A breaking wave has no steady-wave solution to impose at a boundary.
+    """
+    err, _ = raschii.check_breaking_criteria(height, depth, period=period)
+    if err:
+        raise ValueError(
+            f"{name}={height} m breaks for period={period} s, depth={depth} m: "
+            + err.strip().replace("\n", "; ")
+        )
+
+
+def ramp_factor(t: float, duration: float) -> float:
+    """Half-cosine start-up ramp r(t) = (1 - cos(pi t / T_r)) / 2 on [0, T_r], 0 before, 1 after;
+    identically 1 when there is no ramp (T_r = 0).
+
+    A flume starts from rest: multiplying elevation and velocity by r(t) avoids the impulsive
+    start that would otherwise launch a spurious transient from the wavemaker boundary.
+    r is C1 (zero slope at both ends).
+    """
+    if duration <= 0.0:  # no ramp: the theory holds at all times, negative ones included
+        return 1.0
+    if t <= 0.0:
+        return 0.0
+    if t >= duration:
+        return 1.0
+    return 0.5 * (1.0 - math.cos(math.pi * t / duration))
+
+
+class WaveTheory:
+    """Base of the analytic theories; satisfies `wave_client.model.WaveModel`.
+
+    Subclasses implement ``_eta(x, t)`` and ``_uw(x, z, t, eta)`` (unramped, z already clamped
+    to the surface) and set ``depth``, ``period`` and ``g``.
+
+    Above the instantaneous surface (z > eta) the velocity returned is the **surface value**
+    (z clamped to eta). Coupling data must never contain NaN, and zero would put a velocity
+    jump right at the crest: SPH buffer particles whose centre lies a fraction of a particle
+    spacing above the interpolated surface would be stopped dead while their neighbours move.
+    The surface value is the continuous extension. Points below the bed (z < -depth) are
+    refused: they mean a datum mix-up (absolute SPH z passed instead of z from still water).
+    """
+
+    depth: float
+    period: float
+    g: float
+
+    def __init__(self, ramp_time: float = 0.0) -> None:
+        ramp_time = float(ramp_time)
+        if not math.isfinite(ramp_time) or ramp_time < 0.0:
+            raise ValueError(f"ramp_time must be a finite number >= 0 s, got {ramp_time!r}")
+        self.ramp_time = ramp_time
+        self.t = 0.0
+
+    # --- WaveModel contract -------------------------------------------------------------
+    def advance_to(self, t: float) -> None:
+        """Set the theory's clock to ``t`` [s] (analytic: no state to integrate)."""
+        t = float(t)
+        if not math.isfinite(t):
+            raise ValueError(f"t must be finite, got {t!r}")
+        self.t = t
+
+    def elevation(self, x: ArrayLike) -> np.ndarray:
+        """Surface elevation eta(x, t) [m] above still water, including the start-up ramp."""
+        xa = np.asarray(x, dtype=float)
+        return ramp_factor(self.t, self.ramp_time) * self._eta(xa, self.t)
+
+    def velocity(self, x: ArrayLike, z: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
+        """(u, w) [m/s] at (x, z), z up from still water; surface value above the surface."""
+        xa, za = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(z, dtype=float))
+        if not (np.all(np.isfinite(xa)) and np.all(np.isfinite(za))):
+            raise ValueError("x and z must be finite")
+        # tolerance: nodes placed exactly on the bed may carry round-off
+        if np.any(za < -self.depth * (1.0 + 1e-9)):
+            raise ValueError(
+                f"z below the bed: min(z) = {za.min():.6g} m < -depth = {-self.depth:.6g} m "
+                "(z is measured up from the still-water level, not from the tank floor)"
+            )
+        r = ramp_factor(self.t, self.ramp_time)
+        eta = r * self._eta(xa, self.t)
+        zc = np.clip(za, -self.depth, eta)
+        u, w = self._uw(xa, zc, self.t, eta)
+        return r * u, r * w
+
+    def impose(self, x: float, eta: float, u_ref: float) -> None:
+        """Analytic theories are not driven by SPH: feedback is ignored."""
+
+    # --- to implement -------------------------------------------------------------------
+    def _eta(self, x: np.ndarray, t: float) -> np.ndarray:
+        raise NotImplementedError
+
+    def _uw(
+        self, x: np.ndarray, z: np.ndarray, t: float, eta: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
+        raise NotImplementedError

@@ -1,0 +1,119 @@
+"""Linear (Airy) progressive and standing waves, and the linear dispersion relation.
+
+Reference: R. G. Dean & R. A. Dalrymple, *Water Wave Mechanics for Engineers and Scientists*
+(1991), ch. 3-4. z is measured up from the still-water level, z = -d at the bed.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from wave_client.theories.base import G, WaveTheory, check_not_breaking, require_positive
+
+
+def wavenumber(omega: ArrayLike, depth: float, g: float = G) -> np.ndarray:
+    """Solve the linear dispersion relation omega^2 = g k tanh(k d) for k [rad/m].
+
+    Vectorised over omega [rad/s]. Newton iterations from Eckart's (1952) explicit
+    approximation k0 = (omega^2/g) / sqrt(tanh(omega^2 d / g)), which is within 5 %, so a
+    handful of iterations reach machine precision.
+    """
+    depth = require_positive("depth", depth)
+    w = np.asarray(omega, dtype=float)
+    if np.any(~np.isfinite(w)) or np.any(w <= 0.0):
+        raise ValueError("omega must be positive and finite")
+    k0 = w**2 / g
+    k = k0 / np.sqrt(np.tanh(k0 * depth))
+    for _ in range(50):
+        th = np.tanh(k * depth)
+        f = g * k * th - w**2
+        df = g * th + g * k * depth * (1.0 - th**2)
+        step = f / df
+        k = k - step
+        if np.all(np.abs(step) <= 1e-14 * k):
+            return k
+    raise ValueError("dispersion relation did not converge (check omega and depth)")  # pragma: no cover
+
+
+def depth_profiles(k: ArrayLike, z: ArrayLike, depth: float) -> tuple[np.ndarray, np.ndarray]:
+    """cosh(k (z + d)) / sinh(k d) and sinh(k (z + d)) / sinh(k d), without overflow.
+
+    Written as exp(k z) (1 +- exp(-2 k (z + d))) / (1 - exp(-2 k d)) so deep-water components
+    (k d in the hundreds) stay finite; requires z >= -d. k and z broadcast.
+    """
+    k = np.asarray(k, dtype=float)
+    z = np.asarray(z, dtype=float)
+    e = np.exp(-2.0 * k * (z + depth))
+    den = -np.expm1(-2.0 * k * depth)
+    ez = np.exp(k * z)
+    return ez * (1.0 + e) / den, ez * -np.expm1(-2.0 * k * (z + depth)) / den
+
+
+class AiryWave(WaveTheory):
+    """Linear progressive wave travelling towards +x.
+
+    eta = (H/2) cos(k x - omega t),  omega^2 = g k tanh(k d)
+    u   = (H/2) omega cosh(k (z + d)) / sinh(k d) cos(k x - omega t)
+    w   = (H/2) omega sinh(k (z + d)) / sinh(k d) sin(k x - omega t)
+
+    Between z = 0 and the crest the profile is evaluated at the actual z (as raschii's
+    AiryWave does); above the surface the surface value is returned (see `WaveTheory`).
+    """
+
+    def __init__(
+        self, height: float, period: float, depth: float, *, ramp_time: float = 0.0, g: float = G
+    ) -> None:
+        super().__init__(ramp_time)
+        self.height = require_positive("height", height)
+        self.period = require_positive("period", period)
+        self.depth = require_positive("depth", depth)
+        self.g = require_positive("g", g)
+        check_not_breaking(self.height, self.period, self.depth)
+        self.omega = 2.0 * np.pi / self.period
+        self.k = float(wavenumber(self.omega, self.depth, self.g))
+        self.length = 2.0 * np.pi / self.k
+
+    def _eta(self, x: np.ndarray, t: float) -> np.ndarray:
+        return 0.5 * self.height * np.cos(self.k * x - self.omega * t)
+
+    def _uw(self, x, z, t, eta):
+        a = 0.5 * self.height
+        phase = self.k * x - self.omega * t
+        ch, sh = depth_profiles(self.k, z, self.depth)
+        return a * self.omega * ch * np.cos(phase), a * self.omega * sh * np.sin(phase)
+
+
+class StandingWave(WaveTheory):
+    """Linear standing wave, e.g. the sloshing mode of a closed tank (walls at antinodes).
+
+    eta = A cos(k x) cos(omega t),  A = H/2,  omega^2 = g k tanh(k d)
+    u   = A omega cosh(k (z + d)) / sinh(k d) sin(k x) sin(omega t)
+    w   = -A omega sinh(k (z + d)) / sinh(k d) cos(k x) sin(omega t)
+
+    ``height`` is the crest-to-trough range at an antinode (H = 2A). It is the superposition
+    of two progressive waves of height H/2 travelling in opposite directions. Nodes of eta at
+    k x = pi/2 + n pi; u vanishes at the antinodes k x = n pi (where the walls of a tank of
+    length L = n pi / k stand).
+    """
+
+    def __init__(
+        self, height: float, period: float, depth: float, *, ramp_time: float = 0.0, g: float = G
+    ) -> None:
+        super().__init__(ramp_time)
+        self.height = require_positive("height", height)
+        self.period = require_positive("period", period)
+        self.depth = require_positive("depth", depth)
+        self.g = require_positive("g", g)
+        check_not_breaking(self.height, self.period, self.depth)
+        self.omega = 2.0 * np.pi / self.period
+        self.k = float(wavenumber(self.omega, self.depth, self.g))
+        self.length = 2.0 * np.pi / self.k
+
+    def _eta(self, x: np.ndarray, t: float) -> np.ndarray:
+        return 0.5 * self.height * np.cos(self.k * x) * np.cos(self.omega * t)
+
+    def _uw(self, x, z, t, eta):
+        s = 0.5 * self.height * self.omega * np.sin(self.omega * t)
+        ch, sh = depth_profiles(self.k, z, self.depth)
+        return s * ch * np.sin(self.k * x), -s * sh * np.cos(self.k * x)

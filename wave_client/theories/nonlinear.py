@@ -1,0 +1,110 @@
+"""Nonlinear regular waves through `raschii`: Stokes 2nd-5th order and stream-function waves.
+
+- Stokes: J. D. Fenton (1985), "A fifth-order Stokes theory for steady waves",
+  J. Waterway, Port, Coastal and Ocean Eng. 111(2), 216-234 (`raschii.StokesWave`).
+- Stream function: M. M. Rienecker & J. D. Fenton (1981), "A Fourier approximation method for
+  steady water waves", J. Fluid Mech. 104, 119-137 (`raschii.FentonWave`).
+
+raschii measures z from the bed (z = 0 at the bed, z = d at still water) and returns the
+earth-frame velocity with zero Eulerian mean current (Stokes' first definition of celerity);
+it is given the period and solves for the wavelength. We convert z explicitly:
+z_raschii = z + d.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import raschii
+
+from wave_client.theories.base import G, WaveTheory, check_not_breaking, require_positive
+
+
+class _RaschiiWave(WaveTheory):
+    """Adapter from a raschii wave object to the `WaveModel` contract."""
+
+    def __init__(self, height: float, period: float, depth: float, ramp_time: float, g: float):
+        super().__init__(ramp_time)
+        self.height = require_positive("height", height)
+        self.period = require_positive("period", period)
+        self.depth = require_positive("depth", depth)
+        self.g = require_positive("g", g)
+        check_not_breaking(self.height, self.period, self.depth)
+
+    def _build(self, make) -> None:  # make: () -> raschii wave
+        try:
+            wave = make()
+        except raschii.RaschiiError as exc:  # includes NonConvergenceError
+            raise ValueError(
+                f"{type(self).__name__} did not converge for height={self.height} m, "
+                f"period={self.period} s, depth={self.depth} m: {exc}"
+            ) from exc
+        if not np.isfinite(wave.length) or abs(wave.period - self.period) > 1e-6 * self.period:
+            raise ValueError(
+                f"{type(self).__name__}: raschii returned period {wave.period} s for the requested "
+                f"period={self.period} s (height={self.height} m, depth={self.depth} m)"
+            )
+        self.raschii_wave = wave
+        self.length = float(wave.length)
+        self.k = float(wave.k)
+        self.celerity = float(wave.c)
+
+    def _eta(self, x: np.ndarray, t: float) -> np.ndarray:
+        eta = self.raschii_wave.surface_elevation(x.ravel(), t, include_depth=False)
+        return np.asarray(eta, dtype=float).reshape(x.shape)
+
+    def _uw(self, x, z, t, eta):
+        # z is already clamped to the surface, so every point is wet for raschii
+        vel = self.raschii_wave.velocity(x.ravel(), (z + self.depth).ravel(), t, all_points_wet=True)
+        vel = np.asarray(vel, dtype=float).reshape(-1, 2)
+        return vel[:, 0].reshape(x.shape), vel[:, 1].reshape(x.shape)
+
+
+class StokesWave(_RaschiiWave):
+    """Stokes wave of order 2 to 5 (Fenton 1985) through ``raschii.StokesWave``."""
+
+    def __init__(
+        self,
+        height: float,
+        period: float,
+        depth: float,
+        *,
+        order: int = 5,
+        ramp_time: float = 0.0,
+        g: float = G,
+    ) -> None:
+        super().__init__(height, period, depth, ramp_time, g)
+        if int(order) != order or not 2 <= order <= 5:
+            raise ValueError(f"order must be an integer from 2 to 5, got {order!r}")
+        self.order = int(order)
+        self._build(
+            lambda: raschii.StokesWave(
+                self.height, self.depth, period=self.period, N=self.order, g=self.g
+            )
+        )
+
+
+class StreamFunctionWave(_RaschiiWave):
+    """Stream-function (Fourier) wave of Rienecker & Fenton (1981) through ``raschii.FentonWave``.
+
+    ``n_fourier`` is the number of Fourier modes; raise it for steep or shallow-water waves.
+    """
+
+    def __init__(
+        self,
+        height: float,
+        period: float,
+        depth: float,
+        *,
+        n_fourier: int = 10,
+        ramp_time: float = 0.0,
+        g: float = G,
+    ) -> None:
+        super().__init__(height, period, depth, ramp_time, g)
+        if int(n_fourier) != n_fourier or not 2 <= n_fourier <= 64:
+            raise ValueError(f"n_fourier must be an integer from 2 to 64, got {n_fourier!r}")
+        self.n_fourier = int(n_fourier)
+        self._build(
+            lambda: raschii.FentonWave(
+                self.height, self.depth, period=self.period, N=self.n_fourier, g=self.g
+            )
+        )
