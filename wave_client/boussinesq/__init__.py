@@ -1,0 +1,11 @@
+"""Nwogu extended Boussinesq far-field wave model (1D horizontal, variable depth).
+
+`BoussinesqModel` satisfies `wave_client.model.WaveModel`; `wavesph waves SCENE.toml` runs it
+alone (`scene.py`, `wave_client/waves_cli.py`).
+"""
+
+from .dispersion import airy_celerity, nwogu_celerity, nwogu_wavenumber
+from .solver import BoussinesqModel, BoussinesqUnstableError
+
+__all__ = ["BoussinesqModel", "BoussinesqUnstableError", "airy_celerity", "nwogu_celerity",
+           "nwogu_wavenumber"]
