@@ -1,0 +1,201 @@
+"""The SPH-side session: which message may come when, and checks against the handshake."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from protocol import (Bye, Capability, ClientSession, Error, ErrorCode, Get, GetNodes, GoBack, Hello,
+                      Nodes, ProtocolError, RemoteError, Result, Set, Solve, SphSession, Welcome,
+                      decode_frame, scene_hash)
+from protocol.session import Measure, PeerError, Reply, Restore, SetWindow, SolveWindow, State
+
+HASH = scene_hash(b'{"scene": 1}')
+N, G = 3, 2
+
+
+def make_session(capabilities: int = Capability.GOBACK) -> SphSession:
+    welcome = Welcome(capabilities, HASH, g=9.81, depth=0.5, still_water_level=0.5, z_ref=-0.25,
+                      t_start=0.0, t_end=1.0, dt_sph=1e-4, window_max=0.1, idle_timeout=30.0,
+                      n_nodes=N, n_gauges=G, max_payload=0, run_id="r1", server="test")
+    nodes = Nodes(np.zeros(N), np.linspace(-0.5, 0, N), np.zeros(N, np.uint32), [1.0, 2.0])
+    return SphSession(welcome, nodes)
+
+
+def result(t: float = 0.0) -> Result:
+    return Result(t, 7, np.full(G, 0.01), np.ones(G, np.uint32), np.zeros(G), np.zeros(G))
+
+
+def window(t0: float, t1: float, n: int = N) -> Set:
+    return Set(t0, t1, np.ones(n), np.zeros(n), np.zeros(n))
+
+
+class Peer:
+    """Client side talking to the session through real bytes."""
+
+    def __init__(self, session: SphSession) -> None:
+        self.s, self.c = session, ClientSession()
+
+    def send(self, msg):
+        return self.s.receive(*decode_frame(self.c.request(msg), self.s.max_payload))
+
+    def expect(self, data: bytes, cls):
+        return self.c.reply(*decode_frame(data), expect=cls)
+
+
+def handshake(peer: Peer) -> Welcome:
+    action = peer.send(Hello(Capability.GOBACK, HASH, "r1", "pytest"))
+    return peer.expect(action.data, Welcome)
+
+
+def test_a_full_coupled_run():
+    s = make_session()
+    peer = Peer(s)
+    welcome = handshake(peer)
+    assert welcome.capabilities == Capability.GOBACK and welcome.n_nodes == N
+    nodes = peer.expect(peer.send(GetNodes()).data, Nodes)
+    assert nodes.gauge_x.tolist() == [1.0, 2.0]
+    t = 0.0
+    for _ in range(3):
+        action = peer.send(window(t, t + 0.1))
+        assert isinstance(action, SetWindow) and action.u.tolist() == [1.0] * N
+        action = peer.send(Solve())
+        assert action == SolveWindow(t, t + 0.1)
+        reply = peer.expect(s.result(action, result()), Result)
+        t += 0.1
+        assert reply.t == pytest.approx(t) and reply.steps == 7
+    # iterate the last window: back to its start, then set it again
+    action = peer.send(GoBack())
+    assert isinstance(action, Restore) and action.t == pytest.approx(0.2)
+    assert peer.expect(s.result(action, result()), Result).t == pytest.approx(0.2)
+    with pytest.raises(ProtocolError, match="no solved window"):
+        peer.send(GoBack())
+
+
+def test_goback_only_once_and_then_set_at_window_start():
+    s = make_session()
+    peer = Peer(s)
+    handshake(peer)
+    peer.send(window(0.0, 0.1))
+    s.result(peer.send(Solve()), result())
+    s.result(peer.send(GoBack()), result())
+    with pytest.raises(ProtocolError) as exc:
+        peer.send(window(0.1, 0.2))  # the clock went back to 0
+    assert exc.value.code is ErrorCode.TIME_MISMATCH
+
+
+@pytest.mark.parametrize("first", [GetNodes(), Set(0.0, 0.1, [0.0] * N, [0.0] * N, [0.0] * N), Solve(),
+                                   Get(), GoBack()])
+def test_nothing_before_hello(first):
+    with pytest.raises(ProtocolError, match="before HELLO") as exc:
+        Peer(make_session()).send(first)
+    assert exc.value.code is ErrorCode.OUT_OF_ORDER
+
+
+@pytest.mark.parametrize("bad, code, text", [
+    (lambda: Solve(), ErrorCode.OUT_OF_ORDER, "SOLVE without a SET"),
+    (lambda: GoBack(), ErrorCode.OUT_OF_ORDER, "no solved window"),
+    (lambda: Hello(0), ErrorCode.OUT_OF_ORDER, "HELLO"),
+    (lambda: result(), ErrorCode.OUT_OF_ORDER, "server only"),
+    (lambda: window(0.0, 0.1, n=N + 1), ErrorCode.SHAPE_MISMATCH, "SET.u has 4 values"),
+    (lambda: window(0.5, 0.6), ErrorCode.TIME_MISMATCH, "t0=0.5"),
+    (lambda: window(0.0, 0.0), ErrorCode.BAD_VALUE, "empty"),
+    (lambda: window(0.0, 0.2), ErrorCode.BAD_VALUE, "window_max"),
+])
+def test_refusals_name_the_problem(bad, code, text):
+    peer = Peer(make_session())
+    handshake(peer)
+    with pytest.raises(ProtocolError, match=text) as exc:
+        peer.send(bad())
+    assert exc.value.code is code
+
+
+def test_set_after_t_end_is_refused():
+    s = make_session()
+    peer = Peer(s)
+    handshake(peer)
+    t = 0.0
+    for _ in range(10):
+        peer.send(window(t, t + 0.1))
+        s.result(peer.send(Solve()), result())
+        t += 0.1
+    with pytest.raises(ProtocolError, match="t_end") as exc:
+        peer.send(window(t, t + 0.05))
+    assert exc.value.code is ErrorCode.BAD_VALUE
+
+
+def test_scene_hash_and_run_id_checked_zero_hash_accepted():
+    with pytest.raises(ProtocolError) as exc:
+        Peer(make_session()).send(Hello(0, scene_hash(b"other"), "r1"))
+    assert exc.value.code is ErrorCode.SCENE_MISMATCH
+    with pytest.raises(ProtocolError) as exc:
+        Peer(make_session()).send(Hello(0, HASH, "r2"))
+    assert exc.value.code is ErrorCode.BUSY
+    peer = Peer(make_session())
+    assert isinstance(peer.send(Hello(0)), Reply)  # zero hash, no run id: accepted
+
+
+def test_goback_needs_the_capability():
+    s = make_session()
+    peer = Peer(s)
+    peer.expect(peer.send(Hello(0, HASH)).data, Welcome)
+    peer.send(window(0.0, 0.1))
+    s.result(peer.send(Solve()), result())
+    with pytest.raises(ProtocolError, match="capability"):
+        peer.send(GoBack())
+
+
+def test_wrong_seq_is_refused():
+    s = make_session()
+    s.receive(1, Hello(0))
+    with pytest.raises(ProtocolError, match="seq 3, expected 2") as exc:
+        s.receive(3, GetNodes())
+    assert exc.value.code is ErrorCode.OUT_OF_ORDER
+
+
+def test_bye_error_and_closed_state():
+    s = make_session()
+    peer = Peer(s)
+    handshake(peer)
+    action = peer.send(Bye("done"))
+    assert isinstance(action, Reply) and action.close
+    assert isinstance(decode_frame(action.data)[1], Bye)
+    with pytest.raises(ProtocolError, match="closed"):
+        peer.send(Get())
+    s2 = make_session()
+    assert Peer(s2).send(Error(5, "model blew up")) == PeerError(5, "model blew up")
+    assert s2.state is State.CLOSED
+
+
+def test_error_frame_reaches_the_client_as_remote_error():
+    s = make_session()
+    peer = Peer(s)
+    handshake(peer)
+    try:
+        peer.send(Solve())
+    except ProtocolError as exc:
+        frame = s.error_frame(exc)
+    with pytest.raises(RemoteError, match="SOLVE without a SET") as exc:
+        peer.expect(frame, Result)
+    assert exc.value.code is ErrorCode.OUT_OF_ORDER
+
+
+def test_max_payload_follows_the_handshake():
+    s = make_session()
+    before = s.max_payload
+    s.receive(1, Hello(0))
+    assert s.max_payload == max(16 + 3 * (4 + 8 * N), 4104)
+    assert before == 4 + 32 + 2 * (4 + 4096)
+    big = make_session()
+    big.offer.n_nodes = 1000  # the payload limit follows the scene's node count
+    big.receive(1, Hello(0))
+    assert big.max_payload == 16 + 3 * (4 + 8000)
+
+
+def test_get_is_allowed_any_time_after_hello_and_does_not_move_the_clock():
+    s = make_session()
+    peer = Peer(s)
+    handshake(peer)
+    action = peer.send(Get())
+    assert isinstance(action, Measure)
+    assert peer.expect(s.result(action, result(t=99.0)), Result).t == 0.0
