@@ -1,0 +1,138 @@
+"""Particle positions for a scene: fluid on a lattice, dummy wall particles in layers.
+
+Every particle sits on the lattice (x0 + (i + 1/2) dp, z0 + (j + 1/2) dp) anchored at the tank's
+lower-left inner corner, except the right wall, which is laid out from x1 so that it is always
+dp/2 from the wall face. Wall layers are ``n_layers = ceil(2h/dp)`` deep so that a fluid particle
+at the wall sees a full kernel support (2h) of dummy particles.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .scene import Bed, Rect, Scene
+
+
+@dataclass
+class Layout:
+    """Initial particle positions of a scene."""
+
+    fluid_x: np.ndarray
+    fluid_z: np.ndarray
+    fluid_surface: np.ndarray  # z of the free surface above each fluid particle (hydrostatics)
+    wall_x: np.ndarray
+    wall_z: np.ndarray
+    n_layers: int
+
+
+def wall_layers(scene: Scene) -> int:
+    return int(math.ceil(2.0 * scene.h / scene.dp - 1e-9))
+
+
+def _lattice(scene: Scene, xa: float, xb: float, za: float, zb: float) -> tuple[np.ndarray, np.ndarray]:
+    """Lattice points with xa < x < xb and za < z < zb."""
+    dp, t = scene.dp, scene.tank
+    i0 = math.floor((xa - t.x0) / dp - 0.5) - 1
+    i1 = math.ceil((xb - t.x0) / dp - 0.5) + 1
+    j0 = math.floor((za - t.z0) / dp - 0.5) - 1
+    j1 = math.ceil((zb - t.z0) / dp - 0.5) + 1
+    xs = t.x0 + (np.arange(i0, i1 + 1) + 0.5) * dp
+    zs = t.z0 + (np.arange(j0, j1 + 1) + 0.5) * dp
+    eps = 1e-9 * dp
+    xs = xs[(xs > xa + eps) & (xs < xb - eps)]
+    zs = zs[(zs > za + eps) & (zs < zb - eps)]
+    gx, gz = np.meshgrid(xs, zs, indexing="ij")
+    return gx.ravel(), gz.ravel()
+
+
+def _polyline_distance(bed: Bed, x: np.ndarray, z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Distance of points to the polyline, and whether each point is below it (within its x range)."""
+    pts = np.asarray(bed.points, dtype=float)
+    dist = np.full(x.shape, np.inf)
+    for (ax, az), (bx, bz) in zip(pts[:-1], pts[1:]):
+        ex, ez = bx - ax, bz - az
+        s = np.clip(((x - ax) * ex + (z - az) * ez) / (ex * ex + ez * ez), 0.0, 1.0)
+        dist = np.minimum(dist, np.hypot(x - (ax + s * ex), z - (az + s * ez)))
+    inside = (x >= pts[0, 0]) & (x <= pts[-1, 0])
+    below = inside & (z < np.interp(x, pts[:, 0], pts[:, 1]))
+    return dist, below
+
+
+def _rect_shell(scene: Scene, r: Rect, thickness: float) -> tuple[np.ndarray, np.ndarray]:
+    x, z = _lattice(scene, r.x0, r.x1, r.z0, r.z1)
+    d = np.minimum.reduce([x - r.x0, r.x1 - x, z - r.z0, r.z1 - z])
+    keep = d < thickness
+    return x[keep], z[keep]
+
+
+def build_layout(scene: Scene) -> Layout:
+    """Place fluid and wall particles for ``scene``."""
+    dp, t = scene.dp, scene.tank
+    nl = wall_layers(scene)
+    th = nl * dp
+    # tank walls: left and right columns (including the corners), bottom rows
+    zs = t.z0 + (np.arange(-nl, math.ceil((t.z1 - t.z0) / dp)) + 0.5) * dp
+    zs = zs[zs <= t.z1]
+    xs_bottom = t.x0 + (np.arange(0, math.ceil((t.x1 - t.x0) / dp - 0.5 + 1e-9)) + 0.5) * dp
+    xs_bottom = xs_bottom[xs_bottom < t.x1 - 0.25 * dp]
+    wx, wz = [], []
+    for k in range(nl):
+        for xw in (t.x0 - (k + 0.5) * dp, t.x1 + (k + 0.5) * dp):
+            wx.append(np.full(zs.size, xw))
+            wz.append(zs)
+        wx.append(xs_bottom)
+        wz.append(np.full(xs_bottom.size, t.z0 - (k + 0.5) * dp))
+    # sloping beds: lattice points below the line, within the wall thickness of it
+    for bed in scene.beds:
+        pts = np.asarray(bed.points)
+        bx, bz = _lattice(scene, max(pts[:, 0].min(), t.x0), min(pts[:, 0].max(), t.x1),
+                          max(pts[:, 1].min() - th, t.z0), min(pts[:, 1].max(), t.z1))
+        d, below = _polyline_distance(bed, bx, bz)
+        keep = below & (d < th)
+        wx.append(bx[keep])
+        wz.append(bz[keep])
+    for s in scene.structures:
+        sx, sz = _rect_shell(scene, s, th)
+        keep = (sx > t.x0) & (sx < t.x1) & (sz > t.z0)
+        wx.append(sx[keep])
+        wz.append(sz[keep])
+    wall_x = np.concatenate(wx)
+    wall_z = np.concatenate(wz)
+    # remove duplicates (beds and structures may overlap the tank walls or each other)
+    key = np.round(np.stack([wall_x, wall_z]) / (0.25 * dp)).astype(np.int64)
+    _, first = np.unique(key, axis=1, return_index=True)
+    first.sort()
+    wall_x, wall_z = wall_x[first], wall_z[first]
+
+    # fluid: lattice points of every water block, inside the tank, outside beds and structures
+    fx, fz, fs = [], [], []
+    for b in scene.water_blocks:
+        x, z = _lattice(scene, b.x0, b.x1, b.z0, b.z1)
+        fx.append(x)
+        fz.append(z)
+        fs.append(np.full(x.size, b.z1))
+    fluid_x, fluid_z, surf = np.concatenate(fx), np.concatenate(fz), np.concatenate(fs)
+    key = np.round(np.stack([fluid_x, fluid_z]) / (0.25 * dp)).astype(np.int64)
+    _, first = np.unique(key, axis=1, return_index=True)
+    first.sort()
+    fluid_x, fluid_z = fluid_x[first], fluid_z[first]
+    # surface above a point: the highest block top among blocks covering its x
+    surf = np.full(fluid_x.size, -np.inf)
+    for b in scene.water_blocks:
+        cover = (fluid_x > b.x0) & (fluid_x < b.x1)
+        surf[cover] = np.maximum(surf[cover], b.z1)
+    half = 0.5 * dp * (1 - 1e-6)
+    keep = (fluid_x > t.x0 + half) & (fluid_x < t.x1 - half) & (fluid_z > t.z0 + half)
+    for bed in scene.beds:
+        d, below = _polyline_distance(bed, fluid_x, fluid_z)
+        keep &= ~below & (d >= half)
+    for s in scene.structures:
+        inside = ((fluid_x > s.x0 - half) & (fluid_x < s.x1 + half)
+                  & (fluid_z > s.z0 - half) & (fluid_z < s.z1 + half))
+        keep &= ~inside
+    if not keep.any():
+        raise ValueError("water_blocks: no fluid particle left after removing beds and structures")
+    return Layout(fluid_x[keep], fluid_z[keep], surf[keep], wall_x, wall_z, nl)

@@ -1,0 +1,88 @@
+"""Run directory: meta.json (config, versions, progress, status), probes.csv, VTK snapshots.
+
+Everything is written as it comes: the CSV is flushed after each row, meta.json is replaced
+atomically (write + rename), so a crash or an unstable stop leaves the last good outputs on disk.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import os
+import platform
+import sys
+from importlib import metadata
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+
+def package_versions() -> dict[str, str]:
+    out = {"python": sys.version.split()[0], "platform": platform.platform()}
+    for name in ("wavesph", "numpy", "numba", "pydantic", "pyevtk"):
+        try:
+            out[name] = metadata.version(name)
+        except metadata.PackageNotFoundError:
+            out[name] = "not installed"
+    return out
+
+
+def write_json_atomic(path: Path, data: dict[str, Any]) -> None:
+    tmp = path.with_suffix(path.suffix + ".tmp")
+    tmp.write_text(json.dumps(data, indent=2, default=str))
+    os.replace(tmp, path)
+
+
+class RunWriter:
+    """Writes one run's outputs into ``run_dir``."""
+
+    def __init__(self, run_dir: str | Path, columns: list[str], config: dict[str, Any]) -> None:
+        self.dir = Path(run_dir)
+        self.dir.mkdir(parents=True, exist_ok=True)
+        (self.dir / "snapshots").mkdir(exist_ok=True)
+        self.meta: dict[str, Any] = {"config": config, "versions": package_versions(),
+                                     "status": "created"}
+        self.columns = ["t", "step"] + columns
+        self._csv_file = open(self.dir / "probes.csv", "w", newline="")
+        self._csv = csv.writer(self._csv_file)
+        self._csv.writerow(self.columns)
+        self._csv_file.flush()
+        self.snapshots: list[tuple[float, str]] = []
+        self.update_meta()
+
+    def update_meta(self, **fields: Any) -> None:
+        self.meta.update(fields)
+        write_json_atomic(self.dir / "meta.json", self.meta)
+
+    def probe_row(self, t: float, step: int, values: dict[str, float | None]) -> None:
+        """One CSV row; a dry gauge is written as the word ``dry``, never as NaN."""
+        row: list[Any] = [repr(float(t)), step]
+        for c in self.columns[2:]:
+            v = values.get(c)
+            row.append("dry" if v is None else repr(float(v)))
+        self._csv.writerow(row)
+        self._csv_file.flush()
+
+    def snapshot(self, t: float, x: np.ndarray, z: np.ndarray, data: dict[str, np.ndarray]) -> Path:
+        """Particles as VTK unstructured points (.vtu) plus a ParaView collection (run.pvd)."""
+        from pyevtk.hl import pointsToVTK
+
+        k = len(self.snapshots)
+        stem = self.dir / "snapshots" / f"particles_{k:05d}"
+        y = np.zeros_like(x)
+        path = pointsToVTK(str(stem), np.ascontiguousarray(x), y, np.ascontiguousarray(z),
+                           data={key: np.ascontiguousarray(v) for key, v in data.items()})
+        self.snapshots.append((t, Path(path).name))
+        entries = "\n".join(f'    <DataSet timestep="{tt!r}" file="snapshots/{name}"/>'
+                            for tt, name in self.snapshots)
+        pvd = ('<?xml version="1.0"?>\n<VTKFile type="Collection" version="0.1">\n  <Collection>\n'
+               f"{entries}\n  </Collection>\n</VTKFile>\n")
+        tmp = self.dir / "run.pvd.tmp"
+        tmp.write_text(pvd)
+        os.replace(tmp, self.dir / "run.pvd")
+        return Path(path)
+
+    def close(self) -> None:
+        if not self._csv_file.closed:
+            self._csv_file.close()

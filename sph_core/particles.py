@@ -1,0 +1,117 @@
+"""Particles as structure-of-arrays with spare capacity.
+
+All real-valued fields live in one float64 array ``f[field, slot]`` (each field row contiguous);
+``kind`` (int8) and ``ids`` (int64) are separate. Slots ``[0, n)`` are in use; ``n <= capacity``
+leaves room for open boundaries to create particles. Every array has a twin buffer: reordering
+by cell gathers into the twin and the two are swapped, so nothing is allocated per step.
+
+Row layout (2D). The first ``N_SORTED_*`` rows are carried through a reorder; the others are
+recomputed after it. A 3D build adds Y, VY, AY, VWY rows; kernels name rows, never positions.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+# particle kinds
+FLUID = 0
+WALL = 1
+INLET = 2      # reserved: open-boundary buffers (issue 3)
+OUTLET = 3     # reserved
+INACTIVE = -1  # a free slot inside [0, n): skipped by every pass, sorted to the end
+
+# float rows, carried through reordering
+X, Z, VX, VZ, AX, AZ, RHO, P, M = range(9)
+# state at the start of a step, used by the two-pass symplectic predictor-corrector only
+XN, ZN, VXN, VZN, RHON = range(9, 14)
+# recomputed after every reorder: density rate, wall velocity for viscous terms (Adami no-slip)
+DRHO, VWX, VWZ = range(14, 17)
+N_FIELDS = 17
+N_SORTED_KDK = 9
+N_SORTED_PC = 14
+
+FIELD_NAMES = ("x", "z", "vx", "vz", "ax", "az", "rho", "p", "m",
+               "xn", "zn", "vxn", "vzn", "rhon", "drho", "vwx", "vwz")
+
+
+@dataclass
+class Checkpoint:
+    """An exact copy of a particle set and its clock."""
+
+    f: np.ndarray
+    kind: np.ndarray
+    ids: np.ndarray
+    n: int
+    next_id: int
+    t: float
+    dt: float
+    steps: int
+
+
+class ParticleSet:
+    """Structure-of-arrays particle storage with twin buffers and spare capacity."""
+
+    def __init__(self, capacity: int) -> None:
+        if capacity <= 0:
+            raise ValueError(f"capacity: must be > 0, got {capacity}")
+        self.capacity = int(capacity)
+        self.f = np.zeros((N_FIELDS, self.capacity))
+        self.f2 = np.zeros_like(self.f)
+        self.kind = np.full(self.capacity, INACTIVE, dtype=np.int8)
+        self.kind2 = self.kind.copy()
+        self.ids = np.full(self.capacity, -1, dtype=np.int64)
+        self.ids2 = self.ids.copy()
+        self.n = 0
+        self.next_id = 0
+
+    def add(self, x: np.ndarray, z: np.ndarray, kind: int, rho: np.ndarray, mass: np.ndarray) -> np.ndarray:
+        """Append particles at rest; return their ids."""
+        x = np.asarray(x, dtype=float)
+        k = x.size
+        if self.n + k > self.capacity:
+            raise ValueError(f"capacity: {self.capacity} too small for {self.n + k} particles")
+        s = slice(self.n, self.n + k)
+        self.f[:, s] = 0.0
+        self.f[X, s] = x
+        self.f[Z, s] = z
+        self.f[RHO, s] = rho
+        self.f[M, s] = mass
+        self.kind[s] = kind
+        new_ids = np.arange(self.next_id, self.next_id + k, dtype=np.int64)
+        self.ids[s] = new_ids
+        self.n += k
+        self.next_id += k
+        return new_ids
+
+    def swap(self) -> None:
+        """Exchange the live arrays with their twins (after a reorder into the twins)."""
+        self.f, self.f2 = self.f2, self.f
+        self.kind, self.kind2 = self.kind2, self.kind
+        self.ids, self.ids2 = self.ids2, self.ids
+
+    def field(self, row: int) -> np.ndarray:
+        """View of one field over the slots in use."""
+        return self.f[row, : self.n]
+
+    def mask(self, kind: int) -> np.ndarray:
+        return self.kind[: self.n] == kind
+
+    def count(self, kind: int) -> int:
+        return int(np.count_nonzero(self.mask(kind)))
+
+    def snapshot(self, t: float, dt: float, steps: int) -> Checkpoint:
+        n = self.n
+        return Checkpoint(self.f[:, :n].copy(), self.kind[:n].copy(), self.ids[:n].copy(),
+                          n, self.next_id, t, dt, steps)
+
+    def restore(self, c: Checkpoint) -> None:
+        if c.n > self.capacity:
+            raise ValueError("checkpoint: more particles than this set's capacity")
+        self.f[:, : c.n] = c.f
+        self.kind[: c.n] = c.kind
+        self.kind[c.n:] = INACTIVE
+        self.ids[: c.n] = c.ids
+        self.n = c.n
+        self.next_id = c.next_id

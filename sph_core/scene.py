@@ -1,0 +1,225 @@
+"""Scene description: a validated tank configuration, from TOML or Python objects.
+
+Coordinates are absolute (SPH datum): x to the right, z up, the tank floor usually at z = 0.
+Rectangles are given by their corners (x0, x1, z0, z1) in metres. Unknown keys are errors
+(``extra="forbid"``), and every error names its field path, e.g.
+``water_blocks.0.z1: must be greater than z0``.
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from pathlib import Path
+from typing import Annotated, Literal, Union
+
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+
+
+class SceneError(ValueError):
+    """A scene configuration is invalid; the message names each offending field."""
+
+
+class _Model(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class Rect(_Model):
+    """Axis-aligned rectangle [x0, x1] x [z0, z1] [m]."""
+
+    x0: float
+    x1: float
+    z0: float
+    z1: float
+
+    @model_validator(mode="after")
+    def _ordered(self) -> "Rect":
+        if not self.x1 > self.x0:
+            raise ValueError("x1: must be greater than x0")
+        if not self.z1 > self.z0:
+            raise ValueError("z1: must be greater than z0")
+        return self
+
+
+class Tank(Rect):
+    """The fluid domain: walls of dummy particles left (x0), right (x1) and below (z0).
+
+    The walls reach up to z1, which is also the top of the computational domain: a particle above
+    z1 has left the domain and stops the run."""
+
+
+class WaterBlock(Rect):
+    """A rectangle filled with fluid particles at rest, hydrostatic below its top z1."""
+
+
+class Bed(_Model):
+    """A sloping bed: a polyline (x increasing) with dummy particles in layers below it."""
+
+    points: list[tuple[float, float]] = Field(min_length=2)
+
+    @model_validator(mode="after")
+    def _increasing(self) -> "Bed":
+        xs = [p[0] for p in self.points]
+        if any(b <= a for a, b in zip(xs, xs[1:])):
+            raise ValueError("points: x must increase strictly along the polyline")
+        return self
+
+
+class Structure(Rect):
+    """A fixed rectangular structure: a shell of dummy particles one kernel support thick."""
+
+
+class Constants(_Model):
+    """Physical and numerical constants (SI)."""
+
+    rho0: float = Field(1000.0, gt=0, description="reference density [kg/m^3]")
+    g: float = Field(9.81, gt=0, description="gravity [m/s^2], acting in -z")
+    c0: float | None = Field(None, gt=0, description="speed of sound [m/s]; default c0_factor*sqrt(2 g H)")
+    c0_factor: float = Field(10.0, gt=0, description="c0 = c0_factor * sqrt(2 g H), H = water height")
+    h_over_dp: float = Field(1.3, ge=1.0, le=2.0, description="smoothing length h / dp")
+    cfl: float = Field(0.25, gt=0, le=0.5, description="Courant number of the adaptive time step")
+    alpha: float = Field(0.01, ge=0, description="Monaghan artificial viscosity coefficient")
+    nu: float = Field(1.0e-6, ge=0, description="laminar kinematic viscosity [m^2/s]")
+    delta: float = Field(0.1, ge=0, description="delta-SPH density diffusion coefficient")
+    wall_slip: Literal["no_slip", "free_slip"] = "no_slip"
+    density_band: tuple[float, float] = Field((0.7, 1.3), description="sane rho/rho0 band")
+    integrator: Literal["kdk", "symplectic_pc"] = Field(
+        "kdk", description="kdk: leapfrog, 1 force pass/step; symplectic_pc: DualSPHysics-style, 2 passes")
+
+    @model_validator(mode="after")
+    def _band(self) -> "Constants":
+        lo, hi = self.density_band
+        if not (0 < lo < 1 < hi):
+            raise ValueError("density_band: must satisfy 0 < low < 1 < high")
+        return self
+
+
+class PointProbe(_Model):
+    """Kernel-interpolated velocity (u, w) and pressure p at a point."""
+
+    kind: Literal["point"]
+    name: str = Field(min_length=1)
+    x: float
+    z: float
+
+
+class ElevationProbe(_Model):
+    """Free-surface z at a given x by the vertical-line method (seed 004, second method)."""
+
+    kind: Literal["elevation"]
+    name: str = Field(min_length=1)
+    x: float
+    threshold: float = Field(0.5, gt=0, lt=1, description="surface where sum(m W) < threshold*rho0")
+
+
+class FrontProbe(_Model):
+    """Largest x of fluid particles that have at least ``min_neighbours`` fluid neighbours."""
+
+    kind: Literal["front"]
+    name: str = Field(min_length=1)
+    min_neighbours: int = Field(3, ge=0)
+
+
+Probe = Annotated[Union[PointProbe, ElevationProbe, FrontProbe], Field(discriminator="kind")]
+
+
+class Output(_Model):
+    """Output cadence in simulated seconds (0 = never)."""
+
+    probe_every: float = Field(0.01, ge=0)
+    snapshot_every: float = Field(0.0, ge=0)
+
+
+class Scene(_Model):
+    """A complete SPH tank scene."""
+
+    name: str = "scene"
+    dp: float = Field(gt=0, description="initial particle spacing [m]")
+    t_end: float = Field(gt=0, description="end time [s]")
+    still_water_level: float | None = Field(None, description="z of the still-water level [m]")
+    tank: Tank
+    water_blocks: list[WaterBlock] = Field(min_length=1)
+    beds: list[Bed] = []
+    structures: list[Structure] = []
+    constants: Constants = Constants()
+    output: Output = Output()
+    probes: list[Probe] = []
+
+    @model_validator(mode="after")
+    def _consistent(self) -> "Scene":
+        t = self.tank
+        for i, b in enumerate(self.water_blocks):
+            if b.x0 < t.x0 - 1e-12 or b.x1 > t.x1 + 1e-12 or b.z0 < t.z0 - 1e-12 or b.z1 > t.z1:
+                raise ValueError(f"water_blocks.{i}: must lie inside the tank")
+            if min(b.x1 - b.x0, b.z1 - b.z0) < self.dp:
+                raise ValueError(f"water_blocks.{i}: must be at least dp wide and high")
+        names = [p.name for p in self.probes]
+        dup = {n for n in names if names.count(n) > 1}
+        if dup:
+            raise ValueError(f"probes: duplicate names {sorted(dup)}")
+        for i, p in enumerate(self.probes):
+            x = getattr(p, "x", None)
+            if x is not None and not (t.x0 <= x <= t.x1):
+                raise ValueError(f"probes.{i}.x: must lie inside the tank [{t.x0}, {t.x1}]")
+        if self.output.snapshot_every and self.output.snapshot_every > self.t_end:
+            raise ValueError("output.snapshot_every: must not exceed t_end")
+        return self
+
+    # derived quantities -------------------------------------------------------------------
+    @property
+    def h(self) -> float:
+        """Smoothing length h = h_over_dp * dp [m]; the kernel support is 2h."""
+        return self.constants.h_over_dp * self.dp
+
+    @property
+    def water_height(self) -> float:
+        """Highest water surface above the lowest water bottom [m] (for c0)."""
+        return max(b.z1 for b in self.water_blocks) - min(b.z0 for b in self.water_blocks)
+
+    @property
+    def c0(self) -> float:
+        """Speed of sound [m/s]: explicit, or c0_factor * sqrt(2 g H)."""
+        c = self.constants
+        return c.c0 if c.c0 is not None else c.c0_factor * math.sqrt(2.0 * c.g * self.water_height)
+
+
+def _format_errors(exc: ValidationError) -> str:
+    lines = []
+    for err in exc.errors():
+        loc = [str(p) for p in err["loc"] if p not in ("function-after",)]
+        # discriminated unions add the tag name to the path: drop it
+        loc = [p for p in loc if p not in ("point", "elevation", "front")]
+        msg = err["msg"].removeprefix("Value error, ")
+        if ": " in msg and not msg.startswith(("Input", "Field")):
+            head, tail = msg.split(": ", 1)
+            if head.split(".")[0] in {"x0", "x1", "z0", "z1", "points", "density_band"}:
+                loc.append(head)
+                msg = tail
+            elif loc == [] or "." in head or head in {"probes", "output.snapshot_every"}:
+                loc = head.split(".") if not loc else loc + head.split(".")
+                msg = tail
+        lines.append(f"{'.'.join(loc) or '<scene>'}: {msg}")
+    return "; ".join(lines)
+
+
+def make_scene(data: dict) -> Scene:
+    """Validate a plain dict (e.g. parsed TOML) into a Scene; raise SceneError naming the fields."""
+    try:
+        return Scene.model_validate(data)
+    except ValidationError as exc:
+        raise SceneError(f"invalid scene: {_format_errors(exc)}") from None
+
+
+def load_scene(path: str | Path) -> Scene:
+    """Read a TOML scene file into a validated Scene."""
+    path = Path(path)
+    try:
+        data = tomllib.loads(path.read_text())
+    except FileNotFoundError:
+        raise SceneError(f"scene file not found: {path}") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise SceneError(f"{path}: not valid TOML ({exc})") from None
+    try:
+        return make_scene(data)
+    except SceneError as exc:
+        raise SceneError(f"{path}: {exc}") from None

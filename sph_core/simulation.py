@@ -1,0 +1,349 @@
+"""A Simulation owns the particles, the clock, the probes and the run directory.
+
+    sim = Simulation(scene, run_dir=None)   # run_dir: CSV probes, VTK snapshots, meta.json
+    sim.advance_to(t_end, progress=None)    # raises UnstableError(step, t, cause)
+    sim.checkpoint() -> Checkpoint; sim.restore(c)   # exact state copy (protocol `goback`)
+    sim.probe_values() -> dict[str, float | None]    # configured probes at the current state
+
+The time loop itself is one jitted call (``wcsph.advance``) that runs until the next output
+time; Python only handles probes, snapshots, metadata and the progress callback.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from pathlib import Path
+from typing import Any, Callable
+
+import numba
+import numpy as np
+
+from . import wcsph
+from .eos import hydrostatic_density, tait_b
+from .geometry import build_layout
+from .kernels import wendland_alpha
+from .neighbours import CellGrid
+from .output import RunWriter
+from .particles import (DRHO, FLUID, M, N_FIELDS, P, RHO, VX, VZ, WALL, X, Z, Checkpoint,
+                        ParticleSet)
+from .probes import (fluid_neighbour_counts, interpolate_points, line_mass_density,
+                     surface_from_line)
+from .scene import ElevationProbe, FrontProbe, PointProbe, Scene
+
+STEPS_PER_CALL = 200  # steps per jitted call between progress callbacks
+
+
+class UnstableError(RuntimeError):
+    """The run became unstable; ``step``, ``t`` and ``cause`` say when and why."""
+
+    def __init__(self, step: int, t: float, cause: str) -> None:
+        super().__init__(f"unstable at step {step}, t = {t:.6g} s: {cause}")
+        self.step = step
+        self.t = t
+        self.cause = cause
+
+
+class Simulation:
+    """WCSPH run of one scene; see the module docstring for the contract."""
+
+    def __init__(self, scene: Scene, run_dir: str | Path | None = None, spare: float = 0.1) -> None:
+        self.scene = scene
+        c = scene.constants
+        layout = build_layout(scene)
+        dp, h = scene.dp, scene.h
+        self.h = h
+        self.c0 = scene.c0
+        self.b = tait_b(c.rho0, self.c0)
+        n = layout.wall_x.size + layout.fluid_x.size
+        self.particles = ps = ParticleSet(max(int(n * (1.0 + spare)), n + 1))
+        vol = dp * dp
+        ps.add(layout.wall_x, layout.wall_z, WALL, np.full(layout.wall_x.size, c.rho0),
+               np.full(layout.wall_x.size, c.rho0 * vol))
+        rho_f = hydrostatic_density(layout.fluid_z, layout.fluid_surface, c.rho0, c.g, self.b)
+        # mass = rho * dp^2: the lattice is the compressed hydrostatic state, so the initial
+        # pressure is hydrostatic and the particle volume is exactly dp^2
+        ps.add(layout.fluid_x, layout.fluid_z, FLUID, rho_f, rho_f * vol)
+        self.n_layers = layout.n_layers
+        t = scene.tank
+        wall = layout.n_layers * dp
+        self.grid = CellGrid.covering(t.x0 - wall, t.x1 + wall, t.z0 - wall, t.z1, 2.0 * h)
+        aw = wendland_alpha(h)
+        prm = np.zeros(wcsph.N_PRM)
+        prm[wcsph.PR_H] = h
+        prm[wcsph.PR_ALPHA_W] = aw
+        prm[wcsph.PR_ALPHA_F] = 5.0 * aw / (h * h)
+        prm[wcsph.PR_RHO0] = c.rho0
+        prm[wcsph.PR_C0] = self.c0
+        prm[wcsph.PR_B] = self.b
+        prm[wcsph.PR_GAMMA] = 7.0
+        prm[wcsph.PR_GX] = 0.0
+        prm[wcsph.PR_GZ] = -c.g
+        prm[wcsph.PR_ALPHA] = c.alpha
+        prm[wcsph.PR_NU] = c.nu
+        prm[wcsph.PR_DELTA] = c.delta
+        prm[wcsph.PR_CFL] = c.cfl
+        prm[wcsph.PR_RHO_LO], prm[wcsph.PR_RHO_HI] = c.density_band
+        prm[wcsph.PR_NOSLIP] = 1.0 if c.wall_slip == "no_slip" else 0.0
+        prm[wcsph.PR_FX0], prm[wcsph.PR_FX1] = t.x0, t.x1
+        prm[wcsph.PR_FZ0], prm[wcsph.PR_FZ1] = t.z0, t.z1
+        prm[wcsph.PR_XMIN], prm[wcsph.PR_ZMIN] = self.grid.xmin, self.grid.zmin
+        prm[wcsph.PR_INV_CS] = 1.0 / self.grid.cs
+        self.prm = prm
+        self.integrator = wcsph.INTEGRATORS[c.integrator]
+        self.passes_per_step = wcsph.PASSES_PER_STEP[c.integrator]
+        cap = ps.capacity
+        self.cell = np.zeros(cap, dtype=np.int64)
+        self.cell2 = np.zeros(cap, dtype=np.int64)
+        self.order = np.zeros(cap, dtype=np.int64)
+        self.cell_start = np.zeros(self.grid.ncell + 2, dtype=np.int64)
+        self.cursor = np.zeros(self.grid.ncell + 1, dtype=np.int64)
+        self._counts = np.zeros(cap, dtype=np.int64)
+        self.dt = float(wcsph.initialise(*self._arrays(), ps.n, prm, self.grid.ncx, self.grid.ncz))
+        self._swap()
+        self.t = 0.0
+        self.steps = 0
+        self.wall_time = 0.0
+        self.v_max = 0.0
+        self.fluid_mass0 = self.fluid_mass()
+        # probes
+        self._points = [p for p in scene.probes if isinstance(p, PointProbe)]
+        self._elev = [p for p in scene.probes if isinstance(p, ElevationProbe)]
+        self._fronts = [p for p in scene.probes if isinstance(p, FrontProbe)]
+        self._px = np.array([p.x for p in self._points], dtype=float)
+        self._pz = np.array([p.z for p in self._points], dtype=float)
+        self._pout = np.zeros((len(self._points), 4))
+        nz = int(math.floor((t.z1 - t.z0) / (0.5 * dp)))
+        self._line_z = t.z0 + (np.arange(nz) + 0.5) * 0.5 * dp
+        self._line_rho = np.zeros(self._line_z.size)
+        self.history: list[dict[str, float | None]] = []
+        self._k_probe = 0
+        self._k_snap = 0
+        self.status = "created"
+        self.writer: RunWriter | None = None
+        if run_dir is not None:
+            self.writer = RunWriter(run_dir, self.probe_columns(), scene.model_dump(mode="json"))
+            self.writer.update_meta(**self._meta_fields())
+        self._record_outputs()
+
+    # ---------------------------------------------------------------- state access
+    def _arrays(self) -> tuple:
+        ps = self.particles
+        return (ps.f, ps.f2, ps.kind, ps.kind2, ps.ids, ps.ids2, self.cell, self.cell2, self.order,
+                self.cell_start, self.cursor)
+
+    def _swap(self) -> None:
+        self.particles.swap()
+        self.cell, self.cell2 = self.cell2, self.cell
+
+    @property
+    def n_particles(self) -> int:
+        """Particles in use (fluid + wall + buffers)."""
+        return int(np.count_nonzero(self.particles.kind[: self.particles.n] >= 0))
+
+    @property
+    def n_fluid(self) -> int:
+        return self.particles.count(FLUID)
+
+    def fluid_mass(self) -> float:
+        ps = self.particles
+        return float(ps.field(M)[ps.mask(FLUID)].sum())
+
+    def fluid_state(self) -> dict[str, np.ndarray]:
+        """Copies of the fluid particles' fields, ordered by particle id."""
+        ps = self.particles
+        sel = ps.mask(FLUID)
+        order = np.argsort(ps.ids[: ps.n][sel])
+        out = {name: ps.field(row)[sel][order].copy() for name, row in
+               (("x", X), ("z", Z), ("vx", VX), ("vz", VZ), ("rho", RHO), ("p", P), ("m", M))}
+        out["id"] = ps.ids[: ps.n][sel][order].copy()
+        return out
+
+    # ---------------------------------------------------------------- probes
+    def probe_columns(self) -> list[str]:
+        cols: list[str] = []
+        for p in self._points:
+            cols += [f"{p.name}_u", f"{p.name}_w", f"{p.name}_p"]
+        for p in self._elev:
+            cols.append(f"{p.name}_z_surface")
+            if self.scene.still_water_level is not None:
+                cols.append(f"{p.name}_eta")
+        for p in self._fronts:
+            cols.append(f"{p.name}_x")
+        return cols
+
+    def probe_values(self) -> dict[str, float | None]:
+        """Configured probes at the current state [SI]; None marks a dry probe."""
+        g = self.grid
+        f, kind = self.particles.f, self.particles.kind
+        aw = self.prm[wcsph.PR_ALPHA_W]
+        out: dict[str, float | None] = {}
+        if self._points:
+            interpolate_points(f, kind, self.cell_start, self._px, self._pz, self.h, aw, g.xmin,
+                               g.zmin, 1.0 / g.cs, g.ncx, g.ncz, self._pout)
+            for k, p in enumerate(self._points):
+                wet = self._pout[k, 3] > 0.05
+                for j, suffix in enumerate(("u", "w", "p")):
+                    out[f"{p.name}_{suffix}"] = float(self._pout[k, j]) if wet else None
+        rho0 = self.scene.constants.rho0
+        for p in self._elev:
+            line_mass_density(f, kind, self.cell_start, float(p.x), self._line_z, self.h, aw,
+                              g.xmin, g.zmin, 1.0 / g.cs, g.ncx, g.ncz, self._line_rho)
+            zs = surface_from_line(self._line_z, self._line_rho, p.threshold * rho0)
+            out[f"{p.name}_z_surface"] = zs
+            swl = self.scene.still_water_level
+            if swl is not None:
+                out[f"{p.name}_eta"] = None if zs is None else zs - swl
+        if self._fronts:
+            ps = self.particles
+            fluid_neighbour_counts(f, kind, self.cell, self.cell_start, ps.n, self.h, g.ncx,
+                                   g.ncz, self._counts)
+            counts = self._counts[: ps.n]
+            x = ps.field(X)
+            for p in self._fronts:
+                sel = counts >= p.min_neighbours
+                out[f"{p.name}_x"] = float(x[sel].max()) if sel.any() else None
+        return out
+
+    # ---------------------------------------------------------------- outputs
+    def _meta_fields(self) -> dict[str, Any]:
+        return {"status": self.status, "t": self.t, "steps": self.steps,
+                "wall_time_s": round(self.wall_time, 3), "dt": self.dt,
+                "n_particles": self.n_particles, "n_fluid": self.n_fluid,
+                "c0": self.c0, "h": self.h, "integrator": self.scene.constants.integrator,
+                "passes_per_step": self.passes_per_step, "threads": numba.get_num_threads(),
+                "particle_steps_per_s": (self.n_particles * self.steps / self.wall_time
+                                         if self.wall_time > 0 else None)}
+
+    def _record_outputs(self) -> None:
+        """Probes and snapshots whose time has come (t = k * cadence)."""
+        o = self.scene.output
+        eps = 1e-9 * max(self.dt, 1e-12)
+        if o.probe_every > 0 and self.t >= self._k_probe * o.probe_every - eps:
+            values = self.probe_values()
+            self.history.append({"t": self.t, **values})
+            if self.writer:
+                self.writer.probe_row(self.t, self.steps, values)
+            self._k_probe = int(math.floor(self.t / o.probe_every + 1e-6)) + 1
+        if self.writer and o.snapshot_every > 0 and self.t >= self._k_snap * o.snapshot_every - eps:
+            self.write_snapshot()
+            self._k_snap = int(math.floor(self.t / o.snapshot_every + 1e-6)) + 1
+
+    def write_snapshot(self) -> None:
+        if self.writer is None:
+            raise RuntimeError("write_snapshot: this simulation has no run_dir")
+        ps = self.particles
+        sel = ps.kind[: ps.n] >= 0
+        fld = {name: ps.field(row)[sel] for name, row in
+               (("rho", RHO), ("pressure", P), ("vx", VX), ("vz", VZ))}
+        fld["kind"] = ps.kind[: ps.n][sel].astype(np.int32)
+        fld["id"] = ps.ids[: ps.n][sel].astype(np.int64)
+        fld["speed"] = np.hypot(fld["vx"], fld["vz"])
+        self.writer.snapshot(self.t, ps.field(X)[sel], ps.field(Z)[sel], fld)
+
+    def _next_output_time(self, t_target: float) -> float:
+        o = self.scene.output
+        t_next = t_target
+        if o.probe_every > 0:
+            t_next = min(t_next, self._k_probe * o.probe_every)
+        if self.writer and o.snapshot_every > 0:
+            t_next = min(t_next, self._k_snap * o.snapshot_every)
+        return t_next
+
+    # ---------------------------------------------------------------- time loop
+    def advance_to(self, t_end: float, progress: Callable[["Simulation"], None] | None = None) -> None:
+        """Advance to time ``t_end`` [s], recording outputs on their cadence.
+
+        Raises UnstableError (status ``unstable`` in meta.json) if the guard trips; the outputs
+        written so far stay on disk."""
+        if not math.isfinite(t_end):
+            raise ValueError(f"t_end: must be finite, got {t_end}")
+        if self.status == "unstable":
+            raise RuntimeError("advance_to: the run is unstable; restore a checkpoint first")
+        self.status = "running"
+        try:
+            while self.t < t_end:
+                t_stop = self._next_output_time(t_end)
+                tic = time.perf_counter()
+                ps = self.particles
+                t, dt, steps, status, swapped, n_flag, vmax = wcsph.advance(
+                    *self._arrays(), ps.n, self.prm, self.grid.ncx, self.grid.ncz,
+                    self.integrator, self.t, self.dt, t_stop, STEPS_PER_CALL)
+                self.wall_time += time.perf_counter() - tic
+                if swapped:
+                    self._swap()
+                self.t, self.dt, self.steps, self.v_max = float(t), float(dt), self.steps + steps, vmax
+                if status not in (wcsph.ST_REACHED_T, wcsph.ST_STEP_LIMIT):
+                    self._fail_unstable(status, n_flag)
+                self._record_outputs()
+                if progress is not None:
+                    progress(self)
+            self.status = "completed" if self.t >= self.scene.t_end else "paused"
+        except UnstableError:
+            raise
+        except BaseException as exc:  # keep the record honest on Ctrl-C or a bug
+            self.status = "interrupted" if isinstance(exc, KeyboardInterrupt) else "failed"
+            if self.writer:
+                self.writer.update_meta(**self._meta_fields(), cause=repr(exc))
+            raise
+        if self.writer:
+            self.writer.update_meta(**self._meta_fields())
+
+    def _fail_unstable(self, status: int, n_flag: int) -> None:
+        ps = self.particles
+        sel = ps.mask(FLUID)
+        x, z, rho = ps.field(X)[sel], ps.field(Z)[sel], ps.field(RHO)[sel]
+        ids = ps.ids[: ps.n][sel]
+        cause = wcsph.STATUS_TEXT[status]
+        if status == wcsph.ST_DENSITY:
+            lo, hi = self.scene.constants.density_band
+            bad = np.nonzero((rho < lo * self.scene.constants.rho0) | (rho > hi * self.scene.constants.rho0))[0]
+            cause += f" [{lo}, {hi}] rho0"
+        elif status == wcsph.ST_LEFT_DOMAIN:
+            t = self.scene.tank
+            bad = np.nonzero(~((x >= t.x0) & (x <= t.x1) & (z >= t.z0) & (z <= t.z1)))[0]
+        else:
+            v = np.hypot(ps.field(VX)[sel], ps.field(VZ)[sel])
+            bad = np.nonzero(~(np.isfinite(v) & np.isfinite(rho)))[0]
+        cause += f": {n_flag} particle(s)"
+        if bad.size:
+            k = bad[0]
+            cause += f", e.g. id {ids[k]} at x={x[k]:.4g} z={z[k]:.4g} rho={rho[k]:.6g}"
+        self.status = "unstable"
+        if self.writer:
+            self.writer.update_meta(**self._meta_fields(), cause=cause, unstable_step=self.steps,
+                                    unstable_t=self.t)
+        raise UnstableError(self.steps, self.t, cause)
+
+    # ---------------------------------------------------------------- checkpoints
+    def checkpoint(self) -> Checkpoint:
+        """An exact copy of the state (particles, clock, dt)."""
+        return self.particles.snapshot(self.t, self.dt, self.steps)
+
+    def restore(self, c: Checkpoint) -> None:
+        """Return exactly to a checkpoint; the cell lists are rebuilt for its particle order."""
+        self.particles.restore(c)
+        self.t, self.dt, self.steps = c.t, c.dt, c.steps
+        self._rebuild_cells()
+        self.status = "paused"
+        o = self.scene.output
+        self._k_probe = int(math.floor(self.t / o.probe_every + 1e-9)) + 1 if o.probe_every else 0
+        self._k_snap = (int(math.floor(self.t / o.snapshot_every + 1e-9)) + 1
+                        if o.snapshot_every else 0)
+
+    def _rebuild_cells(self) -> None:
+        """Cell lists for the current order without moving particles (for probes after restore)."""
+        from .neighbours import compute_cells, counting_sort
+
+        ps, g = self.particles, self.grid
+        compute_cells(ps.f[X], ps.f[Z], ps.kind, ps.n, g.xmin, g.zmin, 1.0 / g.cs, g.ncx, g.ncz,
+                      self.cell)
+        counting_sort(self.cell, ps.n, g.ncell, self.cell_start, self.cursor, self.order)
+        if not np.array_equal(self.order[: ps.n], np.arange(ps.n)):
+            # the checkpoint was not taken in cell order (cannot happen for our own checkpoints)
+            raise RuntimeError("restore: checkpoint particles are not sorted by cell")
+
+    def close(self) -> None:
+        if self.writer:
+            self.writer.update_meta(**self._meta_fields())
+            self.writer.close()
