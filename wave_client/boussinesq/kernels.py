@@ -138,6 +138,52 @@ def shapiro_filter(f: np.ndarray, work: np.ndarray, i_end: int) -> None:
 
 
 @njit(cache=True)
+def rk4_step(t0: float, dt: float, eta: np.ndarray, u: np.ndarray, uu: np.ndarray,
+             e0: np.ndarray, f0: np.ndarray, h: np.ndarray, coef_a: np.ndarray, coef_b: np.ndarray,
+             lower: np.ndarray, cprime: np.ndarray, minv: np.ndarray, sponge: np.ndarray,
+             src_shape: np.ndarray, src_amp: np.ndarray, src_omega: np.ndarray, src_phase: np.ndarray,
+             src_ramp: float, g: float, dx: float, i_fix: int, eta_fix: float, u_fix: float,
+             eta_s: np.ndarray, u_s: np.ndarray, uu_s: np.ndarray, ke: np.ndarray, kf: np.ndarray,
+             acc_e: np.ndarray, acc_f: np.ndarray, work_q: np.ndarray, work_d: np.ndarray) -> None:
+    """One classical Runge-Kutta step of (eta, U) from t0; starts the multistep history.
+
+    e0, f0 hold R(t0); on return eta, u, uu are at t0 + dt (R at t0 + dt is not evaluated).
+    """
+    n = eta.size
+    i_fix_p = i_fix + NG
+    for i in range(NG, n - NG):
+        acc_e[i] = e0[i]
+        acc_f[i] = f0[i]
+        ke[i] = e0[i]
+        kf[i] = f0[i]
+    for stage in range(3):
+        frac = 1.0 if stage == 2 else 0.5
+        weight = 1.0 if stage == 2 else 2.0
+        for i in range(NG, n - NG):
+            eta_s[i] = eta[i] + frac * dt * ke[i]
+            uu_s[i] = uu[i] + frac * dt * kf[i]
+        for i in range(i_fix_p, n - NG):
+            eta_s[i] = eta_fix
+            uu_s[i] = u_fix
+        thomas_solve(lower, cprime, minv, uu_s, u_s, NG)
+        fill_ghosts(eta_s, u_s)
+        ts = t0 + frac * dt
+        src = source_signal(ts, src_amp, src_omega, src_phase, src_ramp)
+        rhs(eta_s, u_s, h, coef_a, coef_b, sponge, src_shape, src, g, dx, i_fix, work_q, work_d, ke, kf)
+        for i in range(NG, n - NG):
+            acc_e[i] += weight * ke[i]
+            acc_f[i] += weight * kf[i]
+    for i in range(NG, n - NG):
+        eta[i] += dt / 6.0 * acc_e[i]
+        uu[i] += dt / 6.0 * acc_f[i]
+    for i in range(i_fix_p, n - NG):
+        eta[i] = eta_fix
+        uu[i] = u_fix
+    thomas_solve(lower, cprime, minv, uu, u, NG)
+    fill_ghosts(eta, u)
+
+
+@njit(cache=True)
 def advance_steps(n_steps: int, t0: float, dt: float, n_hist: int, tol: float, max_iter: int,
                   filter_every: int, step0: int,
                   eta: np.ndarray, u: np.ndarray, uu: np.ndarray, e_hist: np.ndarray, f_hist: np.ndarray,
@@ -156,8 +202,8 @@ def advance_steps(n_steps: int, t0: float, dt: float, n_hist: int, tol: float, m
     Predictor (AB3):  f* = f^n + dt/12 (23 R^n - 16 R^{n-1} + 5 R^{n-2})
     Corrector (AM4):  f^(k+1) = f^n + dt/24 (9 R^(k) + 19 R^n - 5 R^{n-1} + R^{n-2}),
     iterated until sum|d eta|/sum|eta| and sum|d u|/sum|u| between successive iterates are below
-    `tol` (Wei & Kirby 1995), for f = (eta, U), R = (E, F). The first two steps use the
-    lower-order pairs AB1/AM2 and AB2/AM3 (history length n_hist < 3).
+    `tol` (Wei & Kirby 1995), for f = (eta, U), R = (E, F). While the history is shorter than
+    three levels (start, or after the state was set), classical RK4 steps fill it.
 
     e_hist, f_hist: (3, n) with rows R^n, R^{n-1}, R^{n-2}, filled for the first n_hist rows.
     i_fix: first model node held at (eta_fix, u_fix) (two-way coupling), or the node count.
@@ -166,17 +212,30 @@ def advance_steps(n_steps: int, t0: float, dt: float, n_hist: int, tol: float, m
     """
     n = eta.size
     i_fix_p = i_fix + NG  # padded index
+    p0, p1, p2 = 23.0 / 12.0, -16.0 / 12.0, 5.0 / 12.0
+    c_new, c0, c1, c2 = 9.0 / 24.0, 19.0 / 24.0, -5.0 / 24.0, 1.0 / 24.0
     for step in range(n_steps):
         t1 = t0 + (step + 1) * dt
-        if n_hist >= 3:
-            p0, p1, p2 = 23.0 / 12.0, -16.0 / 12.0, 5.0 / 12.0
-            c_new, c0, c1, c2 = 9.0 / 24.0, 19.0 / 24.0, -5.0 / 24.0, 1.0 / 24.0
-        elif n_hist == 2:
-            p0, p1, p2 = 1.5, -0.5, 0.0
-            c_new, c0, c1, c2 = 5.0 / 12.0, 8.0 / 12.0, -1.0 / 12.0, 0.0
-        else:
-            p0, p1, p2 = 1.0, 0.0, 0.0
-            c_new, c0, c1, c2 = 0.5, 0.5, 0.0, 0.0
+        if n_hist < 3:
+            # start (or restart) the history with 4th-order Runge-Kutta steps
+            rk4_step(t1 - dt, dt, eta, u, uu, e_hist[0], f_hist[0], h, coef_a, coef_b, lower, cprime,
+                     minv, sponge, src_shape, src_amp, src_omega, src_phase, src_ramp, g, dx,
+                     i_fix, eta_fix, u_fix, eta_new, u_new, uu_new, e_new, f_new, eta_prev, u_prev,
+                     work_q, work_d)
+            src = source_signal(t1, src_amp, src_omega, src_phase, src_ramp)
+            rhs(eta, u, h, coef_a, coef_b, sponge, src_shape, src, g, dx, i_fix,
+                work_q, work_d, e_new, f_new)
+            for i in range(NG, n - NG):
+                e_hist[2, i] = e_hist[1, i]
+                e_hist[1, i] = e_hist[0, i]
+                e_hist[0, i] = e_new[i]
+                f_hist[2, i] = f_hist[1, i]
+                f_hist[1, i] = f_hist[0, i]
+                f_hist[0, i] = f_new[i]
+            n_hist += 1
+            if not np.isfinite(eta[NG]):
+                return -(step + 1)
+            continue
         # predictor
         for i in range(NG, n - NG):
             eta_new[i] = eta[i] + dt * (p0 * e_hist[0, i] + p1 * e_hist[1, i] + p2 * e_hist[2, i])
@@ -237,8 +296,6 @@ def advance_steps(n_steps: int, t0: float, dt: float, n_hist: int, tol: float, m
             eta[i] = eta_new[i]
             u[i] = u_new[i]
             uu[i] = uu_new[i]
-        if n_hist < 3:
-            n_hist += 1
         if filter_every > 0 and (step0 + step + 1) % filter_every == 0:
             end = min(n - NG, i_fix_p)
             shapiro_filter(eta, work_q, end)

@@ -1,0 +1,143 @@
+"""Physics of the Nwogu Boussinesq model: dispersion, generation, solitary wave, convergence.
+
+References (nobody tuned): Nwogu's linear dispersion relation and Airy theory
+(wave_client.boussinesq.dispersion), the solitary-wave speed sqrt(g (d + H)), the target
+amplitude of the Wei-Kirby-Sinha source function.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.optimize import curve_fit
+
+from wave_client.boussinesq import BoussinesqModel, airy_celerity, nwogu_celerity, nwogu_wavenumber
+
+G = 9.81
+
+
+def standing_wave_speed(kd: float, depth: float, ppw: int = 32) -> float:
+    """Phase speed omega/k of a small standing wave eta = a cos(kx) cos(omega t) in a closed tank
+    one wavelength long (the walls mirror the mode exactly), from a fit of the wall series."""
+    k = kd / depth
+    wl = 2 * np.pi / k
+    m = BoussinesqModel(0.0, wl, wl / ppw, depth, courant=0.25)
+    a = 1e-4 * depth
+    m.set_state(a * np.cos(k * m.x), np.zeros_like(m.x))
+    omega0 = k * float(nwogu_celerity(kd, depth))
+    n = int(round(3 * 2 * np.pi / omega0 / m.dt))
+    ts, es = np.empty(n), np.empty(n)
+    for i in range(n):
+        m.advance_steps(1)
+        ts[i], es[i] = m.t, m.eta_nodes[0]
+    (omega, _, _), _ = curve_fit(lambda t, w, amp, ph: amp * np.cos(w * t + ph), ts, es, p0=[omega0, a, 0.0])
+    return omega / k
+
+
+@pytest.mark.parametrize("kd", [0.5, 1.0, 2.0, 3.0])
+def test_linear_dispersion_matches_nwogu_and_airy(kd):
+    depth = 0.7
+    c = standing_wave_speed(kd, depth)
+    c_nwogu = float(nwogu_celerity(kd, depth))
+    c_airy = float(airy_celerity(kd, depth))
+    assert abs(c / c_nwogu - 1) < 0.01
+    # Against Airy: within Nwogu's own error of the relation, plus 0.2 % for the discretisation.
+    assert abs(c / c_airy - 1) <= abs(c_nwogu / c_airy - 1) + 0.002
+
+
+def fit_harmonic(t: np.ndarray, y: np.ndarray, omega: float) -> tuple[float, float]:
+    """Amplitude and phase phi of y = A cos(omega t - phi) by least squares."""
+    basis = np.c_[np.cos(omega * t), np.sin(omega * t)]
+    (cc, ss), *_ = np.linalg.lstsq(basis, y, rcond=None)
+    return float(np.hypot(cc, ss)), float(np.arctan2(ss, cc))
+
+
+@pytest.mark.parametrize("depth,period", [(0.5, 2.0), (0.5, 0.9)])
+def test_source_function_generates_target_wave(depth, period):
+    """Small regular waves from the source: amplitude H/2 and phase k|x - x_s| at gauges on both
+    sides, and no standing-wave modulation (the sponges absorb)."""
+    height = 0.002
+    omega = 2 * np.pi / period
+    k = float(nwogu_wavenumber(omega, depth))
+    wl = 2 * np.pi / k
+    m = BoussinesqModel(-3 * wl, 6 * wl, wl / 40, depth, sponge_left=1.5 * wl, sponge_right=1.5 * wl)
+    m.set_regular_wave(0.0, height, period, ramp_periods=2)
+    xs = np.array([-wl, 0.75 * wl, 1.5 * wl, 2.25 * wl, 3.0 * wl])
+    m.advance_to(20 * period)
+    n = int(round(20 * period / m.dt / 4))
+    ts, es = np.empty(n), np.empty((n, xs.size))
+    for i in range(n):
+        m.advance_steps(4)
+        ts[i], es[i] = m.t, m.elevation(xs)
+    for j, x in enumerate(xs):
+        amp, phase = fit_harmonic(ts, es[:, j], omega)
+        assert amp == pytest.approx(height / 2, rel=0.01), f"amplitude at x = {x:.3f} m"
+        dphi = np.angle(np.exp(1j * (phase - k * abs(x))))
+        assert abs(dphi) < 0.02, f"phase at x = {x:.3f} m"
+
+
+def test_solitary_wave_keeps_height_and_speed():
+    """H/d = 0.1 over 50 depths (flat bed). Initialised with the KdV-type profile
+    eta = H sech^2(sqrt(3H/(4d^3)) (x - x0)), u_alpha = c eta / (d + eta); the main crest settles
+    within the first depths (it sheds a small tail) and then keeps its height."""
+    d, height = 1.0, 0.1
+    kappa = np.sqrt(3 * height / (4 * d**3))
+    c = np.sqrt(G * (d + height))
+    m = BoussinesqModel(0.0, 90.0 * d, 0.05 * d, d)
+    x0 = 15.0 * d
+    eta = height / np.cosh(kappa * (m.x - x0)) ** 2
+    m.set_state(eta, c * eta / (d + eta))
+    t_end = 50.0 * d / c
+    rec = []
+    for i in range(1, 41):
+        m.advance_to(i * t_end / 40)
+        j = int(np.argmax(m.eta_nodes))
+        a2, a1, a0 = np.polyfit(m.x[j - 1:j + 2] - m.x[j], m.eta_nodes[j - 1:j + 2], 2)
+        rec.append((m.t, m.x[j] - a1 / (2 * a2), a0 - a1 * a1 / (4 * a2)))
+    t, xc, hc = np.array(rec).T
+    assert xc[-1] - xc[0] > 48 * d  # it did travel ~50 depths
+    assert np.all(np.abs(hc / height - 1) < 0.02)
+    speed = np.polyfit(t[20:], xc[20:], 1)[0]
+    assert speed == pytest.approx(c, rel=0.01)
+    assert abs(hc[-1] / hc[20] - 1) < 0.002  # the settled crest keeps its height
+
+
+def standing_wave_run(kd: float, ppw: int, n_steps: int) -> tuple[np.ndarray, np.ndarray]:
+    """Linear standing wave (a = 1e-10 d, so nonlinear terms are negligible) in a closed tank one
+    wavelength long, run to t = 3.25 periods (where phase errors show): (eta / a, exact / a)
+    with the exact solution cos(kx) cos(omega t), omega from Nwogu's dispersion relation."""
+    depth = 1.0
+    k = kd / depth
+    wl = 2 * np.pi / k
+    omega = k * float(nwogu_celerity(kd, depth))
+    t_end = 3.25 * 2 * np.pi / omega
+    m = BoussinesqModel(0.0, wl, wl / ppw, depth, dt=t_end / n_steps, tol=1e-12, max_iter=50)
+    a = 1e-10 * depth
+    m.set_state(a * np.cos(k * m.x), np.zeros_like(m.x))
+    m.advance_steps(n_steps)
+    return m.eta_nodes / a, np.cos(k * m.x) * np.cos(omega * m.t)
+
+
+def steps_for(ppw: int, courant: float, kd: float = 1.0) -> int:
+    wl = 2 * np.pi / kd
+    t_end = 3.25 * 2 * np.pi / (kd / 1.0 * float(nwogu_celerity(kd, 1.0)))
+    return int(np.ceil(t_end / (courant * wl / ppw / np.sqrt(G))))
+
+
+def test_convergence_order_space_and_time():
+    """dx and dt halved together: the error falls at 2nd order, the order of the 3-point dispersive
+    terms (Wei & Kirby 1995: truncation O(dx^4, dx^2 mu^2); first derivatives are 4th order, so
+    coarse grids show a steeper, 4th-order-dominated fall). dt halved alone on a fixed grid: the
+    iterated ABM corrector (RK4 start) converges at 4th order."""
+    n0 = steps_for(40, 0.4)
+    e = []
+    for r in (1, 2, 4):
+        eta, exact = standing_wave_run(1.0, 40 * r, n0 * r)
+        e.append(np.max(np.abs(eta - exact)))
+    orders = np.log2(np.array(e[:-1]) / np.array(e[1:]))
+    assert np.all((orders > 1.7) & (orders < 2.5)), (e, orders)
+    # time alone: the exact solution of the semi-discrete system is replaced by a 16x finer step
+    n1 = steps_for(40, 0.8)
+    ref, _ = standing_wave_run(1.0, 40, 16 * n1)
+    et = [np.max(np.abs(standing_wave_run(1.0, 40, r * n1)[0] - ref)) for r in (1, 2)]
+    assert np.log2(et[0] / et[1]) > 3.7, et
