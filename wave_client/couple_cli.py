@@ -1,0 +1,125 @@
+"""`wavesph couple`: drive a wave model against a running SPH server.
+
+    wavesph couple --url ws://127.0.0.1:8000/runs/r1/couple --model stokes --H 0.08 --T 2
+    wavesph couple --url tcp://127.0.0.1:8766 --run-id r1 --model irregular --H 0.15 --T 2 \
+                   --output gauges.csv
+
+The still-water depth defaults to the scene's (sent by the server in WELCOME); --d is checked
+against it. Exit status: 0 done, 1 the coupled run failed (reason on stderr), 2 bad arguments.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from typing import Any
+
+from protocol import Welcome
+
+THEORY_MODELS = ("linear", "stokes", "stream", "standing", "irregular")
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    p = parser
+    p.add_argument("--url", required=True,
+                   help="ws://HOST:PORT/runs/ID/couple or tcp://HOST:PORT (then give --run-id)")
+    p.add_argument("--model", required=True, choices=THEORY_MODELS + ("boussinesq",),
+                   help="wave model driving the SPH inlet")
+    p.add_argument("--H", type=float, help="wave height [m] (irregular: significant height Hs)")
+    p.add_argument("--T", type=float, help="wave period [s] (irregular: peak period Tp)")
+    p.add_argument("--d", type=float, default=None,
+                   help="still-water depth [m]; default: the scene's depth at the inlet")
+    p.add_argument("--ramp-periods", type=float, default=2.0,
+                   help="half-cosine start-up ramp, in wave periods (the flume starts at rest)")
+    p.add_argument("--order", type=int, default=5, help="Stokes order, 2-5 (--model stokes)")
+    p.add_argument("--n-fourier", type=int, default=10, help="Fourier modes (--model stream)")
+    p.add_argument("--gamma", type=float, default=3.3, help="JONSWAP peak enhancement (irregular)")
+    p.add_argument("--components", type=int, default=200, help="wave components (irregular)")
+    p.add_argument("--seed", type=int, default=0, help="random phases seed (irregular)")
+    p.add_argument("--config", default=None,
+                   help="Boussinesq model configuration file (--model boussinesq)")
+    p.add_argument("--window", type=float, default=None,
+                   help="coupling window [s]; default min(server window_max, T/50)")
+    p.add_argument("--t-end", type=float, default=None, help="stop at this time [s]")
+    p.add_argument("--no-absorb", action="store_true",
+                   help="do not apply the seed 002 active-absorption correction")
+    p.add_argument("--x-offset", type=float, default=0.0,
+                   help="model x = SPH x + offset [m]")
+    p.add_argument("--inlet-gauge", type=int, default=None,
+                   help="gauge index measuring the inlet (default: nearest to the inlet)")
+    p.add_argument("--outlet-gauge", type=int, default=None,
+                   help="gauge index measuring the outlet (default: nearest to the outlet)")
+    p.add_argument("--run-id", default=None, help="run to couple to (required with tcp://)")
+    p.add_argument("--scene-hash", default=None,
+                   help="SHA-256 (hex) of the scene the model was set up for; refused if it differs")
+    p.add_argument("--timeout", type=float, default=120.0,
+                   help="longest wait for a server reply [s] (one SPH window)")
+    p.add_argument("--output", default=None, help="CSV file for the gauge series (must not exist)")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+
+
+def model_factory(args: argparse.Namespace):
+    """A callable(Welcome) -> WaveModel for the chosen --model (depth from WELCOME if no --d)."""
+    if args.model == "boussinesq":
+        try:
+            from wave_client.boussinesq import couple_model  # type: ignore[attr-defined]
+        except ImportError as exc:
+            raise ValueError("--model boussinesq is not available in this build: "
+                             f"wave_client.boussinesq provides no couple_model ({exc})") from exc
+        return lambda welcome: couple_model(args, welcome)
+    from wave_client.theories import build_theory
+
+    if args.H is None or args.T is None:
+        raise ValueError(f"--model {args.model} needs --H and --T")
+    options: dict[str, Any] = {"ramp_time": args.ramp_periods * args.T}
+    if args.model == "stokes":
+        options["order"] = args.order
+    elif args.model == "stream":
+        options["n_fourier"] = args.n_fourier
+    elif args.model == "irregular":
+        options.update(gamma=args.gamma, n_components=args.components, seed=args.seed)
+    if args.ramp_periods < 0:
+        raise ValueError(f"--ramp-periods must be >= 0, got {args.ramp_periods}")
+
+    def make(welcome: Welcome):
+        depth = welcome.depth if args.d is None else args.d
+        return build_theory(args.model, height=args.H, period=args.T, depth=depth, **options)
+
+    if args.d is not None:  # validate the theory now, before connecting
+        make(None)
+    return make
+
+
+def main(args: argparse.Namespace) -> int:
+    from wave_client.coupling import CouplingError, CouplingOptions, couple
+
+    try:
+        factory = model_factory(args)
+        scene_hash = None
+        if args.scene_hash is not None:
+            try:
+                scene_hash = bytes.fromhex(args.scene_hash)
+            except ValueError:
+                scene_hash = b""
+            if len(scene_hash) != 32:
+                raise ValueError("--scene-hash must be 64 hex digits (SHA-256)")
+        options = CouplingOptions(window=args.window, t_end=args.t_end, absorb=not args.no_absorb,
+                                  x_offset=args.x_offset, inlet_gauge=args.inlet_gauge,
+                                  outlet_gauge=args.outlet_gauge)
+        if args.url.startswith("tcp://") and not args.run_id:
+            raise ValueError("--run-id is required with a tcp:// url (the HELLO names the run)")
+        report = couple(args.url, factory, options, run_id=args.run_id, scene_hash=scene_hash,
+                        timeout=args.timeout, log_path=args.output, progress=not args.no_progress)
+    except ValueError as exc:
+        print(f"wavesph couple: {exc}", file=sys.stderr)
+        return 2
+    except CouplingError as exc:
+        print(f"wavesph couple: {exc}", file=sys.stderr)
+        return 1
+    n = len(report.records)
+    t = report.records[-1].t1 if n else float("nan")
+    overhead = report.model_time / report.wall_time if report.wall_time > 0 else 0.0
+    print(f"coupled {n} windows to t = {t:.6g} s in {report.wall_time:.2f} s "
+          f"(wave model {overhead:.1%} of wall time); gauges used {report.gauges}"
+          + (f"; series in {args.output}" if args.output else ""))
+    return 0

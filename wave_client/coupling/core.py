@@ -1,0 +1,283 @@
+"""Sans-I/O coupling client: what to send next, given the wave model and the server's replies.
+
+Client side of seed 001, Algorithm 2 (explicit coupling, one exchange per window) with the
+active-absorption correction of seed 002 (Altomare et al. 2017), on the wire format of
+`protocol/PROTOCOL.md`. No sockets here: `transport.py` moves the bytes, `runner.py` loops.
+
+Per window [t0, t1]:
+  1. advance the wave model to t1;
+  2. sample u, w at the boundary nodes and eta at their x; correct u (below);
+  3. SET(t0, t1, u, w, eta) + SOLVE  ->  RESULT(eta, wet, u_ref, w_ref at the gauges, at t1);
+  4. mismatch at the inlet/outlet gauges: d_eta = eta_measured - eta_model(gauge x, t1);
+     ``model.impose(x_gauge_in, eta_measured, u_ref)`` (two-way models use it, theories ignore it).
+
+Correction (seed 002, shallow-water active absorption), applied to the next window's u, with
+c = sqrt(g/d), g and d from WELCOME:
+    inlet:   u_in  = u_model - (eta_in,measured  - eta_model) * c
+    outlet:  u_out = u_model - (eta_model - eta_out,measured) * c
+Only the horizontal velocity is corrected, uniformly over depth. The measurement of window n
+corrects window n+1 (one-window lag, as the exchange is explicit).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from protocol import (NO_SCENE_HASH, Capability, ClientSession, Error, ErrorCode, GetNodes, Hello,
+                      Message, Nodes, ProtocolError, Result, Set, Side, Solve, Welcome, Bye)
+from wave_client.model import WaveModel
+
+CLIENT_NAME = "wavesph-couple/0.1"
+TIME_RTOL = 1e-9  # relative tolerance when matching the server's clock
+
+
+class CouplingError(RuntimeError):
+    """The coupled run could not go on; the message says why and what to change."""
+
+
+@dataclass(frozen=True)
+class CouplingOptions:
+    """Client-side choices of a coupled run.
+
+    window:   coupling window [s]; None: min(WELCOME.window_max, model period / 50) (or window_max
+              for a model without ``period``). Boundary data are interpolated linearly in time
+              over a window, so it must resolve the wave period.
+    t_end:    stop at this time [s] (None: the server's t_end).
+    absorb:   apply the seed 002 correction at the inlet and outlet.
+    x_offset: model x = SPH x + x_offset [m] (the two codes may use different x origins).
+    inlet_gauge, outlet_gauge: index of the gauge that measures eta for that side's correction;
+              None: the gauge nearest that side's nodes (and nearer to it than to the other side).
+    depth_rtol: largest relative difference accepted between the model's depth and WELCOME.depth.
+    """
+
+    window: float | None = None
+    t_end: float | None = None
+    absorb: bool = True
+    x_offset: float = 0.0
+    inlet_gauge: int | None = None
+    outlet_gauge: int | None = None
+    depth_rtol: float = 0.01
+
+
+@dataclass
+class WindowRecord:
+    """What one window sent and got back (all SI, z up from still water)."""
+
+    t0: float
+    t1: float
+    steps: int                 # SPH sub-steps the server took
+    eta: np.ndarray            # measured elevation at each gauge at t1 [m]
+    wet: np.ndarray            # 1 where the gauge found water
+    u_ref: np.ndarray          # measured velocity at z_ref at each gauge [m/s]
+    w_ref: np.ndarray
+    eta_model: np.ndarray      # wave-model elevation at each gauge at t1 [m]
+    du_inlet: float            # correction added to u at the inlet nodes in this window [m/s]
+    du_outlet: float           # ... at the outlet nodes [m/s]
+
+
+ModelSource = WaveModel | Callable[[Welcome], WaveModel]
+
+
+@dataclass
+class _Side:
+    """Nodes of one open boundary, grouped by x so the model is asked one vertical at a time."""
+
+    index: np.ndarray                                  # node indices of this side
+    columns: list[tuple[float, np.ndarray]] = field(default_factory=list)  # (x, node indices)
+    gauge: int | None = None
+
+
+class CouplingCore:
+    """State machine of the client; every method returns the bytes to send (if any).
+
+    ``model`` is a `WaveModel`, or a callable building one from the server's WELCOME (so its
+    depth can be taken from the scene). Use: ``hello()``, ``on_welcome(seq, msg)`` ->
+    GETNODES frame, ``on_nodes(seq, msg)``, then while ``windows_left``: ``next_window()`` ->
+    [SET, SOLVE] frames, ``on_result(seq, msg)`` -> `WindowRecord`; finally ``bye()``.
+    """
+
+    def __init__(self, model: ModelSource, options: CouplingOptions | None = None, *,
+                 run_id: str = "", scene_hash: bytes = NO_SCENE_HASH,
+                 client_name: str = CLIENT_NAME) -> None:
+        self._model_source = model
+        self.model: WaveModel | None = model if isinstance(model, WaveModel) else None
+        if self.model is None and not callable(model):
+            raise TypeError("model must be a WaveModel or a callable(Welcome) -> WaveModel")
+        self.options = options or CouplingOptions()
+        self.run_id = run_id
+        self.scene_hash = scene_hash
+        self.client_name = client_name
+        self.session = ClientSession()
+        self.welcome: Welcome | None = None
+        self.nodes: Nodes | None = None
+        self.times: np.ndarray = np.zeros(0)   # window ends t_1 .. t_n, t_0 = t_start
+        self.window_index = 0                  # windows solved so far
+        self._sides: dict[Side, _Side] = {}
+        self._mismatch = {Side.INLET: 0.0, Side.OUTLET: 0.0}  # eta_measured - eta_model [m]
+        self._pending: tuple[float, float, float, float] | None = None  # t0, t1, du_in, du_out
+
+    # --- handshake ------------------------------------------------------------------------
+    def hello(self) -> bytes:
+        return self.session.request(Hello(0, self.scene_hash, self.run_id, self.client_name))
+
+    def on_welcome(self, seq: int, msg: Message) -> bytes:
+        """Check the offer against the model; the GETNODES frame to send."""
+        welcome = self.session.reply(seq, msg, expect=Welcome)
+        self.welcome = welcome
+        if self.model is None:
+            self.model = self._model_source(welcome)  # type: ignore[operator]
+            if not isinstance(self.model, WaveModel):
+                raise CouplingError("the model factory did not return a WaveModel")
+        d_model, d_sph = float(self.model.depth), welcome.depth
+        if abs(d_model - d_sph) > self.options.depth_rtol * d_sph:
+            raise CouplingError(
+                f"depth mismatch: the wave model has depth={d_model} m, the SPH scene has "
+                f"{d_sph} m at the inlet (tolerance {self.options.depth_rtol:.0%}); "
+                "set the model's depth to the scene's")
+        t_stop = welcome.t_end if self.options.t_end is None else self.options.t_end
+        if not t_stop > welcome.t_start or t_stop > welcome.t_end * (1 + TIME_RTOL):
+            raise CouplingError(f"t_end={t_stop} s must lie in ({welcome.t_start}, "
+                                f"{welcome.t_end}] s, the server's run time")
+        window = self.options.window
+        if window is None:
+            period = getattr(self.model, "period", None)
+            window = welcome.window_max if period is None else min(welcome.window_max, period / 50)
+        if not (math.isfinite(window) and window > 0):
+            raise CouplingError(f"window must be a positive number of seconds, got {window}")
+        if window > welcome.window_max * (1 + TIME_RTOL):
+            raise CouplingError(f"window={window} s exceeds the server's window_max="
+                                f"{welcome.window_max} s")
+        n = max(1, math.ceil((t_stop - welcome.t_start) / window - 1e-9))
+        self.times = welcome.t_start + window * np.arange(1, n + 1)
+        self.times[-1] = t_stop  # the last window ends exactly at t_stop
+        self.window = window
+        self.model.advance_to(welcome.t_start)
+        return self.session.request(GetNodes())
+
+    def on_nodes(self, seq: int, msg: Message) -> None:
+        """Group the boundary nodes by side and column; pick the correction gauges."""
+        nodes = self.session.reply(seq, msg, expect=Nodes)
+        self.nodes = nodes
+        for side in (Side.INLET, Side.OUTLET):
+            idx = np.flatnonzero(nodes.side == side)
+            if idx.size:
+                xs = nodes.x[idx]
+                cols = [(float(x), idx[xs == x]) for x in np.unique(xs)]
+                self._sides[side] = _Side(idx, cols)
+        unknown = set(np.unique(nodes.side).tolist()) - {int(Side.INLET), int(Side.OUTLET)}
+        if unknown:
+            raise ProtocolError(ErrorCode.BAD_VALUE, f"NODES.side has unknown values {sorted(unknown)}")
+        n_g = nodes.gauge_x.size
+        for side, chosen in ((Side.INLET, self.options.inlet_gauge),
+                             (Side.OUTLET, self.options.outlet_gauge)):
+            if side not in self._sides:
+                continue
+            if chosen is not None:
+                if not 0 <= chosen < n_g:
+                    name = "inlet_gauge" if side is Side.INLET else "outlet_gauge"
+                    raise CouplingError(f"{name}={chosen}: the scene has {n_g} gauges")
+                self._sides[side].gauge = chosen
+            else:
+                self._sides[side].gauge = self._nearest_gauge(side)
+
+    def _nearest_gauge(self, side: Side) -> int | None:
+        assert self.nodes is not None
+        gx = self.nodes.gauge_x
+        if gx.size == 0:
+            return None
+        own = abs(gx - self.nodes.x[self._sides[side].index].mean())
+        other_side = Side.OUTLET if side is Side.INLET else Side.INLET
+        ok = np.ones(gx.size, bool)
+        if other_side in self._sides:
+            ok = own < abs(gx - self.nodes.x[self._sides[other_side].index].mean())
+        return int(np.flatnonzero(ok)[np.argmin(own[ok])]) if ok.any() else None
+
+    @property
+    def gauges(self) -> dict[str, int | None]:
+        """Gauge index used for each side's correction (None: no correction there)."""
+        return {("inlet" if s is Side.INLET else "outlet"): v.gauge for s, v in self._sides.items()}
+
+    # --- windows --------------------------------------------------------------------------
+    @property
+    def windows_left(self) -> int:
+        return int(self.times.size - self.window_index)
+
+    def next_window(self) -> list[bytes]:
+        """[SET, SOLVE] frames for the next window (model advanced to its end)."""
+        assert self.welcome is not None and self.nodes is not None and self.model is not None
+        if self.windows_left <= 0:
+            raise CouplingError("no window left: the run reached t_end")
+        t0 = self.welcome.t_start if self.window_index == 0 else float(self.times[self.window_index - 1])
+        t1 = float(self.times[self.window_index])
+        self.model.advance_to(t1)
+        x_off = self.options.x_offset
+        n = self.nodes.x.size
+        u, w = np.zeros(n), np.zeros(n)
+        for side in self._sides.values():
+            for x, idx in side.columns:
+                uc, wc = self.model.velocity(x + x_off, self.nodes.z[idx])
+                u[idx], w[idx] = uc, wc
+        eta = np.asarray(self.model.elevation(self.nodes.x + x_off), dtype=float).reshape(n)
+        c = math.sqrt(self.welcome.g / self.welcome.depth)
+        du_in = du_out = 0.0
+        if self.options.absorb:
+            du_in = -self._mismatch[Side.INLET] * c    # u_in = u - (eta_meas - eta_model) c
+            du_out = self._mismatch[Side.OUTLET] * c   # u_out = u - (eta_model - eta_meas) c
+            if Side.INLET in self._sides:
+                u[self._sides[Side.INLET].index] += du_in
+            if Side.OUTLET in self._sides:
+                u[self._sides[Side.OUTLET].index] += du_out
+        for name, a in (("u", u), ("w", w), ("eta", eta)):
+            if not np.all(np.isfinite(a)):
+                raise CouplingError(f"the wave model returned non-finite {name} at t={t1} s")
+        self._pending = (t0, t1, du_in, du_out)
+        return [self.session.request(Set(t0, t1, u, w, eta)), self.session.request(Solve())]
+
+    def on_result(self, seq: int, msg: Message) -> WindowRecord:
+        """Take the RESULT of the window: record it, compute the next correction, feed back."""
+        assert self.welcome is not None and self.nodes is not None and self.model is not None
+        if self._pending is None:
+            raise CouplingError("RESULT without a window in flight")
+        result = self.session.reply(seq, msg, expect=Result)
+        t0, t1, du_in, du_out = self._pending
+        if abs(result.t - t1) > TIME_RTOL * max(1.0, abs(t1)):
+            raise ProtocolError(ErrorCode.TIME_MISMATCH,
+                                f"RESULT.t={result.t} s, the window ended at t1={t1} s")
+        x_off = self.options.x_offset
+        gx = self.nodes.gauge_x
+        eta_model = (np.asarray(self.model.elevation(gx + x_off), dtype=float).reshape(gx.size)
+                     if gx.size else np.zeros(0))
+        for side, s in self._sides.items():
+            g = s.gauge
+            # a dry gauge measured nothing: no correction rather than a spurious one
+            self._mismatch[side] = (float(result.eta[g] - eta_model[g])
+                                    if g is not None and result.wet[g] else 0.0)
+        inlet = self._sides.get(Side.INLET)
+        if inlet is not None and inlet.gauge is not None and result.wet[inlet.gauge]:
+            g = inlet.gauge
+            self.model.impose(float(gx[g] + x_off), float(result.eta[g]), float(result.u_ref[g]))
+        self._pending = None
+        self.window_index += 1
+        return WindowRecord(t0, t1, int(result.steps), result.eta.copy(), result.wet.copy(),
+                            result.u_ref.copy(), result.w_ref.copy(), eta_model, du_in, du_out)
+
+    # --- ending ---------------------------------------------------------------------------
+    def bye(self, reason: str = "done") -> bytes:
+        return self.session.request(Bye(reason))
+
+    def on_bye(self, seq: int, msg: Message) -> None:
+        self.session.reply(seq, msg, expect=Bye)
+
+    def error_frame(self, exc: BaseException) -> bytes:
+        """ERROR frame telling the server why the client stops (sent before closing)."""
+        if isinstance(exc, ProtocolError):
+            code, text = exc.code, exc.text
+        elif isinstance(exc, TimeoutError):
+            code, text = ErrorCode.TIMEOUT, f"client: {exc}"
+        else:
+            code, text = ErrorCode.INTERNAL, f"client: {type(exc).__name__}: {exc}"
+        return self.session.request(Error(int(code), text.encode()[:4000].decode(errors="ignore")))

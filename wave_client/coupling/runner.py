@@ -1,0 +1,195 @@
+"""The coupling loop over a real connection: handshake, windows, BYE; errors made clear.
+
+    from wave_client.coupling import couple, CouplingOptions
+    from wave_client.theories import StokesWave
+    report = couple("ws://127.0.0.1:8000/runs/r1/couple", StokesWave(0.08, 2.0, 1.0, ramp_time=4.0),
+                    CouplingOptions(window=0.04), log_path="gauges.csv")
+
+On any failure the client sends an ERROR frame (when the connection still stands) and closes,
+then raises: `ServerError` (the server sent ERROR), `CouplingTimeout` (no reply in time),
+`CouplingError` (anything else, connection lost included). Every window is appended to the CSV
+log and flushed as it arrives, so a failed run keeps what it measured.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TextIO
+
+import numpy as np
+from tqdm import tqdm
+
+from protocol import ErrorCode, ProtocolError, RemoteError, Welcome
+from wave_client.coupling.core import (CouplingCore, CouplingError, CouplingOptions, ModelSource,
+                                       WindowRecord)
+from wave_client.coupling.transport import TransportClosed, open_transport, parse_url
+
+
+class CouplingTimeout(CouplingError):
+    """The server did not answer within the timeout (vanished or stuck)."""
+
+
+class ServerError(CouplingError):
+    """The server refused or failed: it sent an ERROR frame (``code``, ``text``)."""
+
+    def __init__(self, code: ErrorCode, text: str) -> None:
+        super().__init__(f"server error {code.name} ({int(code)}): {text}")
+        self.code, self.text = code, text
+
+
+@dataclass
+class CouplingReport:
+    """What a coupled run did: every window's record, and where the wall time went."""
+
+    welcome: Welcome | None = None
+    gauges: dict[str, int | None] = field(default_factory=dict)
+    records: list[WindowRecord] = field(default_factory=list)
+    wall_time: float = 0.0     # s, whole run
+    model_time: float = 0.0    # s, spent in the wave model (advance + sampling + feedback)
+    wait_time: float = 0.0     # s, waiting for the server (SPH solve + transport)
+
+    @property
+    def t(self) -> np.ndarray:
+        return np.array([r.t1 for r in self.records])
+
+    @property
+    def eta(self) -> np.ndarray:
+        """Measured elevation, shape (windows, gauges) [m]."""
+        return np.array([r.eta for r in self.records]).reshape(len(self.records), -1)
+
+
+class GaugeLog:
+    """CSV of the gauge series, one row per window, flushed as it comes (nothing lost on a crash).
+
+    Columns: t [s], steps, then per gauge i: eta_i [m] (measured), wet_i, u_ref_i, w_ref_i [m/s],
+    eta_model_i [m]; finally du_inlet, du_outlet [m/s] (the seed 002 corrections applied).
+    """
+
+    def __init__(self, path: Path, header: str) -> None:
+        self.path = Path(path)
+        if self.path.exists():
+            raise ValueError(f"log_path {self.path} exists: refusing to overwrite a run's data")
+        self._f: TextIO = self.path.open("x", encoding="utf-8")
+        for line in header.splitlines():
+            self._f.write(f"# {line}\n")
+        self._columns_written = False
+
+    def write(self, r: WindowRecord) -> None:
+        n = r.eta.size
+        if not self._columns_written:
+            cols = ["t", "steps"]
+            for i in range(n):
+                cols += [f"eta_{i}", f"wet_{i}", f"u_ref_{i}", f"w_ref_{i}", f"eta_model_{i}"]
+            self._f.write(",".join(cols + ["du_inlet", "du_outlet"]) + "\n")
+            self._columns_written = True
+        row = [f"{r.t1:.9g}", str(r.steps)]
+        for i in range(n):
+            row += [f"{r.eta[i]:.9g}", str(int(r.wet[i])), f"{r.u_ref[i]:.9g}", f"{r.w_ref[i]:.9g}",
+                    f"{r.eta_model[i]:.9g}"]
+        self._f.write(",".join(row + [f"{r.du_inlet:.9g}", f"{r.du_outlet:.9g}"]) + "\n")
+        self._f.flush()
+
+    def close(self) -> None:
+        self._f.close()
+
+
+async def run_coupling(url: str, model: ModelSource, options: CouplingOptions | None = None, *,
+                       run_id: str | None = None, scene_hash: bytes | None = None,
+                       timeout: float = 120.0, connect_timeout: float = 10.0,
+                       log_path: str | Path | None = None, progress: bool = True) -> CouplingReport:
+    """Couple ``model`` to the SPH server at ``url`` until t_end; see the module docstring.
+
+    ``timeout`` bounds every wait for a reply [s] (a RESULT takes as long as SPH needs for one
+    window); ``run_id`` defaults to the one in a ws:// url (required by the server on tcp://).
+    """
+    if not timeout > 0 or not connect_timeout > 0:
+        raise ValueError("timeout and connect_timeout must be > 0 s")
+    _, _, _, url_run = parse_url(url)
+    core = CouplingCore(model, options, run_id=run_id if run_id is not None else url_run,
+                        **({} if scene_hash is None else {"scene_hash": scene_hash}))
+    report = CouplingReport()
+    log: GaugeLog | None = None
+    if log_path is not None:
+        log = GaugeLog(Path(log_path), f"wavesph couple: gauge series from {url}\n"
+                       "SI units; eta up from the still-water level; t is the SPH time")
+    start = time.perf_counter()
+    try:
+        transport = await open_transport(url, connect_timeout)
+    except (OSError, TimeoutError) as exc:
+        if log is not None:
+            log.close()
+        raise CouplingError(f"cannot connect to {url}: {exc or type(exc).__name__}") from exc
+    bar = None
+    stage = "handshake"
+    try:
+        await transport.send([core.hello()])
+        await transport.send([core.on_welcome(*await transport.recv(timeout))])
+        core.on_nodes(*await transport.recv(timeout))
+        report.welcome, report.gauges = core.welcome, core.gauges
+        bar = tqdm(total=core.windows_left, unit="window", desc="coupling", disable=not progress)
+        while core.windows_left:
+            stage = f"window {core.window_index + 1}/{core.times.size}"
+            t_a = time.perf_counter()
+            frames = core.next_window()
+            t_b = time.perf_counter()
+            await transport.send(frames)
+            reply = await transport.recv(timeout)
+            t_c = time.perf_counter()
+            record = core.on_result(*reply)
+            report.records.append(record)
+            report.model_time += (t_b - t_a) + (time.perf_counter() - t_c)
+            report.wait_time += t_c - t_b
+            if log is not None:
+                log.write(record)
+            bar.update()
+            bar.set_postfix(t=f"{record.t1:.3f}s", steps=record.steps)
+        stage = "closing"
+        await transport.send([core.bye()])
+        try:
+            core.on_bye(*await transport.recv(min(timeout, 5.0)))
+        except (TimeoutError, TransportClosed, ProtocolError):
+            pass  # the work is done and logged; a missing BYE echo loses nothing
+    except RemoteError as exc:
+        raise ServerError(exc.code, exc.text) from exc
+    except TimeoutError as exc:
+        await _send_error(transport, core, TimeoutError(f"no reply within {timeout} s at {stage}"))
+        raise CouplingTimeout(f"the server did not answer within {timeout} s ({stage}); "
+                              "it is stuck or gone") from exc
+    except TransportClosed as exc:
+        raise CouplingError(f"connection lost at {stage}: {exc}") from exc
+    except BaseException as exc:  # protocol violation, model failure, Ctrl-C: tell the server
+        await _send_error(transport, core, exc)
+        if isinstance(exc, ProtocolError):
+            raise CouplingError(f"bad reply from the server at {stage}: {exc}") from exc
+        raise
+    finally:
+        report.wall_time = time.perf_counter() - start
+        if bar is not None:
+            bar.close()
+        if log is not None:
+            log.close()
+        await _close_quietly(transport)
+    return report
+
+
+async def _send_error(transport, core: CouplingCore, exc: BaseException) -> None:
+    try:
+        await asyncio.wait_for(transport.send([core.error_frame(exc)]), 2.0)
+    except Exception:  # the connection may already be gone: nothing more to tell
+        pass
+
+
+async def _close_quietly(transport) -> None:
+    try:
+        await asyncio.wait_for(transport.close(), 5.0)
+    except Exception:
+        pass
+
+
+def couple(url: str, model: ModelSource, options: CouplingOptions | None = None,
+           **kwargs) -> CouplingReport:
+    """Blocking wrapper of `run_coupling` (same arguments)."""
+    return asyncio.run(run_coupling(url, model, options, **kwargs))
