@@ -76,7 +76,8 @@ class Constants(_Model):
     g: float = Field(9.81, gt=0, description="gravity [m/s^2], acting in -z")
     c0: float | None = Field(None, gt=0, description="speed of sound [m/s]; default c0_factor*sqrt(2 g H)")
     c0_factor: float = Field(10.0, gt=0, description="c0 = c0_factor * sqrt(2 g H), H = water height")
-    h_over_dp: float = Field(1.3, ge=1.0, le=2.0, description="smoothing length h / dp")
+    h_over_dp: float = Field(1.4142, ge=1.0, le=2.0,
+                             description="smoothing length h / dp; sqrt(2) keeps the lattice gradient moment within 1%")
     cfl: float = Field(0.25, gt=0, le=0.5, description="Courant number of the adaptive time step")
     alpha: float = Field(0.01, ge=0, description="Monaghan artificial viscosity coefficient")
     nu: float = Field(1.0e-6, ge=0, description="laminar kinematic viscosity [m^2/s]")
@@ -123,6 +124,22 @@ class FrontProbe(_Model):
 Probe = Annotated[Union[PointProbe, ElevationProbe, FrontProbe], Field(discriminator="kind")]
 
 
+class OpenBoundary(_Model):
+    """An open end of the tank (issue 3, seed 002): the tank wall on ``side`` is replaced by a
+    buffer of particles, one kernel support wide, outside the tank face (x0 or x1).
+
+    Buffer particles take the velocity of a boundary-data source (see ``sph_core.boundary_data``).
+    ``elevation``: ``imposed`` takes the source's elevation (inlet of seed 002); ``extrapolated``
+    takes the one measured by the boundary gauge inside the fluid (outlet). ``absorb`` applies the
+    seed 002 correction u = u_theory + n_x (eta_measured - eta_theory) sqrt(g/d), n_x the outward
+    normal (-1 left, +1 right). The gauge stands ``gauge_offset`` [m] inside the face (default 2h)."""
+
+    side: Literal["left", "right"]
+    elevation: Literal["imposed", "extrapolated"] = "imposed"
+    absorb: bool = True
+    gauge_offset: float | None = Field(None, gt=0, description="boundary gauge distance inside the face [m]")
+
+
 class Output(_Model):
     """Output cadence in simulated seconds (0 = never)."""
 
@@ -144,10 +161,16 @@ class Scene(_Model):
     constants: Constants = Constants()
     output: Output = Output()
     probes: list[Probe] = []
+    open_boundaries: list[OpenBoundary] = []
 
     @model_validator(mode="after")
     def _consistent(self) -> "Scene":
         t = self.tank
+        sides = [o.side for o in self.open_boundaries]
+        if len(set(sides)) != len(sides):
+            raise ValueError(f"open_boundaries: one boundary per side, got sides {sides}")
+        if self.open_boundaries and self.still_water_level is None:
+            raise ValueError("still_water_level: required when the scene has open_boundaries")
         for i, b in enumerate(self.water_blocks):
             if b.x0 < t.x0 - 1e-12 or b.x1 > t.x1 + 1e-12 or b.z0 < t.z0 - 1e-12 or b.z1 > t.z1:
                 raise ValueError(f"water_blocks.{i}: must lie inside the tank")

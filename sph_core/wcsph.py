@@ -11,7 +11,7 @@ momentum:
               - sum_j m_j 4 nu F_ij r^2 / ((rho_i + rho_j)(r^2 + 0.01 h^2)) v_ij + g   (Lo & Shao 2002)
     Pi_ij = -alpha c0 h (v_ij.r_ij) / (rho_bar (r^2 + 0.01 h^2)) if v_ij.r_ij < 0 else 0   (Monaghan 1992)
 walls (Adami, Hu & Adams 2012, eq. 22 of seed 004), from fluid neighbours f of wall particle s:
-    p_s = [sum_f p_f W_sf + (g - a_s) . sum_f rho_f r_sf W_sf] / sum_f W_sf,  rho_s = EOS^-1(p_s),
+    p_s = max(0, [sum_f p_f W_sf + (g - a_s) . sum_f rho_f r_sf W_sf] / sum_f W_sf),  rho_s = EOS^-1(p_s),
     no-slip: v_s(viscous) = 2 v_s - sum_f v_f W_sf / sum_f W_sf;  no fluid neighbour: p_s = 0.
 time step (Monaghan 1989; DualSPHysics):
     dt = min(CFL h / (c_max + |v|_max), CFL sqrt(h / |a|_max), 0.125 h^2 / nu).
@@ -35,8 +35,8 @@ from numba import njit, prange
 from .eos import density, pressure
 from .kernels import f_of_q, w_of_q
 from .neighbours import sort_by_cell
-from .particles import (AX, AZ, DRHO, FLUID, M, N_SORTED_KDK, N_SORTED_PC, P, RHO, RHON, VWX,
-                        VWZ, VX, VXN, VZ, VZN, WALL, XN, ZN, X, Z)
+from .particles import (AX, AZ, DRHO, FLUID, INLET, M, N_SORTED_KDK, N_SORTED_PC, OUTLET, P, RHO,
+                        RHON, VWX, VWZ, VX, VXN, VZ, VZN, WALL, XN, ZN, X, Z)
 
 # indices into the float parameter vector ``prm``
 (PR_H, PR_ALPHA_W, PR_ALPHA_F, PR_RHO0, PR_C0, PR_B, PR_GAMMA, PR_GX, PR_GZ, PR_ALPHA, PR_NU,
@@ -100,7 +100,8 @@ def wall_pass(f, kind, cell, cell_start, n, ncx, ncz, prm):
             for zz in range(max(cz - 1, 0), min(cz + 2, ncz)):
                 row = zz * ncx
                 for j in range(cell_start[row + cxl], cell_start[row + cxh + 1]):
-                    if kind[j] == FLUID:
+                    # fluid and active open-boundary buffer particles (kinds 0, 2, 3)
+                    if kind[j] == FLUID or kind[j] == INLET or kind[j] == OUTLET:
                         dx = xi - x[j]
                         dz = zi - z[j]
                         r2 = dx * dx + dz * dz
@@ -111,7 +112,9 @@ def wall_pass(f, kind, cell, cell_start, n, ncx, ncz, prm):
                             svx += vx[j] * w
                             svz += vz[j] * w
             if sw > 0.0:
-                pi = sp / sw
+                # no suction: a negative extrapolated pressure (free surface near the wall)
+                # would pull fluid into the wall
+                pi = max(sp / sw, 0.0)
                 p[i] = pi
                 rho[i] = density(pi, rho0, b, gam)
                 vwx[i] = 2.0 * vx[i] - svx / sw
@@ -180,7 +183,9 @@ def fluid_pass(f, kind, cell, cell_start, n, ncx, ncz, prm):
                 row = zz * ncx
                 for j in range(cell_start[row + cxl], cell_start[row + cxh + 1]):
                     kj = kind[j]
-                    if j == i or (kj != FLUID and kj != WALL):
+                    # INACTIVE (-1) and idle buffer slots (> OUTLET) do not interact; active
+                    # buffer particles (INLET, OUTLET) act as fluid with imposed velocity
+                    if j == i or kj < FLUID or kj > OUTLET:
                         continue
                     dx = xi - x[j]
                     dz = zi - z[j]
@@ -196,8 +201,8 @@ def fluid_pass(f, kind, cell, cell_start, n, ncx, ncz, prm):
                     dvz = vzi - vz[j]
                     cont -= vol * fij * (dvx * dx + dvz * dz)
                     pf = mj * (pi + p[j]) / (rhoi * rhoj)
-                    visc = kj == FLUID or noslip
-                    if kj == FLUID:
+                    visc = kj != WALL or noslip
+                    if kj != WALL:
                         # height along gravity: z_i - z_j for g = (0, -g)
                         up = -(gdir_x * dx + gdir_z * dz)
                         diff += (rhoj - rhoi - khyd * up) * fij * vol

@@ -1,0 +1,309 @@
+"""Open-boundary buffers (Tafuni et al. 2018; seed 002) and the jitted time loop that hosts them.
+
+A flume has at most two open ends, index b = 0 (left, particle kinds INLET / INLET_IDLE) and
+b = 1 (right, OUTLET / OUTLET_IDLE). Each end is a buffer of width L >= 2h outside the tank face
+x_f, outward normal n_x (-1 left, +1 right); d = (x - x_f) n_x is the depth into the buffer.
+
+Every step, for buffer particle i of end b (the window [t0, t1] holds the source's samples,
+interpolated linearly in time and linearly in z between the nodes):
+    u_i = u(z_i, t) + du_b,  w_i = w(z_i, t),  x_i += dt u_i       (z_i fixed: layers stay level)
+    du_b = n_x (eta_meas,b - eta_gauge,b(t)) sqrt(g/d)  if absorbing        (seed 002 correction)
+    surface z_s,b = swl + eta_b(t)  (elevation imposed)  or  swl + eta_meas,b  (extrapolated)
+    active (interacts as fluid) iff z_i < z_s,b;  rho_i = rho0 (1 + rho0 g (z_s,b - z_i)/B)^(1/7)
+    (hydrostatic below the imposed or measured surface; Tait EOS, same form as the initial state).
+Crossings (d: depth into the buffer, counted per end so that mass balance is exact):
+    fluid with d >= 0            -> buffer                         (counter OUT)
+    active buffer with d < 0     -> fluid, new buffer particle at x + n_x L, same z (IN, CREATED)
+    idle buffer with d < 0       -> removed (it is above the surface), replaced as above (REMOVED)
+    buffer with d >= L           -> removed (slot INACTIVE, dropped at the next sort) (REMOVED)
+The measured elevation comes from a gauge a short distance inside the face: the vertical-line
+method (seed 004, second method), surface where sum_j m_j W falls below rho0/2, fluid and
+active buffer particles counted; NaN when dry (then no correction, imposed surface used).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit, prange
+
+from .eos import pressure
+from .kernels import w_of_q
+from .particles import AX, AZ, DRHO, FLUID, INACTIVE, INLET, M, N_SORTED_KDK, OUTLET, P, RHO, VX, VZ, X, Z
+from .wcsph import (PR_ALPHA_W, PR_B, PR_GAMMA, PR_GZ, PR_H, PR_RHO0, PR_XMIN, PR_ZMIN, PR_INV_CS,
+                    ST_REACHED_T, ST_STEP_LIMIT, ST_NONFINITE, ST_DENSITY, ST_LEFT_DOMAIN, _sort,
+                    fluid_pass, kdk_kick, kdk_kick_drift, stable_dt, wall_pass)
+
+# idle buffer particles: above the boundary's surface, kept in place but not interacting
+INLET_IDLE = 4
+OUTLET_IDLE = 5
+ACTIVE_KIND = (INLET, OUTLET)
+IDLE_KIND = (INLET_IDLE, OUTLET_IDLE)
+
+# status code of the open loop beyond those of wcsph
+ST_CAPACITY = 5
+STATUS_TEXT = {ST_CAPACITY: "particle capacity exhausted by open-boundary inflow"}
+
+# per-end parameters obp[b, :]
+(OB_ON, OB_XF, OB_NX, OB_LEN, OB_SWL, OB_SQGD, OB_ABSORB, OB_IMPOSED, OB_XG, OB_ZBED, OB_ZTOP,
+ OB_DZG) = range(12)
+N_OBP = 12
+# per-end counters[b, :]
+C_IN, C_OUT, C_CREATED, C_REMOVED = range(4)
+N_COUNTERS = 4
+
+
+@njit(cache=True)
+def _blend(a, lv, k, r):
+    """(1 - r) a[lv=0, k] + r a[lv=1, k] for a window array a[level, node]."""
+    return (1.0 - r) * a[0, k] + r * a[1, k]
+
+
+@njit(cache=True)
+def profile_value(zn, a, r, z):
+    """Profile a[level, node] at height z: linear in z between nodes zn (clamped at the ends),
+    linear in time with weight r of level 1."""
+    nn = zn.size
+    k = np.searchsorted(zn, z)
+    if k <= 0:
+        return _blend(a, 0, 0, r)
+    if k >= nn:
+        return _blend(a, 0, nn - 1, r)
+    s = (z - zn[k - 1]) / (zn[k] - zn[k - 1])
+    return (1.0 - s) * _blend(a, 0, k - 1, r) + s * _blend(a, 0, k, r)
+
+
+@njit(cache=True)
+def window_weight(t, win_t):
+    """Weight r of the window end in the linear time interpolation, clamped to [0, 1]."""
+    span = win_t[1] - win_t[0]
+    if span <= 0.0:
+        return 1.0
+    return min(max((t - win_t[0]) / span, 0.0), 1.0)
+
+
+@njit(cache=True)
+def boundary_state(b, r, obp, win_eta, win_etag, eta_meas):
+    """(z_s, du) of end b: the surface the buffer uses and the absorption velocity correction."""
+    eta_th = (1.0 - r) * win_eta[b, 0] + r * win_eta[b, 1]
+    etag_th = (1.0 - r) * win_etag[b, 0] + r * win_etag[b, 1]
+    em = eta_meas[b]
+    du = 0.0
+    if obp[b, OB_ABSORB] > 0.5 and math.isfinite(em):
+        du = obp[b, OB_NX] * (em - etag_th) * obp[b, OB_SQGD]
+    eta = eta_th
+    if obp[b, OB_IMPOSED] < 0.5 and math.isfinite(em):
+        eta = em
+    zs = obp[b, OB_SWL] + eta
+    # the surface never leaves the tank (validated data; a measured one could overshoot)
+    zs = min(max(zs, obp[b, OB_ZBED]), obp[b, OB_ZTOP])
+    return zs, du
+
+
+@njit(cache=True, inline="always")
+def _end_of(k):
+    if k == INLET or k == INLET_IDLE:
+        return 0
+    if k == OUTLET or k == OUTLET_IDLE:
+        return 1
+    return -1
+
+
+@njit(parallel=True, cache=True)
+def buffer_update(f, kind, n, dt, r, zs0, du0, zs1, du1, zn, win_u, win_w, prm):
+    """Impose velocity, move, (de)activate and set hydrostatic density of every buffer particle."""
+    rho0 = prm[PR_RHO0]
+    bb = prm[PR_B]
+    gam = prm[PR_GAMMA]
+    g = -prm[PR_GZ]
+    for i in prange(n):
+        b = _end_of(kind[i])
+        if b < 0:
+            continue
+        zi = f[Z, i]
+        zs = zs0 if b == 0 else zs1
+        du = du0 if b == 0 else du1
+        u = profile_value(zn[b], win_u[b], r, zi) + du
+        w = profile_value(zn[b], win_w[b], r, zi)
+        f[VX, i] = u
+        f[VZ, i] = w
+        f[X, i] += dt * u
+        if zi < zs:
+            kind[i] = ACTIVE_KIND[b]
+            rho = rho0 * (1.0 + rho0 * g * (zs - zi) / bb) ** (1.0 / gam)
+            f[RHO, i] = rho
+            f[P, i] = pressure(rho, rho0, bb, gam)
+        else:
+            kind[i] = IDLE_KIND[b]
+            f[RHO, i] = rho0
+            f[P, i] = 0.0
+        f[DRHO, i] = 0.0
+        f[AX, i] = 0.0
+        f[AZ, i] = 0.0
+
+
+@njit(cache=True)
+def buffer_transitions(f, kind, ids, n, capacity, obp, zs0, zs1, counters, next_id):
+    """Convert particles crossing a face, spawn and remove buffer particles (serial: appends).
+
+    Returns the new slot count, or -1 if the capacity is exhausted."""
+    n0 = n
+    nrows = f.shape[0]
+    for i in range(n0):
+        k = kind[i]
+        if k == FLUID:
+            for b in range(2):
+                if obp[b, OB_ON] > 0.5 and (f[X, i] - obp[b, OB_XF]) * obp[b, OB_NX] >= 0.0:
+                    zs = zs0 if b == 0 else zs1
+                    kind[i] = ACTIVE_KIND[b] if f[Z, i] < zs else IDLE_KIND[b]
+                    counters[b, C_OUT] += 1
+                    break
+            continue
+        b = _end_of(k)
+        if b < 0:
+            continue
+        nx = obp[b, OB_NX]
+        length = obp[b, OB_LEN]
+        d = (f[X, i] - obp[b, OB_XF]) * nx
+        if d < 0.0:
+            if n >= capacity:
+                return -1
+            for row in range(nrows):
+                f[row, n] = f[row, i]
+            f[X, n] = f[X, i] + nx * length
+            kind[n] = k
+            ids[n] = next_id[0]
+            next_id[0] += 1
+            n += 1
+            counters[b, C_CREATED] += 1
+            if k == ACTIVE_KIND[b]:
+                kind[i] = FLUID
+                counters[b, C_IN] += 1
+            else:
+                kind[i] = INACTIVE
+                counters[b, C_REMOVED] += 1
+        elif d >= length:
+            kind[i] = INACTIVE
+            counters[b, C_REMOVED] += 1
+    return n
+
+
+@njit(cache=True)
+def surface_z(f, kind, cell_start, xp, z_lo, z_hi, dz, prm, ncx, ncz):
+    """Free-surface height at x = xp by the vertical-line method (seed 004, eq. 23):
+    rho_f(z) = sum_j m_j W(x - x_j) over fluid and active buffer particles on points z_lo + k dz;
+    the surface is the highest z where rho_f falls through rho0/2 (linear between points).
+    Returns NaN when no point reaches rho0/2 (dry)."""
+    x = f[X]
+    z = f[Z]
+    h = prm[PR_H]
+    aw = prm[PR_ALPHA_W]
+    level = 0.5 * prm[PR_RHO0]
+    xmin = prm[PR_XMIN]
+    zmin = prm[PR_ZMIN]
+    inv_cs = prm[PR_INV_CS]
+    s2 = 4.0 * h * h
+    nz = int((z_hi - z_lo) / dz) + 1
+    cx = min(max(int((xp - xmin) * inv_cs), 0), ncx - 1)
+    cxl = max(cx - 1, 0)
+    cxh = min(cx + 1, ncx - 1)
+    prev = 0.0
+    for k in range(nz - 1, -1, -1):
+        zk = z_lo + k * dz
+        cz = min(max(int((zk - zmin) * inv_cs), 0), ncz - 1)
+        s = 0.0
+        for zz in range(max(cz - 1, 0), min(cz + 2, ncz)):
+            row = zz * ncx
+            for j in range(cell_start[row + cxl], cell_start[row + cxh + 1]):
+                kj = kind[j]
+                if kj == FLUID or kj == INLET or kj == OUTLET:
+                    ddx = xp - x[j]
+                    ddz = zk - z[j]
+                    r2 = ddx * ddx + ddz * ddz
+                    if r2 < s2:
+                        s += f[M, j] * w_of_q(math.sqrt(r2) / h, aw)
+        if s >= level:
+            if k == nz - 1:
+                return zk
+            return zk + (s - level) / (s - prev) * dz
+        prev = s
+    return np.nan
+
+
+@njit(cache=True)
+def measure_boundaries(f, kind, cell_start, obp, eta_meas, prm, ncx, ncz):
+    """eta_meas[b] = surface at the boundary gauge of end b minus the still-water level."""
+    for b in range(2):
+        if obp[b, OB_ON] > 0.5:
+            zsurf = surface_z(f, kind, cell_start, obp[b, OB_XG], obp[b, OB_ZBED], obp[b, OB_ZTOP],
+                              obp[b, OB_DZG], prm, ncx, ncz)
+            eta_meas[b] = zsurf - obp[b, OB_SWL]
+
+
+@njit(cache=True)
+def advance_open(f, f2, kind, kind2, ids, ids2, cell, cell2, order, cell_start, cursor, n,
+                 capacity, prm, ncx, ncz, t, dt, t_stop, max_steps, obp, zn, win_t, win_u, win_w,
+                 win_eta, win_etag, eta_meas, counters, next_id):
+    """Leapfrog (kick-drift-kick, as ``wcsph.advance``) with open-boundary buffers.
+
+    Per step: kick-drift of the fluid; buffers imposed and moved (data at t + dt); crossings;
+    sort (inactive slots dropped: n shrinks); walls, forces, second kick; boundary gauges.
+    Returns (t, dt_next, steps, status, swapped, n_flagged, v_max, n)."""
+    swapped = 0
+    steps = 0
+    status = ST_REACHED_T
+    n_flag = 0
+    v2max = 0.0
+    ncell = ncx * ncz
+    while True:
+        if t >= t_stop:
+            status = ST_REACHED_T
+            break
+        if steps >= max_steps:
+            status = ST_STEP_LIMIT
+            break
+        dts = dt
+        last = False
+        if t + dts >= t_stop:
+            dts = t_stop - t
+            last = True
+        n_out = kdk_kick_drift(f, kind, n, dts, prm)
+        if n_out > 0:
+            status = ST_LEFT_DOMAIN
+            n_flag = n_out
+            break
+        r = window_weight(t + dts, win_t)
+        zs0, du0 = boundary_state(0, r, obp, win_eta, win_etag, eta_meas)
+        zs1, du1 = boundary_state(1, r, obp, win_eta, win_etag, eta_meas)
+        buffer_update(f, kind, n, dts, r, zs0, du0, zs1, du1, zn, win_u, win_w, prm)
+        n_new = buffer_transitions(f, kind, ids, n, capacity, obp, zs0, zs1, counters, next_id)
+        if n_new < 0:
+            status = ST_CAPACITY
+            n_flag = n
+            break
+        n = n_new
+        _sort(f, f2, N_SORTED_KDK, kind, kind2, ids, ids2, cell, cell2, order, cell_start, cursor,
+              n, prm, ncx, ncz)
+        f, f2 = f2, f
+        kind, kind2 = kind2, kind
+        ids, ids2 = ids2, ids
+        cell, cell2 = cell2, cell
+        swapped = 1 - swapped
+        n = cell_start[ncell]  # inactive slots were sorted to the end
+        wall_pass(f, kind, cell, cell_start, n, ncx, ncz, prm)
+        fluid_pass(f, kind, cell, cell_start, n, ncx, ncz, prm)
+        n_bad, n_band, v2max, a2max, rmax = kdk_kick(f, kind, n, dts, prm)
+        measure_boundaries(f, kind, cell_start, obp, eta_meas, prm, ncx, ncz)
+        t = t_stop if last else t + dts
+        steps += 1
+        if n_bad > 0:
+            status = ST_NONFINITE
+            n_flag = n_bad
+            break
+        if n_band > 0:
+            status = ST_DENSITY
+            n_flag = n_band
+            break
+        dt = stable_dt(v2max, a2max, rmax, prm)
+    return t, dt, steps, status, swapped, n_flag, math.sqrt(v2max), n
