@@ -55,10 +55,8 @@ def source_signal(t: float, amp: np.ndarray, omega: np.ndarray, phase: np.ndarra
 @njit(cache=True)
 def rhs(eta: np.ndarray, u: np.ndarray, h: np.ndarray, coef_a: np.ndarray, coef_b: np.ndarray,
         sponge: np.ndarray, src_shape: np.ndarray, src: float, g: float, dx: float,
-        i_fix: int, work_q: np.ndarray, work_d: np.ndarray, e_out: np.ndarray, f_out: np.ndarray) -> None:
+        work_q: np.ndarray, work_d: np.ndarray, e_out: np.ndarray, f_out: np.ndarray) -> None:
     """E and F (module docstring) at all model nodes; ghosts of eta, u must be filled.
-
-    Nodes with model index >= i_fix are held (two-way coupling): E = F = 0 there.
     work_q, work_d: scratch arrays of the padded size (flux and dispersive flux).
     """
     n = eta.size
@@ -71,17 +69,46 @@ def rhs(eta: np.ndarray, u: np.ndarray, h: np.ndarray, coef_a: np.ndarray, coef_
         uxx = u[i + 1] - 2.0 * u[i] + u[i - 1]
         huxx = h[i + 1] * u[i + 1] - 2.0 * h[i] * u[i] + h[i - 1] * u[i - 1]
         work_d[i] = (coef_a[i] * uxx + coef_b[i] * huxx) * invdx2
-    stop = min(n - NG, i_fix + NG)
-    for i in range(NG, stop):
+    for i in range(NG, n - NG):
         qx = (-work_q[i + 2] + 8.0 * (work_q[i + 1] - work_q[i - 1]) + work_q[i - 2]) * inv12
         dflx = (work_d[i + 1] - work_d[i - 1]) * inv2
         e_out[i] = -qx - dflx - sponge[i] * eta[i] + src_shape[i] * src
         etax = (-eta[i + 2] + 8.0 * (eta[i + 1] - eta[i - 1]) + eta[i - 2]) * inv12
         ux = (-u[i + 2] + 8.0 * (u[i + 1] - u[i - 1]) + u[i - 2]) * inv12
         f_out[i] = -g * etax - u[i] * ux - sponge[i] * u[i]
-    for i in range(stop, n - NG):
-        e_out[i] = 0.0
-        f_out[i] = 0.0
+
+
+@njit(cache=True)
+def apply_pins(eta: np.ndarray, uu: np.ndarray, pin_idx: np.ndarray, pin_eta: np.ndarray,
+               pin_u: np.ndarray) -> None:
+    """Hold eta and U (= u: identity row of M) at the coupling-boundary node, if any."""
+    for p in range(pin_idx.size):
+        eta[pin_idx[p] + NG] = pin_eta[p]
+        uu[pin_idx[p] + NG] = pin_u[p]
+
+
+@njit(cache=True)
+def close_boundary(eta: np.ndarray, u: np.ndarray, uu: np.ndarray, pin_idx: np.ndarray) -> None:
+    """Make the coupling-boundary node b the right end of the active grid (two-way coupling).
+
+    The two ghost nodes beyond b take the cubic extrapolation through b-3..b (held value at b):
+    f_{b+1} = 4f_b - 6f_{b-1} + 4f_{b-2} - f_{b-3},  f_{b+2} = 10f_b - 20f_{b-1} + 15f_{b-2} - 4f_{b-3}.
+    The dispersive flux at b takes a second difference across b, so the ghost error is divided
+    by dx^3 in E at b-1: the cubic (O(dx^4)) extrapolation keeps the boundary 2nd-order
+    (a linear or quadratic one makes it 1st-order: tested). The grid beyond is inactive (zero).
+    """
+    if pin_idx.size == 0:
+        return
+    b = pin_idx[pin_idx.size - 1] + NG
+    n = eta.size
+    for f in (eta, u):
+        f[b + 1] = 4.0 * f[b] - 6.0 * f[b - 1] + 4.0 * f[b - 2] - f[b - 3]
+        f[b + 2] = 10.0 * f[b] - 20.0 * f[b - 1] + 15.0 * f[b - 2] - 4.0 * f[b - 3]
+    for i in range(b + NG + 1, n):
+        eta[i] = 0.0
+        u[i] = 0.0
+    for i in range(b + 1, n):
+        uu[i] = 0.0
 
 
 @njit(cache=True)
@@ -142,7 +169,7 @@ def rk4_step(t0: float, dt: float, eta: np.ndarray, u: np.ndarray, uu: np.ndarra
              e0: np.ndarray, f0: np.ndarray, h: np.ndarray, coef_a: np.ndarray, coef_b: np.ndarray,
              lower: np.ndarray, cprime: np.ndarray, minv: np.ndarray, sponge: np.ndarray,
              src_shape: np.ndarray, src_amp: np.ndarray, src_omega: np.ndarray, src_phase: np.ndarray,
-             src_ramp: float, g: float, dx: float, i_fix: int, eta_fix: float, u_fix: float,
+             src_ramp: float, g: float, dx: float, pin_idx: np.ndarray, pin_eta: np.ndarray, pin_u: np.ndarray,
              eta_s: np.ndarray, u_s: np.ndarray, uu_s: np.ndarray, ke: np.ndarray, kf: np.ndarray,
              acc_e: np.ndarray, acc_f: np.ndarray, work_q: np.ndarray, work_d: np.ndarray) -> None:
     """One classical Runge-Kutta step of (eta, U) from t0; starts the multistep history.
@@ -150,7 +177,6 @@ def rk4_step(t0: float, dt: float, eta: np.ndarray, u: np.ndarray, uu: np.ndarra
     e0, f0 hold R(t0); on return eta, u, uu are at t0 + dt (R at t0 + dt is not evaluated).
     """
     n = eta.size
-    i_fix_p = i_fix + NG
     for i in range(NG, n - NG):
         acc_e[i] = e0[i]
         acc_f[i] = f0[i]
@@ -162,25 +188,23 @@ def rk4_step(t0: float, dt: float, eta: np.ndarray, u: np.ndarray, uu: np.ndarra
         for i in range(NG, n - NG):
             eta_s[i] = eta[i] + frac * dt * ke[i]
             uu_s[i] = uu[i] + frac * dt * kf[i]
-        for i in range(i_fix_p, n - NG):
-            eta_s[i] = eta_fix
-            uu_s[i] = u_fix
+        apply_pins(eta_s, uu_s, pin_idx, pin_eta, pin_u)
         thomas_solve(lower, cprime, minv, uu_s, u_s, NG)
         fill_ghosts(eta_s, u_s)
+        close_boundary(eta_s, u_s, uu_s, pin_idx)
         ts = t0 + frac * dt
         src = source_signal(ts, src_amp, src_omega, src_phase, src_ramp)
-        rhs(eta_s, u_s, h, coef_a, coef_b, sponge, src_shape, src, g, dx, i_fix, work_q, work_d, ke, kf)
+        rhs(eta_s, u_s, h, coef_a, coef_b, sponge, src_shape, src, g, dx, work_q, work_d, ke, kf)
         for i in range(NG, n - NG):
             acc_e[i] += weight * ke[i]
             acc_f[i] += weight * kf[i]
     for i in range(NG, n - NG):
         eta[i] += dt / 6.0 * acc_e[i]
         uu[i] += dt / 6.0 * acc_f[i]
-    for i in range(i_fix_p, n - NG):
-        eta[i] = eta_fix
-        uu[i] = u_fix
+    apply_pins(eta, uu, pin_idx, pin_eta, pin_u)
     thomas_solve(lower, cprime, minv, uu, u, NG)
     fill_ghosts(eta, u)
+    close_boundary(eta, u, uu, pin_idx)
 
 
 @njit(cache=True)
@@ -192,7 +216,7 @@ def advance_steps(n_steps: int, t0: float, dt: float, n_hist: int, tol: float, m
                   cprime: np.ndarray, minv: np.ndarray,
                   sponge: np.ndarray, src_shape: np.ndarray, src_amp: np.ndarray, src_omega: np.ndarray,
                   src_phase: np.ndarray, src_ramp: float, g: float, dx: float,
-                  i_fix: int, eta_fix: float, u_fix: float,
+                  pin_idx: np.ndarray, pin_eta: np.ndarray, pin_u: np.ndarray,
                   eta_new: np.ndarray, u_new: np.ndarray, uu_new: np.ndarray,
                   e_new: np.ndarray, f_new: np.ndarray,
                   eta_prev: np.ndarray, u_prev: np.ndarray,
@@ -206,12 +230,11 @@ def advance_steps(n_steps: int, t0: float, dt: float, n_hist: int, tol: float, m
     three levels (start, or after the state was set), classical RK4 steps fill it.
 
     e_hist, f_hist: (3, n) with rows R^n, R^{n-1}, R^{n-2}, filled for the first n_hist rows.
-    i_fix: first model node held at (eta_fix, u_fix) (two-way coupling), or the node count.
+    pin_idx, pin_eta, pin_u: the coupling-boundary node (empty, or one node) and its held eta, u.
     stats: [corrector iterations summed, max iterations of one step, non-converged steps].
     Returns the new history length.
     """
     n = eta.size
-    i_fix_p = i_fix + NG  # padded index
     p0, p1, p2 = 23.0 / 12.0, -16.0 / 12.0, 5.0 / 12.0
     c_new, c0, c1, c2 = 9.0 / 24.0, 19.0 / 24.0, -5.0 / 24.0, 1.0 / 24.0
     for step in range(n_steps):
@@ -220,10 +243,10 @@ def advance_steps(n_steps: int, t0: float, dt: float, n_hist: int, tol: float, m
             # start (or restart) the history with 4th-order Runge-Kutta steps
             rk4_step(t1 - dt, dt, eta, u, uu, e_hist[0], f_hist[0], h, coef_a, coef_b, lower, cprime,
                      minv, sponge, src_shape, src_amp, src_omega, src_phase, src_ramp, g, dx,
-                     i_fix, eta_fix, u_fix, eta_new, u_new, uu_new, e_new, f_new, eta_prev, u_prev,
+                     pin_idx, pin_eta, pin_u, eta_new, u_new, uu_new, e_new, f_new, eta_prev, u_prev,
                      work_q, work_d)
             src = source_signal(t1, src_amp, src_omega, src_phase, src_ramp)
-            rhs(eta, u, h, coef_a, coef_b, sponge, src_shape, src, g, dx, i_fix,
+            rhs(eta, u, h, coef_a, coef_b, sponge, src_shape, src, g, dx,
                 work_q, work_d, e_new, f_new)
             for i in range(NG, n - NG):
                 e_hist[2, i] = e_hist[1, i]
@@ -240,13 +263,12 @@ def advance_steps(n_steps: int, t0: float, dt: float, n_hist: int, tol: float, m
         for i in range(NG, n - NG):
             eta_new[i] = eta[i] + dt * (p0 * e_hist[0, i] + p1 * e_hist[1, i] + p2 * e_hist[2, i])
             uu_new[i] = uu[i] + dt * (p0 * f_hist[0, i] + p1 * f_hist[1, i] + p2 * f_hist[2, i])
-        for i in range(i_fix_p, n - NG):
-            eta_new[i] = eta_fix
-            uu_new[i] = u_fix
+        apply_pins(eta_new, uu_new, pin_idx, pin_eta, pin_u)
         thomas_solve(lower, cprime, minv, uu_new, u_new, NG)
         fill_ghosts(eta_new, u_new)
+        close_boundary(eta_new, u_new, uu_new, pin_idx)
         src = source_signal(t1, src_amp, src_omega, src_phase, src_ramp)
-        rhs(eta_new, u_new, h, coef_a, coef_b, sponge, src_shape, src, g, dx, i_fix,
+        rhs(eta_new, u_new, h, coef_a, coef_b, sponge, src_shape, src, g, dx,
             work_q, work_d, e_new, f_new)
         # corrector iterations
         it = 0
@@ -259,12 +281,11 @@ def advance_steps(n_steps: int, t0: float, dt: float, n_hist: int, tol: float, m
                                             + c2 * e_hist[2, i])
                 uu_new[i] = uu[i] + dt * (c_new * f_new[i] + c0 * f_hist[0, i] + c1 * f_hist[1, i]
                                           + c2 * f_hist[2, i])
-            for i in range(i_fix_p, n - NG):
-                eta_new[i] = eta_fix
-                uu_new[i] = u_fix
+            apply_pins(eta_new, uu_new, pin_idx, pin_eta, pin_u)
             thomas_solve(lower, cprime, minv, uu_new, u_new, NG)
             fill_ghosts(eta_new, u_new)
-            rhs(eta_new, u_new, h, coef_a, coef_b, sponge, src_shape, src, g, dx, i_fix,
+            close_boundary(eta_new, u_new, uu_new, pin_idx)
+            rhs(eta_new, u_new, h, coef_a, coef_b, sponge, src_shape, src, g, dx,
                 work_q, work_d, e_new, f_new)
             de = 0.0
             se = 0.0
@@ -297,12 +318,13 @@ def advance_steps(n_steps: int, t0: float, dt: float, n_hist: int, tol: float, m
             u[i] = u_new[i]
             uu[i] = uu_new[i]
         if filter_every > 0 and (step0 + step + 1) % filter_every == 0:
-            end = min(n - NG, i_fix_p)
-            shapiro_filter(eta, work_q, end)
-            shapiro_filter(u, work_q, end)
+            shapiro_filter(eta, work_q, n - NG)
+            shapiro_filter(u, work_q, n - NG)
+            apply_pins(eta, u, pin_idx, pin_eta, pin_u)
             fill_ghosts(eta, u)
+            close_boundary(eta, u, uu, pin_idx)
             apply_operator(lower, diag, upper, u, uu, NG)
-            rhs(eta, u, h, coef_a, coef_b, sponge, src_shape, src, g, dx, i_fix,
+            rhs(eta, u, h, coef_a, coef_b, sponge, src_shape, src, g, dx,
                 work_q, work_d, e_hist[0], f_hist[0])
         if not np.isfinite(eta[NG]) or not np.isfinite(se):
             return -(step + 1)

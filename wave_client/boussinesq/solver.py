@@ -43,7 +43,7 @@ class _Checkpoint:
     step: int
     n_hist: int
     arrays: tuple[np.ndarray, ...]
-    fixed: tuple[int, float, float]
+    pins: dict[int, tuple[float, float]]
 
 
 def sponge_profile(x: np.ndarray, x0: float, x1: float, width_left: float, width_right: float,
@@ -161,7 +161,8 @@ class BoussinesqModel:
         self._stats = np.zeros(3)
         self._step = 0
         self._n_hist = 0
-        self._i_fix, self._eta_fix, self._u_fix = nm, 0.0, 0.0
+        self._pins: dict[int, tuple[float, float]] = {}  # coupling-boundary node -> (eta, u_alpha)
+        self._pin_idx, self._pin_eta, self._pin_u = np.zeros(0, np.int64), np.zeros(0), np.zeros(0)
         self._lower, self._diag, self._upper = np.zeros(nm), np.zeros(nm), np.zeros(nm)
         self._cprime, self._minv = np.zeros(nm), np.zeros(nm)
         self._factor()
@@ -191,27 +192,30 @@ class BoussinesqModel:
         return 1.5 * 2.0 * math.pi * c / width
 
     def _factor(self) -> None:
-        """Assemble and factor U = M u (rows of walls and held nodes are identity)."""
+        """Assemble and factor U = M u (rows of walls and pinned nodes are identity)."""
         nm, dx2 = self.n_nodes, self.dx * self.dx
         h = self.h_nodes
+        i = np.arange(1, nm - 1)
         self._lower[:] = 0.0
         self._upper[:] = 0.0
         self._diag[:] = 1.0
-        i = np.arange(1, min(nm - 1, self._i_fix))
         self._lower[i] = (self._a2[i] + self._b2[i] * h[i - 1]) / dx2
         self._diag[i] = 1.0 - 2.0 * (self._a2[i] + self._b2[i] * h[i]) / dx2
         self._upper[i] = (self._a2[i] + self._b2[i] * h[i + 1]) / dx2
+        p = self._pin_idx
+        self._lower[p], self._diag[p], self._upper[p] = 0.0, 1.0, 0.0
         K.thomas_factor(self._lower, self._diag, self._upper, self._cprime, self._minv)
 
     def _refresh_rhs(self) -> None:
         """Recompute U = M u and the newest history level from the current state (restart the
         multistep history: used after the state is set from outside)."""
         K.fill_ghosts(self._eta, self._u)
+        K.close_boundary(self._eta, self._u, self._uu, self._pin_idx)
         K.apply_operator(self._lower, self._diag, self._upper, self._u, self._uu, K.NG)
         src = K.source_signal(self.t, self._src_amp, self._src_omega, self._src_phase, self._src_ramp)
         wq, wd = self._scratch[7], self._scratch[8]
         K.rhs(self._eta, self._u, self._h, self._coef_a, self._coef_b, self._sponge, self._src_shape,
-              src, self.g, self.dx, self._i_fix, wq, wd, self._e_hist[0], self._f_hist[0])
+              src, self.g, self.dx, wq, wd, self._e_hist[0], self._f_hist[0])
         self._n_hist = 1
 
     def set_state(self, eta: ArrayLike, u: ArrayLike) -> None:
@@ -286,7 +290,7 @@ class BoussinesqModel:
             self._h, self._coef_a, self._coef_b, self._lower, self._diag, self._upper,
             self._cprime, self._minv, self._sponge, self._src_shape, self._src_amp, self._src_omega,
             self._src_phase, self._src_ramp, self.g, self.dx,
-            self._i_fix, self._eta_fix, self._u_fix,
+            self._pin_idx, self._pin_eta, self._pin_u,
             s[0], s[1], s[2], s[3], s[4], s[5], s[6], s[7], s[8], self._stats)
         if res < 0:
             self._step += -res
@@ -371,28 +375,40 @@ class BoussinesqModel:
 
     # ------------------------------------------------------------------ coupling
     def impose(self, x: float, eta: float, u_ref: float) -> None:
-        """Two-way feedback (seed 001 Alg. 2, line 4): hold eta and u_alpha at the node nearest
-        x and at all nodes beyond it, for the following steps.
+        """Two-way feedback (seed 001 Alg. 2, line 4): eta and u_alpha measured by SPH at x become
+        the right-hand boundary of the model, held for the following steps.
 
-        u_ref is the velocity measured by SPH at the reference depth z_alpha = beta h, i.e. the
-        model's own variable u_alpha. Ignored when the model was built with two_way=False.
+        The grid node nearest x is held at (eta, u_ref) and ends the active grid; its two ghost
+        nodes beyond take the odd reflection about the held values (`kernels.close_boundary`), the
+        grid further right is inactive. A later call moves the boundary if x differs. The SPH
+        zone thus lies at the x > x_b end of the Boussinesq grid, overlapping it. u_ref is the
+        velocity measured at the reference depth z_alpha = beta h, the model's own variable.
+        Ignored when the model was built with two_way=False (absorption-only coupling).
         """
         if not self.two_way:
             return
         i = int(round((float(x) - self.x0) / self.dx))
-        if not (4 <= i <= self.n_nodes - 1):
-            raise ValueError(f"impose: x = {x} m must lie inside the grid, at least 4 nodes from x0")
+        if not (4 <= i <= self.n_nodes - 3):
+            raise ValueError(f"impose: x = {x} m must lie inside the grid, at least 4 nodes from x0 "
+                             f"and 2 from x1 ([{self.x0}, {self.x1}])")
         if not (math.isfinite(eta) and math.isfinite(u_ref)):
             raise ValueError(f"impose: eta ({eta}) and u_ref ({u_ref}) must be finite")
-        self._eta_fix, self._u_fix = float(eta), float(u_ref)
-        if i != self._i_fix:
-            self._i_fix = i
-            self._factor()
+        moved = i not in self._pins
+        self._pins = {i: (float(eta), float(u_ref))}
+        self._sync_pins(refactor=moved)
 
     def release(self) -> None:
-        """Stop holding nodes (back to the free model with its walls and sponges)."""
-        if self._i_fix != self.n_nodes:
-            self._i_fix = self.n_nodes
+        """Remove the coupling boundary; the grid beyond it restarts from rest."""
+        if self._pins:
+            self._pins.clear()
+            self._sync_pins(refactor=True)
+
+    def _sync_pins(self, refactor: bool) -> None:
+        idx = np.array(sorted(self._pins), dtype=np.int64)
+        self._pin_idx = idx
+        self._pin_eta = np.array([self._pins[i][0] for i in idx], float)
+        self._pin_u = np.array([self._pins[i][1] for i in idx], float)
+        if refactor:
             self._factor()
             self._refresh_rhs()
 
@@ -400,15 +416,14 @@ class BoussinesqModel:
         """An exact copy of the state, for the protocol's `goback`."""
         arrays = (self._eta.copy(), self._u.copy(), self._uu.copy(), self._e_hist.copy(),
                   self._f_hist.copy(), self._stats.copy())
-        return _Checkpoint(self._step, self._n_hist, arrays, (self._i_fix, self._eta_fix, self._u_fix))
+        return _Checkpoint(self._step, self._n_hist, arrays, dict(self._pins))
 
     def restore(self, cp: _Checkpoint) -> None:
         """Return to a state saved by `checkpoint`."""
+        refactor = set(cp.pins) != set(self._pins)
+        self._pins = dict(cp.pins)
+        self._sync_pins(refactor)
         for dst, src in zip((self._eta, self._u, self._uu, self._e_hist, self._f_hist, self._stats), cp.arrays):
             dst[...] = src
         self._step, self._n_hist = cp.step, cp.n_hist
-        i_fix, self._eta_fix, self._u_fix = cp.fixed
-        if i_fix != self._i_fix:
-            self._i_fix = i_fix
-            self._factor()
 

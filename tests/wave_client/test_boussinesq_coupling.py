@@ -1,0 +1,142 @@
+"""The Boussinesq model as a coupling partner: WaveModel contract, velocity profile, two-way
+feedback by pinned nodes, absorption-only mode, checkpoint/restore."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from wave_client.boussinesq import BoussinesqModel, nwogu_wavenumber
+from wave_client.boussinesq.dispersion import BETA, alpha, airy_wavenumber
+from wave_client.model import WaveModel
+
+G = 9.81
+
+
+def flume(depth: float, period: float, left: float, right: float, sponge_right: bool = True,
+          height: float = 0.002) -> tuple[BoussinesqModel, float]:
+    """Flat flume [left, right] wavelengths, regular source at x = 0; returns (model, wavelength)."""
+    k = float(nwogu_wavenumber(2 * np.pi / period, depth))
+    wl = 2 * np.pi / k
+    m = BoussinesqModel(left * wl, right * wl, wl / 40, depth, sponge_left=1.5 * wl,
+                        sponge_right=1.5 * wl if sponge_right else 0.0)
+    m.set_regular_wave(0.0, height, period, ramp_periods=2)
+    return m, wl
+
+
+def test_satisfies_wave_model_contract():
+    m, _ = flume(0.5, 2.0, -3, 6)
+    assert isinstance(m, WaveModel)
+    assert m.depth == pytest.approx(0.5)
+    m.advance_to(1.0)
+    assert m.t == pytest.approx(1.0, abs=m.dt / 2)
+    u, w = m.velocity(1.0, np.linspace(-0.5, 0.1, 7))
+    assert u.shape == (7,) and w.shape == (7,) and np.all(np.isfinite(u)) and np.all(np.isfinite(w))
+    with pytest.raises(ValueError, match="outside"):
+        m.elevation(1e3)
+
+
+def test_velocity_profile_of_a_progressive_wave():
+    """Linear progressive wave, kd ~ 1: u(z), w(z) amplitudes per unit eta amplitude match
+    Nwogu's linear profile (u_alpha = g k a / (omega (1 - alpha (kd)^2)), quadratic in z) within
+    1 %, and Airy's cosh/sinh profile within Nwogu's own profile error + 1 %."""
+    depth, period = 0.5, 1.5
+    m, wl = flume(depth, period, -3, 5)
+    omega = 2 * np.pi / period
+    k = 2 * np.pi / wl
+    x = 1.25 * wl
+    zs = np.array([0.0, -0.25 * depth, -0.5 * depth, -depth])
+    m.advance_to(20 * period)
+    n = int(round(8 * period / m.dt / 2))
+    ts, eta, uu, ww = np.empty(n), np.empty(n), np.empty((n, zs.size)), np.empty((n, zs.size))
+    for i in range(n):
+        m.advance_steps(2)
+        ts[i], eta[i] = m.t, m.elevation(x)
+        uu[i], ww[i] = m.velocity(x, zs)
+
+    def amp(y):
+        basis = np.c_[np.cos(omega * ts), np.sin(omega * ts)]
+        c, *_ = np.linalg.lstsq(basis, y, rcond=None)
+        return np.hypot(*c)
+
+    a = amp(eta)
+    u_amp = np.array([amp(uu[:, j]) for j in range(zs.size)]) / a
+    w_amp = np.array([amp(ww[:, j]) for j in range(zs.size)]) / a
+    kd = k * depth
+    za = BETA * depth
+    ua = G * k / (omega * (1 - alpha() * kd**2))
+    u_nw = ua * np.abs(1 - k**2 * ((za - zs) * depth + 0.5 * (za**2 - zs**2)))
+    w_nw = ua * k * (depth + zs)
+    np.testing.assert_allclose(u_amp, u_nw, rtol=0.01)
+    np.testing.assert_allclose(w_amp[:-1], w_nw[:-1], rtol=0.01)
+    assert w_amp[-1] < 1e-3 * w_amp[0]  # no flow through the flat bed
+    ka = float(airy_wavenumber(omega, depth))
+    u_airy = omega * np.cosh(ka * (zs + depth)) / np.sinh(ka * depth)
+    w_airy = omega * np.sinh(ka * (zs + depth)) / np.sinh(ka * depth)
+    assert np.all(np.abs(u_amp / u_airy - 1) <= np.abs(u_nw / u_airy - 1) + 0.01)
+    assert np.all(np.abs(w_amp[:-1] / w_airy[:-1] - 1) <= np.abs(w_nw[:-1] / w_airy[:-1] - 1) + 0.01)
+
+
+def test_two_way_pin_carries_reflected_waves_back():
+    """Model A ends in a reflective wall (stand-in for an SPH zone that reflects); model B runs on
+    a longer absorbing flume but has eta and u_alpha of A imposed at x_b every step. Upstream of
+    x_b, B must reproduce A's partly standing wave (the reflection enters B through the pin),
+    which a free B (no feedback) does not."""
+    depth, period = 0.5, 2.0
+    a_model, wl = flume(depth, period, -3, 4.0, sponge_right=False, height=0.01)
+    b_model, _ = flume(depth, period, -3, 8.0, height=0.01)
+    free, _ = flume(depth, period, -3, 8.0, height=0.01)
+    assert a_model.dt == pytest.approx(b_model.dt)
+    x_b = 3.5 * wl
+    i_b = int(round((x_b - a_model.x0) / a_model.dx))
+    xs = np.array([0.5, 1.0, 1.5, 2.0, 2.5, 3.0]) * wl
+    err, diff_free, scale = 0.0, 0.0, 0.0
+    while a_model.t < 25 * period:
+        a_model.advance_steps(1)
+        b_model.impose(x_b, a_model.eta_nodes[i_b], a_model.u_nodes[i_b])
+        b_model.advance_steps(1)
+        free.advance_steps(1)
+        if a_model.t > 15 * period:
+            ea = a_model.elevation(xs)
+            err = max(err, np.max(np.abs(b_model.elevation(xs) - ea)))
+            diff_free = max(diff_free, np.max(np.abs(free.elevation(xs) - ea)))
+            scale = max(scale, np.max(np.abs(ea)))
+    assert err < 0.01 * scale
+    assert diff_free > 0.5 * scale  # the reflection is a large effect: the test can fail
+
+
+def test_absorption_only_mode_ignores_impose():
+    depth, period = 0.5, 2.0
+    m1, wl = flume(depth, period, -3, 6)
+    m2 = BoussinesqModel(m1.x0, m1.x1, m1.dx, depth, sponge_left=1.5 * wl, sponge_right=1.5 * wl,
+                         two_way=False)
+    m2.set_regular_wave(0.0, 0.002, period, ramp_periods=2)
+    for _ in range(50):
+        m2.impose(3 * wl, 0.5, 1.0)
+        m1.advance_steps(4)
+        m2.advance_steps(4)
+    np.testing.assert_array_equal(m1.eta_nodes, m2.eta_nodes)
+
+
+def test_impose_rejects_bad_input():
+    m, wl = flume(0.5, 2.0, -3, 6)
+    with pytest.raises(ValueError, match="impose"):
+        m.impose(100 * wl, 0.0, 0.0)
+    with pytest.raises(ValueError, match="finite"):
+        m.impose(wl, float("nan"), 0.0)
+
+
+def test_checkpoint_restore_is_exact():
+    m, wl = flume(0.5, 2.0, -3, 6)
+    m.advance_to(3.0)
+    m.impose(4 * wl, 0.001, 0.0)
+    cp = m.checkpoint()
+    m.advance_steps(100)
+    eta1, t1 = m.eta_nodes.copy(), m.t
+    m.release()
+    m.advance_steps(10)
+    m.restore(cp)
+    assert m.t == pytest.approx(3.0, abs=m.dt)
+    m.advance_steps(100)
+    assert m.t == t1
+    np.testing.assert_array_equal(m.eta_nodes, eta1)
