@@ -90,7 +90,8 @@ class SphSession:
     """Protocol state of one coupling connection, SPH side.
 
     ``welcome`` is the server's offer (capabilities it supports, scene summary); the
-    capabilities actually sent are the intersection with the client's. ``nodes`` is the reply
+    capabilities actually sent are the intersection with the client's, and ``max_payload`` is
+    set to the largest frame the client may send for this scene (a SET). ``nodes`` is the reply
     to GETNODES; its lengths must agree with ``welcome``.
     """
 
@@ -98,7 +99,9 @@ class SphSession:
         if not (nodes.x.size == nodes.z.size == nodes.side.size == welcome.n_nodes
                 and nodes.gauge_x.size == welcome.n_gauges):
             raise ValueError("nodes: array lengths disagree with welcome.n_nodes / n_gauges")
-        self.offer = welcome
+        # after HELLO the client may send nothing larger than a SET for this scene
+        self.client_limit = max(set_payload_size(welcome.n_nodes), 4 + 4 + MAX_TEXT)
+        self.offer = replace(welcome, max_payload=self.client_limit)
         self.nodes = nodes
         self.state = State.AWAIT_HELLO
         self.capabilities = 0
@@ -114,7 +117,7 @@ class SphSession:
         """Largest payload the client may send now: before HELLO only a small one."""
         if self.state is State.AWAIT_HELLO:
             return 4 + 32 + 2 * (4 + MAX_TEXT)
-        return max(set_payload_size(self.offer.n_nodes), 4 + 4 + MAX_TEXT)
+        return self.client_limit
 
     # -- incoming ---------------------------------------------------------------------------
     def receive(self, seq: int, msg: Message) -> Action:

@@ -182,14 +182,14 @@ def test_error_frame_reaches_the_client_as_remote_error():
 
 def test_max_payload_follows_the_handshake():
     s = make_session()
-    before = s.max_payload
-    s.receive(1, Hello(0))
-    assert s.max_payload == max(16 + 3 * (4 + 8 * N), 4104)
-    assert before == 4 + 32 + 2 * (4 + 4096)
-    big = make_session()
-    big.offer.n_nodes = 1000  # the payload limit follows the scene's node count
-    big.receive(1, Hello(0))
-    assert big.max_payload == 16 + 3 * (4 + 8000)
+    assert s.max_payload == 4 + 32 + 2 * (4 + 4096)  # before HELLO: at most a HELLO
+    welcome = decode_frame(s.receive(1, Hello(0)).data)[1]
+    assert s.max_payload == welcome.max_payload == max(16 + 3 * (4 + 8 * N), 4104)
+    n = 1000
+    offer = Welcome(0, HASH, 9.81, 1.0, 1.0, -0.5, 0.0, 1.0, 1e-4, 0.1, 30.0, n, 0, 0)
+    big = SphSession(offer, Nodes(np.zeros(n), np.zeros(n), np.zeros(n, np.uint32), []))
+    welcome = decode_frame(big.receive(1, Hello(0)).data)[1]
+    assert big.max_payload == welcome.max_payload == 16 + 3 * (4 + 8 * n)
 
 
 def test_get_is_allowed_any_time_after_hello_and_does_not_move_the_clock():

@@ -1,0 +1,47 @@
+"""`wavesph serve`: the SPH coupling server (HTTP + WebSocket + TCP coupling port)."""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import sys
+from pathlib import Path
+
+from pydantic import ValidationError
+
+from .settings import Settings
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--host", help="HTTP/WebSocket bind address (default 127.0.0.1; "
+                                       "any other address requires --token)")
+    parser.add_argument("--port", type=int, help="HTTP port (default 8765)")
+    parser.add_argument("--tcp-port", type=int, help="plain TCP coupling port (default 8766)")
+    parser.add_argument("--runs-dir", type=Path, help="run store directory (default ./runs)")
+    parser.add_argument("--max-runs", type=int, help="runs stepping at once; more are queued (default 2)")
+    parser.add_argument("--max-particles", type=int, help="particle cap per run (default 2e6)")
+    parser.add_argument("--token", help="API token (or WAVESPH_TOKEN); required off loopback")
+    parser.epilog = "Every option can also be set as WAVESPH_<OPTION> in the environment."
+
+
+def main(args: argparse.Namespace) -> int:
+    import uvicorn
+
+    from .main import create_app
+
+    try:
+        settings = Settings.from_env(host=args.host, port=args.port, tcp_port=args.tcp_port,
+                                     runs_dir=args.runs_dir, max_runs=args.max_runs,
+                                     max_particles=args.max_particles, token=args.token)
+    except ValidationError as exc:
+        for err in exc.errors():
+            field = ".".join(str(p) for p in err["loc"]) or "settings"
+            print(f"wavesph serve: {field}: {err['msg'].removeprefix('Value error, ')}", file=sys.stderr)
+        return 2
+    logging.basicConfig(level=logging.INFO, format="%(asctime)s %(name)s %(message)s")
+    app = create_app(settings)
+    print(f"wavesph serve: http://{settings.host}:{settings.port} (docs at /docs), TCP coupling "
+          f"port {settings.tcp_port}, runs in {settings.runs_dir.resolve()}", file=sys.stderr)
+    uvicorn.run(app, host=settings.host, port=settings.port, log_level="info",
+                ws_max_size=settings.max_frame + 16)
+    return 0

@@ -1,0 +1,228 @@
+"""The coupling door logic shared by the WebSocket and TCP endpoints.
+
+A transport gives ``recv()`` (a list of (seq, message), or None when the peer closed) and
+``send(bytes)``; ``serve_client`` runs the protocol session (protocol.SphSession) against the
+run's engine. Engine calls go to the worker pool; every read has a timeout; the run's state
+says how the session ended, and the gauge rows of every solved window are on disk already.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import logging
+import time
+from typing import Protocol
+
+import numpy as np
+
+from protocol import (Capability, ErrorCode, Nodes, ProtocolError, Result, SphSession, Welcome,
+                      encode_frame)
+from protocol.messages import Error, Hello, Message
+from protocol.session import Measure, PeerError, Reply, Restore, SetWindow, SolveWindow
+
+from .engine import CouplingEngine, Measurement
+from .runs import FAILED, FINISHED, RUNNING, UNSTABLE, Run, RunManager
+
+log = logging.getLogger("wavesph.server")
+
+SERVER_NAME = "wavesph-server 0.1 (protocol 1)"
+
+
+class Transport(Protocol):
+    max_payload: int
+
+    async def recv(self) -> list[tuple[int, Message]] | None: ...
+    async def send(self, data: bytes) -> None: ...
+    async def close(self) -> None: ...
+
+
+class _SessionEnd(Exception):
+    def __init__(self, state: str, reason: str | None, frame: bytes | None = None) -> None:
+        super().__init__(reason)
+        self.state, self.reason, self.frame = state, reason, frame
+
+
+def error_frame(code: ErrorCode, text: str, seq: int = 0) -> bytes:
+    """An ERROR frame outside a session (before the run is known)."""
+    return encode_frame(Error(int(code), text[:4000]), seq)
+
+
+def welcome_for(run: Run, engine: CouplingEngine, idle_timeout: float) -> tuple[Welcome, Nodes]:
+    s, nodes = engine.summary, engine.nodes()
+    opts = run.request.coupling
+    z_ref = s.z_ref if opts.z_ref is None else opts.z_ref
+    welcome = Welcome(int(Capability.GOBACK), bytes.fromhex(run.info.scene_hash), g=s.g, depth=s.depth,
+                      still_water_level=s.still_water_level, z_ref=z_ref, t_start=s.t_start,
+                      t_end=s.t_end, dt_sph=s.dt_sph, window_max=opts.window_max,
+                      idle_timeout=idle_timeout, n_nodes=nodes.x.size, n_gauges=nodes.gauge_x.size,
+                      max_payload=0, run_id=run.info.id, server=SERVER_NAME)
+    return welcome, Nodes(nodes.x, nodes.z, nodes.side, nodes.gauge_x)
+
+
+async def serve_client(manager: RunManager, run: Run, transport: Transport,
+                       first: list[tuple[int, Message]]) -> None:
+    """Run one client's session on ``run`` (already attached); sets the run's final state."""
+    settings, engine = manager.settings, run.engine
+    assert engine is not None and run.gauges is not None
+    loop = asyncio.get_running_loop()
+    welcome, nodes = welcome_for(run, engine, settings.idle_timeout)
+    session = SphSession(welcome, nodes)
+    names = engine.nodes().gauge_names or [f"g{j}" for j in range(nodes.gauge_x.size)]
+    pending = list(first)
+    connected = time.perf_counter()
+    solve_time = 0.0
+    timeout = settings.hello_timeout
+    end: _SessionEnd
+
+    def sync_limits() -> None:
+        transport.max_payload = min(session.max_payload, settings.max_frame)
+
+    sync_limits()
+    try:
+        while True:
+            if not pending:
+                pending = await _recv(transport, timeout, run)
+            seq, msg = pending.pop(0)
+            action = session.receive(seq, msg)
+            sync_limits()
+            timeout = settings.idle_timeout
+            if isinstance(action, Reply):
+                if isinstance(msg, Hello):
+                    run.info.client = msg.client or "unnamed client"
+                    manager._set_state(run, RUNNING)
+                await transport.send(action.data)
+                if action.close:
+                    raise _SessionEnd(FINISHED, None)
+            elif isinstance(action, SetWindow):
+                await loop.run_in_executor(manager.executor, engine.set_window, action.t0, action.t1,
+                                           action.u, action.w, action.eta)
+            elif isinstance(action, SolveWindow):
+                tic = time.perf_counter()
+                measured = await loop.run_in_executor(manager.executor, _solve, engine, run,
+                                                      bool(session.capabilities & Capability.GOBACK))
+                solve_time += time.perf_counter() - tic
+                reply = session.result(action, _result(measured))
+                values = _gauge_values(names, measured)
+                run.gauges.row(engine.t, measured.steps, values)
+                _progress(manager, run, engine, values, connected, solve_time)
+                await transport.send(reply)
+            elif isinstance(action, Measure):
+                measured = await loop.run_in_executor(manager.executor, engine.measure)
+                await transport.send(session.result(action, _result(measured)))
+            elif isinstance(action, Restore):
+                measured = await loop.run_in_executor(manager.executor, _goback, engine)
+                run.gauges.rewind()
+                run.info.windows = max(run.info.windows - 1, 0)
+                _progress(manager, run, engine, {}, connected, solve_time)
+                await transport.send(session.result(action, _result(measured)))
+            elif isinstance(action, PeerError):
+                raise _SessionEnd(FAILED, f"client error {action.code}: {action.text}")
+            if run.cancelled.is_set():
+                raise _Cancel()
+    except _SessionEnd as exc:
+        end = exc
+    except _Cancel:
+        state, reason = manager.cancel_reason
+        end = _SessionEnd(state, reason, session.error_frame(ProtocolError(ErrorCode.CANCELLED, reason)))
+    except _Gone:
+        end = _SessionEnd(FAILED, "client disconnected")
+    except TimeoutError:
+        end = _SessionEnd(FAILED, f"client timed out (silent for {timeout:g} s)",
+                          session.error_frame(ProtocolError(
+                              ErrorCode.TIMEOUT, f"no frame for {timeout:g} s; the run is failed")))
+    except ProtocolError as exc:
+        end = _SessionEnd(FAILED, f"protocol error: {exc}", session.error_frame(exc))
+    except Exception as exc:  # noqa: BLE001 -- engine failures become run states, never a crash
+        from sph_core.simulation import UnstableError
+
+        if isinstance(exc, UnstableError):
+            end = _SessionEnd(UNSTABLE, str(exc), session.error_frame(
+                ProtocolError(ErrorCode.ENGINE_FAILED, str(exc))))
+            run.info.stability = {**run.info.stability, "unstable_step": exc.step, "unstable_t": exc.t}
+        else:
+            log.exception("run %s: coupling failed", run.info.id)
+            end = _SessionEnd(FAILED, f"{type(exc).__name__}: {exc}", session.error_frame(exc))
+    if end.frame is not None:
+        try:
+            await asyncio.wait_for(transport.send(end.frame), 5.0)
+        except Exception:  # noqa: BLE001 -- the peer may be gone; the run state says it all
+            pass
+    try:
+        await asyncio.wait_for(transport.close(), 5.0)
+    except Exception:  # noqa: BLE001
+        pass
+    _progress(manager, run, engine, None, connected, solve_time)
+    manager._set_state(run, end.state, end.reason)
+    run.session_done.set()
+
+
+class _Gone(Exception):
+    """The peer closed the connection without BYE."""
+
+
+class _Cancel(Exception):
+    pass
+
+
+async def _recv(transport: Transport, timeout: float, run: Run) -> list[tuple[int, Message]]:
+    """Next frames, or _Gone / TimeoutError / _Cancel; ProtocolError passes through."""
+    recv = asyncio.ensure_future(transport.recv())
+    cancel = asyncio.ensure_future(run.cancelled.wait())
+    try:
+        done, _ = await asyncio.wait({recv, cancel}, timeout=timeout, return_when=asyncio.FIRST_COMPLETED)
+    finally:
+        cancel.cancel()
+    if recv in done:
+        frames = recv.result()
+        if frames is None:
+            raise _Gone()
+        return frames
+    recv.cancel()
+    if cancel in done:
+        raise _Cancel()
+    raise TimeoutError()
+
+
+def _solve(engine: CouplingEngine, run: Run, checkpoint: bool) -> Measurement:
+    """Worker thread: checkpoint (for GOBACK) then solve one window."""
+    if checkpoint:
+        engine.checkpoint()
+        run.gauges.mark()
+    return engine.solve_window()
+
+
+def _goback(engine: CouplingEngine) -> Measurement:
+    engine.goback()
+    return engine.measure()
+
+
+def _result(m: Measurement) -> Result:
+    wet = np.asarray(m.wet, dtype=bool)
+    z = np.zeros(wet.size)
+    return Result(0.0, int(m.steps), np.where(wet, m.eta, z), wet.astype(np.uint32),
+                  np.where(wet, m.u_ref, z), np.where(wet, m.w_ref, z))
+
+
+def _gauge_values(names: list[str], m: Measurement) -> dict[str, float | None]:
+    out: dict[str, float | None] = {}
+    for j, name in enumerate(names):
+        wet = bool(m.wet[j])
+        out[f"{name}_eta"] = float(m.eta[j]) if wet else None
+        out[f"{name}_u_ref"] = float(m.u_ref[j]) if wet else None
+        out[f"{name}_w_ref"] = float(m.w_ref[j]) if wet else None
+    return out
+
+
+def _progress(manager: RunManager, run: Run, engine: CouplingEngine,
+              values: dict[str, float | None] | None, connected: float, solve_time: float) -> None:
+    info = run.info
+    info.t, info.steps, info.particles = engine.t, engine.steps, engine.n_particles
+    if values:
+        info.last_gauges = values
+        info.windows += 1
+    wall = time.perf_counter() - connected
+    if solve_time > 0:
+        info.particle_steps_per_s = engine.n_particles * engine.steps / solve_time
+    info.coupling_overhead_share = max(0.0, 1.0 - solve_time / wall) if wall > 0 else None
+    info.stability = {**info.stability, **engine.stability()}
+    manager.save(run, force=values is None)

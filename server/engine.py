@@ -1,0 +1,76 @@
+"""The SPH side of a coupled run, as the coupling doors see it.
+
+A coupled run drives an object with this interface. The doors (WebSocket, TCP) speak the
+protocol and call it from a worker thread, never on the event loop. The adapter over
+sph_core's Simulation with open boundaries fills it once sph_core has open boundaries; until
+then the server refuses coupled runs unless an engine factory is given to ``create_app``
+(the tests give a deterministic double).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Callable, Protocol
+
+import numpy as np
+
+from .schemas import RunRequest
+
+
+@dataclass(frozen=True)
+class SceneSummary:
+    """What WELCOME tells the client (PROTOCOL.md, WELCOME). SI units."""
+
+    g: float                  # [m/s^2]
+    depth: float              # still-water depth at the inlet [m]
+    still_water_level: float  # absolute z of the still-water level [m]
+    z_ref: float              # reference level of RESULT velocities, up from still water [m]
+    t_start: float            # [s]
+    t_end: float              # [s]
+    dt_sph: float             # nominal SPH step [s]
+
+
+@dataclass(frozen=True)
+class BoundaryNodes:
+    """Boundary nodes (z up from still water) and gauges, in the order of every array."""
+
+    x: np.ndarray
+    z: np.ndarray
+    side: np.ndarray           # 0 inlet, 1 outlet
+    gauge_x: np.ndarray
+    gauge_names: list[str] = field(default_factory=list)
+
+
+@dataclass(frozen=True)
+class Measurement:
+    """Gauge readings at the engine's current time; eta/u_ref/w_ref are 0 where dry."""
+
+    eta: np.ndarray            # [m] above still water
+    wet: np.ndarray            # bool
+    u_ref: np.ndarray          # [m/s] at z_ref
+    w_ref: np.ndarray          # [m/s] at z_ref
+    steps: int = 0             # SPH sub-steps of the window just solved
+
+
+class CouplingEngine(Protocol):
+    summary: SceneSummary
+    t: float                   # current time [s]
+    steps: int                 # SPH steps since the start
+    n_particles: int
+
+    def nodes(self) -> BoundaryNodes: ...
+    def set_window(self, t0: float, t1: float, u: np.ndarray, w: np.ndarray, eta: np.ndarray) -> None:
+        """Boundary values at t1; the values in force at t0 are those of the previous window."""
+    def solve_window(self) -> Measurement:
+        """Advance from t0 to t1, interpolating boundary values linearly in time."""
+    def measure(self) -> Measurement: ...
+    def checkpoint(self) -> None:
+        """Remember the state (particles, clock, boundary values in force) for ``goback``."""
+    def goback(self) -> None: ...
+    def stability(self) -> dict[str, float]:
+        """Figures such as dt, v_max/c0, mass drift, for GET /runs/{id}."""
+    def close(self) -> None: ...
+
+
+EngineFactory = Callable[[RunRequest, Path], CouplingEngine]

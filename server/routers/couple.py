@@ -1,0 +1,55 @@
+"""WebSocket coupling endpoint: one binary message per protocol frame (PROTOCOL.md)."""
+
+from __future__ import annotations
+
+import asyncio
+
+from fastapi import APIRouter, WebSocket
+
+from protocol import ErrorCode, Hello, ProtocolError
+
+from ..coupling import error_frame, serve_client
+from ..deps import websocket_token_ok
+from ..tcp import HELLO_LIMIT
+from ..transports import WebSocketTransport
+
+router = APIRouter(tags=["coupling"])
+
+
+@router.websocket("/runs/{run_id}/couple")
+async def couple(ws: WebSocket, run_id: str) -> None:
+    if not websocket_token_ok(ws):
+        await ws.close(code=1008, reason="missing or wrong API token")
+        return
+    await ws.accept()
+    manager = ws.app.state.manager
+    transport = WebSocketTransport(ws, min(HELLO_LIMIT, manager.settings.max_frame))
+    seq = 0
+    try:
+        frames = await asyncio.wait_for(transport.recv(), manager.settings.hello_timeout)
+        if frames is None:
+            return
+        seq, msg = frames[0]
+        if not isinstance(msg, Hello):
+            raise ProtocolError(ErrorCode.OUT_OF_ORDER, f"{msg.TYPE.name} before HELLO")
+        if msg.run_id not in ("", run_id):
+            raise ProtocolError(ErrorCode.BUSY, f"HELLO.run_id {msg.run_id!r} differs from the URL's {run_id!r}")
+        try:
+            run = manager.attach(run_id)
+        except ValueError as exc:
+            raise ProtocolError(ErrorCode.BUSY, str(exc)) from None
+    except ProtocolError as exc:
+        await _refuse(transport, exc.code, exc.text, seq)
+        return
+    except TimeoutError:
+        await _refuse(transport, ErrorCode.TIMEOUT, f"no HELLO within {manager.settings.hello_timeout:g} s", 0)
+        return
+    await serve_client(manager, run, transport, frames)
+
+
+async def _refuse(transport: WebSocketTransport, code: ErrorCode, text: str, seq: int) -> None:
+    try:
+        await transport.send(error_frame(code, text, seq))
+    except Exception:  # noqa: BLE001 -- the peer may already be gone
+        pass
+    await transport.close()

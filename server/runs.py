@@ -1,0 +1,280 @@
+"""Run manager: run records, the queue and its concurrency cap, standalone stepping in workers.
+
+Everything here runs on the event loop except the SPH work, which goes to a thread pool
+(``Run.executor``): numba releases the GIL in its parallel loops, and Python threads switch every
+few milliseconds otherwise, so the loop keeps answering HTTP while a run steps.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import logging
+import threading
+import time
+import uuid
+from collections import deque
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+from typing import Any
+
+from .engine import CouplingEngine, EngineFactory
+from .schemas import RunInfo, RunRequest, canonical_scene
+from .settings import Settings
+from .store import GaugeWriter, RunStore
+
+log = logging.getLogger("wavesph.server")
+
+QUEUED, WAITING, RUNNING = "queued", "waiting_for_client", "running"
+FINISHED, CANCELLED, FAILED, UNSTABLE = "finished", "cancelled", "failed", "unstable"
+TERMINAL = frozenset({FINISHED, CANCELLED, FAILED, UNSTABLE})
+
+
+class Cancelled(Exception):
+    """Raised inside a worker when the run's owner cancelled it."""
+
+
+class Run:
+    """One run: its record (``info``, mirrored to meta.json) and its live parts."""
+
+    def __init__(self, info: RunInfo, request: RunRequest, run_dir: Path) -> None:
+        self.info = info
+        self.request = request
+        self.dir = run_dir
+        self.scene_bytes = canonical_scene(request.scene)
+        self.cancel_flag = threading.Event()       # seen by worker threads
+        self.cancelled = asyncio.Event()           # seen by the coupling door
+        self.attached = asyncio.Event()            # a coupling client took the run
+        self.session_done = asyncio.Event()        # its session ended (state already set)
+        self.engine: CouplingEngine | None = None
+        self.gauges: GaugeWriter | None = None
+        self.task: asyncio.Task | None = None
+        self.client_attached = False
+        self._saved_at = 0.0
+
+    @property
+    def terminal(self) -> bool:
+        return self.info.state in TERMINAL
+
+
+class RunManager:
+    def __init__(self, settings: Settings, engine_factory: EngineFactory | None = None) -> None:
+        self.settings = settings
+        self.engine_factory = engine_factory
+        self.store = RunStore(settings.runs_dir)
+        self.runs: dict[str, Run] = {}
+        self.queue: deque[str] = deque()
+        self.active: set[str] = set()
+        self.executor = ThreadPoolExecutor(max_workers=settings.max_runs, thread_name_prefix="sph")
+        self.stopping = False
+        self._load_existing()
+
+    # ------------------------------------------------------------------ records
+    def _load_existing(self) -> None:
+        """Runs left on disk by an earlier server: listed with their data; unfinished ones failed."""
+        for info, request in self.store.load_all():
+            try:
+                req = RunRequest.model_validate(request)
+            except ValueError:
+                continue
+            run = Run(info, req, self.store.root / info.id)
+            self.runs[info.id] = run
+            if not run.terminal:
+                self._set_state(run, FAILED, "server stopped before the run ended")
+
+    def save(self, run: Run, force: bool = True) -> None:
+        now = time.monotonic()
+        if force or now - run._saved_at >= self.settings.meta_interval:
+            run._saved_at = now
+            self.store.save(run.info)
+
+    def _set_state(self, run: Run, state: str, reason: str | None = None) -> None:
+        run.info.state = state
+        run.info.reason = reason
+        run.info.status = f"{state}: {reason}" if reason and state in (FAILED, UNSTABLE) else state
+        if state in TERMINAL:
+            run.info.ended = time.time()
+            run.info.queue_position = None
+        log.info("run %s: %s", run.info.id, run.info.status)
+        self.save(run)
+
+    def _queue_positions(self) -> None:
+        for i, rid in enumerate(self.queue):
+            self.runs[rid].info.queue_position = i + 1
+
+    # ------------------------------------------------------------------ lifecycle
+    def submit(self, request: RunRequest) -> Run:
+        run_id = uuid.uuid4().hex  # 128 random bits: also the credential on the TCP port
+        scene_bytes = canonical_scene(request.scene)
+        from protocol import scene_hash
+
+        info = RunInfo(id=run_id, mode=request.mode, state=QUEUED, status=QUEUED, created=time.time(),
+                       t_end=request.scene.t_end, scene_hash=scene_hash(scene_bytes).hex(),
+                       gauges_file="gauges.csv" if request.mode == "coupled" else "sph/probes.csv")
+        run_dir = self.store.create(run_id, request.model_dump(mode="json"), scene_bytes)
+        run = Run(info, request, run_dir)
+        self.runs[run_id] = run
+        self.queue.append(run_id)
+        self._queue_positions()
+        self.save(run)
+        self._schedule()
+        return run
+
+    def _schedule(self) -> None:
+        while self.queue and len(self.active) < self.settings.max_runs:
+            run = self.runs[self.queue.popleft()]
+            run.info.queue_position = None
+            self.active.add(run.info.id)
+            body = self._standalone(run) if run.request.mode == "standalone" else self._coupled(run)
+            run.task = asyncio.get_running_loop().create_task(body, name=f"run-{run.info.id}")
+        self._queue_positions()
+
+    def _release(self, run: Run) -> None:
+        self.active.discard(run.info.id)
+        self._schedule()
+
+    def cancel(self, run: Run) -> None:
+        if run.terminal:
+            return
+        run.cancel_flag.set()
+        run.cancelled.set()
+        if run.info.state == QUEUED:
+            self.queue.remove(run.info.id)
+            self._set_state(run, CANCELLED, "cancelled by the user")
+            self._queue_positions()
+        # a starting, waiting or running run ends in its own task, which sets the state
+
+    @property
+    def cancel_reason(self) -> tuple[str, str]:
+        """(state, reason) of a run stopped by DELETE or by the server stopping."""
+        if self.stopping:
+            return FAILED, "server stopped before the run ended"
+        return CANCELLED, "cancelled by the user"
+
+    async def shutdown(self) -> None:
+        self.stopping = True
+        for run in list(self.runs.values()):
+            if not run.terminal:
+                run.cancel_flag.set()
+                run.cancelled.set()
+        tasks = [r.task for r in self.runs.values() if r.task and not r.task.done()]
+        if tasks:
+            await asyncio.wait(tasks, timeout=10)
+        for run in self.runs.values():
+            if not run.terminal:
+                self._set_state(run, FAILED, "server stopped before the run ended")
+        self.executor.shutdown(wait=False, cancel_futures=True)
+
+    # ------------------------------------------------------------------ standalone
+    async def _standalone(self, run: Run) -> None:
+        loop = asyncio.get_running_loop()
+        run.info.started = time.time()
+        self._set_state(run, RUNNING)
+        try:
+            await loop.run_in_executor(self.executor, self._step_standalone, run)
+            self._set_state(run, FINISHED)
+        except Cancelled:
+            self._set_state(run, *self.cancel_reason)
+        except Exception as exc:  # noqa: BLE001 -- every failure becomes a run status
+            self._fail(run, exc)
+        finally:
+            self._release(run)
+
+    def _step_standalone(self, run: Run) -> None:
+        """Worker thread: build and advance the sph_core Simulation, reporting progress."""
+        from sph_core.simulation import Simulation
+
+        sim = Simulation(run.request.scene, run_dir=run.dir / "sph")
+        run.info.particles = sim.n_particles
+
+        def progress(s: Simulation) -> None:
+            info = run.info
+            info.t, info.steps = s.t, s.steps
+            info.particle_steps_per_s = (s.n_particles * s.steps / s.wall_time if s.wall_time > 0
+                                         else None)
+            info.stability = simulation_stability(s)
+            if s.history:
+                info.last_gauges = {k: v for k, v in s.history[-1].items() if k != "t"}
+            self.save(run, force=False)
+            if run.cancel_flag.is_set():
+                raise Cancelled()
+
+        try:
+            sim.advance_to(run.request.scene.t_end, progress=progress)
+            progress(sim)
+        finally:
+            sim.close()
+
+    def _fail(self, run: Run, exc: BaseException) -> None:
+        from sph_core.simulation import UnstableError
+
+        if isinstance(exc, UnstableError):
+            run.info.stability = {**run.info.stability, "unstable_step": exc.step, "unstable_t": exc.t}
+            self._set_state(run, UNSTABLE, str(exc))
+        else:
+            log.exception("run %s failed", run.info.id, exc_info=exc)
+            self._set_state(run, FAILED, f"{type(exc).__name__}: {exc}")
+
+    # ------------------------------------------------------------------ coupled
+    async def _coupled(self, run: Run) -> None:
+        """Build the engine, then hold the slot until the client's session ends (see coupling.py)."""
+        loop = asyncio.get_running_loop()
+        try:
+            if self.engine_factory is None:
+                raise RuntimeError("no coupled engine in this build")
+            run.engine = await loop.run_in_executor(self.executor, self.engine_factory,
+                                                    run.request, run.dir)
+            run.info.particles = run.engine.n_particles
+            names = run.engine.nodes().gauge_names or [f"g{j}" for j in range(run.engine.nodes().gauge_x.size)]
+            run.gauges = GaugeWriter(run.dir / "gauges.csv", names)
+            run.info.started = time.time()
+            self._set_state(run, WAITING)
+            woke = await _first_of(run.attached, run.cancelled, self.settings.client_wait_timeout)
+            if woke is None:
+                self._set_state(run, FAILED, f"no client connected within "
+                                             f"{self.settings.client_wait_timeout:g} s")
+            elif woke is run.cancelled and not run.client_attached:
+                self._set_state(run, *self.cancel_reason)
+            else:
+                await run.session_done.wait()  # the door sets the final state
+        except Exception as exc:  # noqa: BLE001
+            self._fail(run, exc)
+        finally:
+            if run.gauges:
+                run.gauges.close()
+            if run.engine:
+                await loop.run_in_executor(self.executor, run.engine.close)
+            self._release(run)
+
+    def attach(self, run_id: str) -> Run:
+        """Give a connecting client its run; ValueError says why not (sent as ERROR BUSY)."""
+        run = self.runs.get(run_id)
+        if run is None:
+            raise ValueError(f"no run {run_id!r} on this server")
+        if run.client_attached or run.info.state != WAITING:
+            why = "already has a coupling client" if run.client_attached else f"is {run.info.status}"
+            raise ValueError(f"run {run_id} {why}")
+        run.client_attached = True
+        run.attached.set()
+        return run
+
+    def snapshot(self, run: Run) -> dict[str, Any]:
+        return run.info.model_dump(mode="json")
+
+
+async def _first_of(a: asyncio.Event, b: asyncio.Event, timeout: float) -> asyncio.Event | None:
+    """Whichever event is set first, or None after ``timeout`` seconds."""
+    waits = {asyncio.ensure_future(a.wait()): a, asyncio.ensure_future(b.wait()): b}
+    done, pending = await asyncio.wait(waits, timeout=timeout, return_when=asyncio.FIRST_COMPLETED)
+    for f in pending:
+        f.cancel()
+    if a.is_set():
+        return a
+    return b if b.is_set() else None
+
+
+def simulation_stability(sim: Any) -> dict[str, float]:
+    """Stability figures of an sph_core Simulation."""
+    mass0 = sim.fluid_mass0
+    return {"dt": sim.dt, "v_max": sim.v_max, "c0": sim.c0,
+            "mach": sim.v_max / sim.c0 if sim.c0 else 0.0,
+            "mass_drift": sim.fluid_mass() / mass0 - 1.0 if mass0 else 0.0}

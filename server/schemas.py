@@ -1,0 +1,77 @@
+"""HTTP request and response bodies."""
+
+from __future__ import annotations
+
+import json
+import math
+from typing import Any, Literal
+
+from pydantic import BaseModel, ConfigDict, Field
+
+from sph_core.geometry import wall_layers
+from sph_core.scene import Scene
+
+
+class CouplingOptions(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+
+    window_max: float = Field(0.05, gt=0, description="longest coupling window the client may use [s]")
+    z_ref: float | None = Field(None, le=0, description="reference level of returned velocities, up "
+                                                        "from still water [m]; default -depth/2")
+
+
+class RunRequest(BaseModel):
+    """POST /runs body: the SPH scene and how the run is driven."""
+
+    model_config = ConfigDict(extra="forbid")
+
+    scene: Scene
+    mode: Literal["coupled", "standalone"] = Field(
+        "coupled", description="coupled: wait for a client on /runs/{id}/couple or the TCP port; "
+                               "standalone: run the scene as it is")
+    coupling: CouplingOptions = CouplingOptions()
+
+
+class RunInfo(BaseModel):
+    """GET /runs/{id}. ``status`` is ``state`` plus the reason, e.g. 'failed: client disconnected'."""
+
+    id: str
+    mode: str
+    state: str
+    status: str
+    reason: str | None = None
+    created: float
+    started: float | None = None
+    ended: float | None = None
+    queue_position: int | None = None
+    t: float = 0.0
+    t_end: float
+    steps: int = 0
+    windows: int = 0
+    particles: int | None = None
+    particle_steps_per_s: float | None = None
+    coupling_overhead_share: float | None = None
+    stability: dict[str, Any] = {}
+    last_gauges: dict[str, float | None] = {}
+    client: str | None = None
+    scene_hash: str
+    gauges_file: str | None = None
+
+
+def canonical_scene(scene: Scene) -> bytes:
+    """The bytes the protocol's scene hash is taken of (PROTOCOL.md, HELLO)."""
+    return json.dumps(scene.model_dump(mode="json"), sort_keys=True, separators=(",", ":")).encode()
+
+
+def estimate_particles(scene: Scene) -> int:
+    """Upper estimate of fluid + wall particles, without building them (for the cap)."""
+    dp, t = scene.dp, scene.tank
+    fluid = sum((b.x1 - b.x0) * (b.z1 - b.z0) for b in scene.water_blocks) / dp**2
+    layers = wall_layers(scene)
+    walls = layers * (2 * (t.z1 - t.z0) + (t.x1 - t.x0)) / dp + 4 * layers**2
+    for bed in scene.beds:
+        length = sum(math.dist(a, b) for a, b in zip(bed.points, bed.points[1:]))
+        walls += layers * length / dp
+    for s in scene.structures:
+        walls += layers * 2 * ((s.x1 - s.x0) + (s.z1 - s.z0)) / dp
+    return int(math.ceil(fluid + walls))

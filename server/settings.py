@@ -1,0 +1,63 @@
+"""Server settings: one class, read from the environment (prefix WAVESPH_) or the CLI."""
+
+from __future__ import annotations
+
+import ipaddress
+import os
+from pathlib import Path
+
+from pydantic import BaseModel, Field, ValidationError, model_validator
+
+ENV_PREFIX = "WAVESPH_"
+
+
+class Settings(BaseModel):
+    host: str = Field("127.0.0.1", description="HTTP/WebSocket bind address")
+    port: int = Field(8765, ge=0, le=65535, description="HTTP port (0: ephemeral)")
+    tcp_host: str | None = Field(None, description="TCP coupling bind address (default: host)")
+    tcp_port: int | None = Field(8766, ge=0, le=65535, description="TCP coupling port; None disables it")
+    runs_dir: Path = Field(Path("runs"), description="one sub-directory per run")
+    token: str | None = Field(None, min_length=16, description="API token (required off loopback)")
+    max_runs: int = Field(2, ge=1, description="runs stepping or holding a coupling slot at once")
+    max_particles: int = Field(2_000_000, ge=1, description="particle-count cap per run")
+    max_frame: int = Field(16 * 1024 * 1024, ge=4104, le=16 * 1024 * 1024,
+                           description="largest coupling frame payload [bytes]")
+    hello_timeout: float = Field(30.0, gt=0, description="[s] for the first frame after connect")
+    idle_timeout: float = Field(600.0, gt=0, description="[s] between client frames")
+    client_wait_timeout: float = Field(3600.0, gt=0, description="[s] a coupled run waits for its client")
+    meta_interval: float = Field(0.5, ge=0, description="[s] least time between meta.json rewrites")
+
+    @property
+    def loopback_only(self) -> bool:
+        return all(_is_loopback(h) for h in (self.host, self.tcp_host or self.host))
+
+    @model_validator(mode="after")
+    def _token_off_loopback(self) -> "Settings":
+        if not self.loopback_only and not self.token:
+            raise ValueError("token: an API token (>= 16 characters) is required when binding "
+                             f"{self.host!r}, which is not a loopback address")
+        return self
+
+    @classmethod
+    def from_env(cls, environ: dict[str, str] | None = None, **overrides: object) -> "Settings":
+        """Settings from WAVESPH_* variables, then ``overrides`` (e.g. CLI options) on top."""
+        env = os.environ if environ is None else environ
+        values: dict[str, object] = {}
+        for name in cls.model_fields:
+            raw = env.get(ENV_PREFIX + name.upper())
+            if raw is not None:
+                values[name] = None if raw == "" and name in ("tcp_port", "token", "tcp_host") else raw
+        values.update({k: v for k, v in overrides.items() if v is not None})
+        return cls(**values)
+
+
+def _is_loopback(host: str) -> bool:
+    if host == "localhost":
+        return True
+    try:
+        return ipaddress.ip_address(host).is_loopback
+    except ValueError:
+        return False
+
+
+__all__ = ["Settings", "ValidationError"]

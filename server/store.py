@@ -1,0 +1,97 @@
+"""Run store on disk: one directory per run, written as the run goes, rebuilt on restart.
+
+    <runs_dir>/<run_id>/
+        request.json   the POST /runs body as validated (scene, mode, coupling options)
+        scene.json     the canonical scene bytes (the protocol's scene hash is their SHA-256)
+        meta.json      RunInfo: status, progress, speed, stability, last gauges (atomic rewrite)
+        gauges.csv     coupled runs: one row per solved window, flushed at once
+        sph/           standalone runs: sph_core's own outputs (probes.csv, meta.json, snapshots/)
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import os
+from pathlib import Path
+from typing import Any
+
+from .schemas import RunInfo
+
+META = "meta.json"
+
+
+def write_json_atomic(path: Path, data: Any) -> None:
+    tmp = path.with_name(path.name + ".tmp")
+    tmp.write_text(json.dumps(data, indent=2, default=str))
+    os.replace(tmp, path)
+
+
+class RunStore:
+    def __init__(self, root: Path) -> None:
+        self.root = Path(root)
+        self.root.mkdir(parents=True, exist_ok=True)
+
+    def create(self, run_id: str, request: dict[str, Any], scene_bytes: bytes) -> Path:
+        d = self.root / run_id
+        d.mkdir()
+        write_json_atomic(d / "request.json", request)
+        (d / "scene.json").write_bytes(scene_bytes)
+        return d
+
+    def save(self, info: RunInfo) -> None:
+        write_json_atomic(self.root / info.id / META, info.model_dump(mode="json"))
+
+    def load_all(self) -> list[tuple[RunInfo, dict[str, Any]]]:
+        """Every run found on disk with its request; unreadable directories are skipped."""
+        out = []
+        for d in sorted(self.root.iterdir()):
+            try:
+                info = RunInfo.model_validate_json((d / META).read_text())
+                request = json.loads((d / "request.json").read_text())
+            except (OSError, ValueError):
+                continue
+            out.append((info, request))
+        return out
+
+
+class GaugeWriter:
+    """gauges.csv of a coupled run: t, steps, then eta / u_ref / w_ref per gauge ('dry' if dry).
+
+    Each row is flushed as written. ``mark()`` before a window and ``rewind()`` on GOBACK drop
+    the rows of a window that is being redone, so the file always holds one row per window."""
+
+    def __init__(self, path: Path, gauge_names: list[str]) -> None:
+        self.columns = ["t", "steps"] + [f"{g}_{q}" for g in gauge_names for q in ("eta", "u_ref", "w_ref")]
+        self._f = open(path, "w", newline="")
+        self._csv = csv.writer(self._f)
+        self._csv.writerow(self.columns)
+        self._f.flush()
+        self._mark = self._f.tell()
+
+    def row(self, t: float, steps: int, values: dict[str, float | None]) -> None:
+        self._csv.writerow([repr(float(t)), steps] +
+                           ["dry" if values.get(c) is None else repr(float(values[c]))
+                            for c in self.columns[2:]])
+        self._f.flush()
+
+    def mark(self) -> None:
+        self._mark = self._f.tell()
+
+    def rewind(self) -> None:
+        self._f.seek(self._mark)
+        self._f.truncate()
+        self._f.flush()
+
+    def close(self) -> None:
+        self._f.close()
+
+
+def read_gauges(path: Path) -> tuple[list[str], list[dict[str, float | None]]]:
+    """A gauge CSV as columns and rows; 'dry' becomes None."""
+    with open(path, newline="") as f:
+        rows = list(csv.reader(f))
+    if not rows:
+        return [], []
+    cols = rows[0]
+    return cols, [{c: (None if v == "dry" else float(v)) for c, v in zip(cols, r)} for r in rows[1:]]

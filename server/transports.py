@@ -1,0 +1,83 @@
+"""The two coupling transports: plain TCP (length-prefixed frames) and WebSocket (one frame per
+binary message). Both give the coupling door the same recv/send/close."""
+
+from __future__ import annotations
+
+import asyncio
+import socket
+
+from fastapi import WebSocket, WebSocketDisconnect
+
+from protocol import ErrorCode, FrameDecoder, ProtocolError, decode_frame
+from protocol.messages import Message
+
+READ_CHUNK = 1 << 16
+
+
+class TcpTransport:
+    def __init__(self, reader: asyncio.StreamReader, writer: asyncio.StreamWriter,
+                 max_payload: int) -> None:
+        self.reader, self.writer = reader, writer
+        self.decoder = FrameDecoder(max_payload)
+        sock = writer.get_extra_info("socket")
+        if sock is not None:
+            sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+
+    @property
+    def max_payload(self) -> int:
+        return self.decoder.max_payload
+
+    @max_payload.setter
+    def max_payload(self, value: int) -> None:
+        self.decoder.max_payload = value
+
+    async def recv(self) -> list[tuple[int, Message]] | None:
+        while True:
+            try:
+                data = await self.reader.read(READ_CHUNK)
+            except ConnectionError:
+                return None
+            if not data:
+                self.decoder.eof()  # a frame cut short is MALFORMED, a clean close is None
+                return None
+            frames = self.decoder.feed(data)
+            if frames:
+                return frames
+
+    async def send(self, data: bytes) -> None:
+        self.writer.write(data)
+        await self.writer.drain()
+
+    async def close(self) -> None:
+        self.writer.close()
+        try:
+            await self.writer.wait_closed()
+        except ConnectionError:
+            pass
+
+
+class WebSocketTransport:
+    def __init__(self, ws: WebSocket, max_payload: int) -> None:
+        self.ws = ws
+        self.max_payload = max_payload
+
+    async def recv(self) -> list[tuple[int, Message]] | None:
+        try:
+            message = await self.ws.receive()
+        except (WebSocketDisconnect, RuntimeError):
+            return None
+        if message["type"] == "websocket.disconnect":
+            return None
+        data = message.get("bytes")
+        if data is None:
+            raise ProtocolError(ErrorCode.MALFORMED, "a text WebSocket message: frames are binary messages")
+        return [decode_frame(data, self.max_payload)]
+
+    async def send(self, data: bytes) -> None:
+        await self.ws.send_bytes(data)
+
+    async def close(self) -> None:
+        try:
+            await self.ws.close()
+        except RuntimeError:
+            pass  # already closed
