@@ -30,16 +30,16 @@ from numba import njit, prange
 
 from .eos import pressure
 from .kernels import w_of_q
-from .particles import AX, AZ, DRHO, FLUID, INACTIVE, INLET, M, N_SORTED_KDK, OUTLET, P, RHO, VX, VZ, X, Z
-from .wcsph import (PR_ALPHA_W, PR_B, PR_GAMMA, PR_GZ, PR_H, PR_RHO0, PR_XMIN, PR_ZMIN, PR_INV_CS,
-                    ST_REACHED_T, ST_STEP_LIMIT, ST_NONFINITE, ST_DENSITY, ST_LEFT_DOMAIN, _sort,
+from .particles import (AX, AZ, DRHO, FLUID, INACTIVE, INLET, M, N_SORTED_KDK, OUTLET, P, RHO, VX,
+                        VZ, X, Z)
+from .wcsph import (PR_ALPHA_W, PR_B, PR_GAMMA, PR_GZ, PR_H, PR_INV_CS, PR_RHO0, PR_XMIN, PR_ZMIN,
+                    ST_DENSITY, ST_LEFT_DOMAIN, ST_NONFINITE, ST_REACHED_T, ST_STEP_LIMIT, _sort,
                     fluid_pass, kdk_kick, kdk_kick_drift, stable_dt, wall_pass)
 
-# idle buffer particles: above the boundary's surface, kept in place but not interacting
+# idle buffer particles: above the boundary's surface, kept in place but not interacting.
+# End b has active kind INLET + b and idle kind INLET_IDLE + b.
 INLET_IDLE = 4
 OUTLET_IDLE = 5
-ACTIVE_KIND = (INLET, OUTLET)
-IDLE_KIND = (INLET_IDLE, OUTLET_IDLE)
 
 # status code of the open loop beyond those of wcsph
 ST_CAPACITY = 5
@@ -55,7 +55,7 @@ N_COUNTERS = 4
 
 
 @njit(cache=True)
-def _blend(a, lv, k, r):
+def _blend(a, k, r):
     """(1 - r) a[lv=0, k] + r a[lv=1, k] for a window array a[level, node]."""
     return (1.0 - r) * a[0, k] + r * a[1, k]
 
@@ -67,11 +67,11 @@ def profile_value(zn, a, r, z):
     nn = zn.size
     k = np.searchsorted(zn, z)
     if k <= 0:
-        return _blend(a, 0, 0, r)
+        return _blend(a, 0, r)
     if k >= nn:
-        return _blend(a, 0, nn - 1, r)
+        return _blend(a, nn - 1, r)
     s = (z - zn[k - 1]) / (zn[k] - zn[k - 1])
-    return (1.0 - s) * _blend(a, 0, k - 1, r) + s * _blend(a, 0, k, r)
+    return (1.0 - s) * _blend(a, k - 1, r) + s * _blend(a, k, r)
 
 
 @njit(cache=True)
@@ -130,12 +130,12 @@ def buffer_update(f, kind, n, dt, r, zs0, du0, zs1, du1, zn, win_u, win_w, prm):
         f[VZ, i] = w
         f[X, i] += dt * u
         if zi < zs:
-            kind[i] = ACTIVE_KIND[b]
+            kind[i] = INLET + b
             rho = rho0 * (1.0 + rho0 * g * (zs - zi) / bb) ** (1.0 / gam)
             f[RHO, i] = rho
             f[P, i] = pressure(rho, rho0, bb, gam)
         else:
-            kind[i] = IDLE_KIND[b]
+            kind[i] = INLET_IDLE + b
             f[RHO, i] = rho0
             f[P, i] = 0.0
         f[DRHO, i] = 0.0
@@ -156,7 +156,7 @@ def buffer_transitions(f, kind, ids, n, capacity, obp, zs0, zs1, counters, next_
             for b in range(2):
                 if obp[b, OB_ON] > 0.5 and (f[X, i] - obp[b, OB_XF]) * obp[b, OB_NX] >= 0.0:
                     zs = zs0 if b == 0 else zs1
-                    kind[i] = ACTIVE_KIND[b] if f[Z, i] < zs else IDLE_KIND[b]
+                    kind[i] = INLET + b if f[Z, i] < zs else INLET_IDLE + b
                     counters[b, C_OUT] += 1
                     break
             continue
@@ -177,7 +177,7 @@ def buffer_transitions(f, kind, ids, n, capacity, obp, zs0, zs1, counters, next_
             next_id[0] += 1
             n += 1
             counters[b, C_CREATED] += 1
-            if k == ACTIVE_KIND[b]:
+            if k == INLET + b:
                 kind[i] = FLUID
                 counters[b, C_IN] += 1
             else:
