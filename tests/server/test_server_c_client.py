@@ -1,0 +1,52 @@
+"""The C example client couples to the real server over the plain TCP port (engine: test double)."""
+
+from __future__ import annotations
+
+import shutil
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+SOURCE = ROOT / "examples" / "c_client" / "wsph_client.c"
+
+
+@pytest.fixture(scope="module")
+def c_client(tmp_path_factory) -> Path:
+    gcc = shutil.which("gcc")
+    if gcc is None:
+        pytest.skip("gcc not found on PATH: the C example client cannot be compiled here")
+    exe = tmp_path_factory.mktemp("cbuild") / "wsph_client"
+    build = subprocess.run([gcc, "-std=c99", "-Wall", "-Wextra", "-pedantic", "-Werror", "-O2",
+                            "-o", str(exe), str(SOURCE), "-lm"], capture_output=True, text=True)
+    assert build.returncode == 0, build.stderr
+    return exe
+
+
+def test_c_client_against_the_server(srv, engines, c_client):
+    run = srv.create()
+    srv.wait_state(run["id"], "waiting_for_client")
+    out = subprocess.run([str(c_client), "127.0.0.1", str(srv.tcp_port), run["id"], "6",
+                          "0.02", "1.0", "0.05"], capture_output=True, text=True, timeout=60)
+    assert out.returncode == 0, out.stderr
+    lines = [line.split() for line in out.stdout.splitlines()]
+    assert len(lines) == 6 and all(w[0] == "RESULT" and w[4] == "dry" for w in lines)
+    info = srv.wait_state(run["id"], "finished")
+    assert info["windows"] == 6 and info["client"] == "wsph_client.c 1.0"
+    # the double echoes the node-mean imposed eta: the C client's Airy elevation at the inlet
+    engine = engines[0]
+    t, _, eta = np.array(engine.imposed).T
+    window_end_eta = eta[49::50]
+    np.testing.assert_allclose([float(w[3]) for w in lines], window_end_eta, rtol=1e-12)
+    assert np.ptp(window_end_eta) > 0.005  # a wave of H = 0.02 m actually went through
+    rows = srv.http.get(f"/runs/{run['id']}/gauges", params={"format": "json"}).json()["rows"]
+    assert [r["g_mid_eta"] for r in rows] == pytest.approx([float(w[3]) for w in lines], rel=1e-12)
+
+
+def test_c_client_gets_a_clear_error_for_an_unknown_run(srv, c_client):
+    out = subprocess.run([str(c_client), "127.0.0.1", str(srv.tcp_port), "no-such-run", "3"],
+                         capture_output=True, text=True, timeout=60)
+    assert out.returncode == 3
+    assert "server error 13: no run 'no-such-run' on this server" in out.stderr
