@@ -1,0 +1,129 @@
+"""`wavesph waves`: scene validation, CLI output, time-series generation, the submerged bar."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from wave_client import waves_cli
+from wave_client.boussinesq.run import run_scene
+from wave_client.boussinesq.scene import SceneError, WaveScene, build_model, load_scene
+
+ROOT = Path(__file__).resolve().parents[2]
+BAR = ROOT / "examples" / "waves" / "beji_battjes.toml"
+
+FLAT = """
+[grid]
+x_start = -20.0
+x_end = 30.0
+dx = 0.05
+t_end = 40.0
+[bathymetry]
+x = [0.0]
+depth = [0.5]
+[wave]
+{wave}
+[sponge]
+left = 7.0
+right = 7.0
+[gauges]
+x = [5.0, 10.0]
+[output]
+every = 0.05
+"""
+
+
+def read_csv(path: Path) -> tuple[np.ndarray, np.ndarray, list[str]]:
+    lines = [ln for ln in path.read_text().splitlines() if not ln.startswith("#")]
+    header = lines[0].split(",")
+    data = np.array([[float(v) for v in ln.split(",")] for ln in lines[1:]])
+    return data[:, 0], data[:, 1:], header
+
+
+def harmonic_amplitudes(t: np.ndarray, y: np.ndarray, omegas: list[float]) -> np.ndarray:
+    cols = [f(w * t) for w in omegas for f in (np.cos, np.sin)] + [np.ones_like(t)]
+    c, *_ = np.linalg.lstsq(np.column_stack(cols), y, rcond=None)
+    return np.hypot(c[0:-1:2], c[1:-1:2])
+
+
+def test_scene_errors_name_the_field(tmp_path):
+    bad = FLAT.format(wave='kind = "regular"\nheight = -0.01\nperiod = 2.0\nx_source = 0.0\ncolour = 1')
+    p = tmp_path / "bad.toml"
+    p.write_text(bad)
+    with pytest.raises(SceneError) as err:
+        load_scene(p)
+    msg = str(err.value)
+    assert "wave.regular.height" in msg and "wave.regular.colour" in msg
+    p.write_text(FLAT.format(wave='kind = "regular"\nheight = 0.01\nperiod = 2.0\nx_source = 0.0')
+                 .replace("x = [5.0, 10.0]", "x = [5.0, 99.0]"))
+    with pytest.raises(SceneError, match="gauges.x"):
+        load_scene(p)
+
+
+def test_cli_writes_gauge_csv_and_reports_bad_scene(tmp_path, capsys):
+    scene = tmp_path / "flat.toml"
+    scene.write_text(FLAT.format(wave='kind = "regular"\nheight = 0.004\nperiod = 2.0\nx_source = 0.0')
+                     .replace("t_end = 40.0", "t_end = 4.0"))
+    out = tmp_path / "g.csv"
+    parser = argparse.ArgumentParser()
+    waves_cli.add_arguments(parser)
+    assert waves_cli.main(parser.parse_args([str(scene), "-o", str(out), "--no-progress"])) == 0
+    t, eta, header = read_csv(out)
+    assert header == ["time_s", "eta_5m", "eta_10m"]
+    assert t[0] == 0.0 and t[-1] == pytest.approx(4.0, abs=0.05) and eta.shape == (t.size, 2)
+    assert np.all(np.isfinite(eta)) and np.abs(eta).max() > 0
+    scene.write_text("[grid]\nx_start = 0\n")
+    assert waves_cli.main(parser.parse_args([str(scene), "--no-progress"])) == 2
+    assert "grid.x_end" in capsys.readouterr().err
+
+
+def test_series_wave_reproduces_its_components(tmp_path):
+    """A bichromatic series given as a CSV is generated with each component's amplitude."""
+    periods, amps = (2.0, 1.25), (0.002, 0.001)
+    t = np.arange(0, 40.0, 0.05)  # 20 and 32 periods: whole periods, a periodic series
+    eta = sum(a * np.cos(2 * np.pi * t / p - 0.3 * i) for i, (a, p) in enumerate(zip(amps, periods)))
+    (tmp_path / "series.csv").write_text("# bichromatic test series\ntime,eta\n"
+                                         + "\n".join(f"{a:.4f},{b:.8e}" for a, b in zip(t, eta)))
+    scene = tmp_path / "s.toml"
+    scene.write_text(FLAT.format(wave='kind = "series"\nfile = "series.csv"\nx_source = 0.0\nramp = 4.0'))
+    out = tmp_path / "g.csv"
+    run_scene(load_scene(scene), out, base_dir=tmp_path, progress=False)
+    tt, ee, _ = read_csv(out)
+    sel = tt > 20.0
+    for j in range(2):
+        a = harmonic_amplitudes(tt[sel], ee[sel, j], [2 * np.pi / p for p in periods])
+        np.testing.assert_allclose(a, amps, rtol=0.02)
+
+
+def test_submerged_bar_is_stable_and_releases_harmonics(tmp_path):
+    """Beji & Battjes (1993) bar, T = 2.02 s, H = 0.02 m: the run stays bounded, and the energy
+    moves from the primary wave into its harmonics over the bar: in front of the bar (5.7 m) the
+    2nd and 3rd harmonics are small bound waves, behind it (>= 15.7 m) the 2nd harmonic is as
+    large as half the primary or more and the 3rd harmonic has grown many times."""
+    scene = load_scene(BAR)
+    scene = scene.model_copy(update={"grid": scene.grid.model_copy(update={"t_end": 36.36})})
+    out = tmp_path / "bar.csv"
+    summary = run_scene(scene, out, base_dir=BAR.parent, progress=False)
+    assert summary["unconverged_steps"] == 0
+    t, eta, _ = read_csv(out)
+    assert np.all(np.isfinite(eta)) and np.abs(eta).max() < 2.5 * 0.02
+    omega = 2 * np.pi / 2.02
+    sel = t > t[-1] - 8 * 2.02
+    amp = np.array([harmonic_amplitudes(t[sel], eta[sel, j], [omega, 2 * omega, 3 * omega])
+                    for j in range(eta.shape[1])])  # gauges x harmonics
+    xs = np.array(scene.gauges.x)
+    front, behind = amp[0], amp[xs >= 15.7]
+    assert front[0] == pytest.approx(0.01, rel=0.05)  # the generated primary wave, H/2
+    assert front[1] < 0.15 * front[0] and front[2] < 0.02 * front[0]
+    assert np.all(behind[:, 1] > 0.5 * behind[:, 0])
+    assert np.all(behind[:, 2] > 10 * front[2])
+
+
+def test_build_model_from_example_scene():
+    scene = load_scene(BAR)
+    assert isinstance(scene, WaveScene)
+    m = build_model(scene, BAR.parent)
+    assert m.depth_at(13.0) == pytest.approx(0.1) and m.depth_at(9.0) == pytest.approx(0.25)
