@@ -100,6 +100,15 @@ class Gauges(_Strict):
         return list(self.names) if self.names else [f"eta_{x:g}m" for x in self.x]
 
 
+class Coupling(_Strict):
+    """Used by `wavesph couple --model boussinesq`; ignored by `wavesph waves`."""
+
+    x: float | None = Field(default=None, description="coupling boundary (SPH inlet) position [m] in "
+                                                       "model coordinates; default grid.x_end")
+    two_way: bool = Field(default=True, description="impose SPH elevation/velocity back (False: "
+                                                    "absorption-only)")
+
+
 class Output(_Strict):
     csv: str = Field(default="gauges.csv", description="gauge CSV path (relative to the working directory)")
     every: float | None = Field(default=None, gt=0, description="sampling interval [s] (default dt)")
@@ -114,6 +123,7 @@ class WaveScene(_Strict):
     solver: Solver = Solver()
     gauges: Gauges
     output: Output = Output()
+    coupling: Coupling = Coupling()
 
     @model_validator(mode="after")
     def _inside(self) -> "WaveScene":
@@ -123,6 +133,9 @@ class WaveScene(_Strict):
             raise ValueError(f"gauges.x {bad} lie outside the grid [{g.x_start}, {g.x_end}]")
         if not g.x_start < self.wave.x_source < g.x_end:
             raise ValueError(f"wave.x_source ({self.wave.x_source}) lies outside the grid")
+        xc = self.coupling.x
+        if xc is not None and not g.x_start < xc <= g.x_end:
+            raise ValueError(f"coupling.x ({xc}) lies outside the grid")
         if self.sponge.left + self.sponge.right >= g.x_end - g.x_start:
             raise ValueError("sponge.left + sponge.right must be shorter than the grid")
         return self
@@ -164,7 +177,8 @@ def build_model(scene: WaveScene, base_dir: Path | None = None) -> BoussinesqMod
     model = BoussinesqModel(
         g.x_start, g.x_end, g.dx, (scene.bathymetry.x, scene.bathymetry.depth), dt=g.dt, courant=g.courant,
         sponge_left=scene.sponge.left, sponge_right=scene.sponge.right, sponge_damping=scene.sponge.damping,
-        filter_every=scene.filter.every, tol=scene.solver.tol, max_iter=scene.solver.max_iter)
+        filter_every=scene.filter.every, tol=scene.solver.tol, max_iter=scene.solver.max_iter,
+        x_couple=scene.coupling.x, two_way=scene.coupling.two_way)
     w = scene.wave
     if isinstance(w, RegularWave):
         model.set_regular_wave(w.x_source, w.height, w.period, w.ramp_periods, w.delta)
