@@ -22,6 +22,7 @@ from protocol.session import Measure, PeerError, Reply, Restore, SetWindow, Solv
 
 from .engine import CouplingEngine, Measurement
 from .runs import FAILED, FINISHED, RUNNING, UNSTABLE, Run, RunManager
+from .transports import PeerGone
 
 log = logging.getLogger("wavesph.server")
 
@@ -124,7 +125,7 @@ async def serve_client(manager: RunManager, run: Run, transport: Transport,
     except _Cancel:
         state, reason = manager.cancel_reason
         end = _SessionEnd(state, reason, session.error_frame(ProtocolError(ErrorCode.CANCELLED, reason)))
-    except _Gone:
+    except (_Gone, PeerGone):
         end = _SessionEnd(FAILED, "client disconnected")
     except TimeoutError:
         end = _SessionEnd(FAILED, f"client timed out (silent for {timeout:g} s)",

@@ -137,7 +137,7 @@ class RunManager:
             return
         run.cancel_flag.set()
         run.cancelled.set()
-        if run.info.state == QUEUED:
+        if run.info.id in self.queue:  # not started yet (a started run may still say queued)
             self.queue.remove(run.info.id)
             self._set_state(run, CANCELLED, "cancelled by the user")
             self._queue_positions()

@@ -14,6 +14,10 @@ from protocol.messages import Message
 READ_CHUNK = 1 << 16
 
 
+class PeerGone(Exception):
+    """The connection broke while sending: the client vanished."""
+
+
 class TcpTransport:
     def __init__(self, reader: asyncio.StreamReader, writer: asyncio.StreamWriter,
                  max_payload: int) -> None:
@@ -45,8 +49,11 @@ class TcpTransport:
                 return frames
 
     async def send(self, data: bytes) -> None:
-        self.writer.write(data)
-        await self.writer.drain()
+        try:
+            self.writer.write(data)
+            await self.writer.drain()
+        except (ConnectionError, RuntimeError) as exc:
+            raise PeerGone(str(exc)) from None
 
     async def close(self) -> None:
         self.writer.close()
@@ -74,7 +81,10 @@ class WebSocketTransport:
         return [decode_frame(data, self.max_payload)]
 
     async def send(self, data: bytes) -> None:
-        await self.ws.send_bytes(data)
+        try:
+            await self.ws.send_bytes(data)
+        except (WebSocketDisconnect, ConnectionError, RuntimeError) as exc:
+            raise PeerGone(str(exc)) from None
 
     async def close(self) -> None:
         try:

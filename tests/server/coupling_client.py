@@ -82,8 +82,8 @@ def run_windows(client, welcome: Welcome, nodes: Nodes, n: int, t0: float = 0.0,
     return out
 
 
-def handshake(client, run_id: str, caps: int = 1):
-    welcome = client.request(Hello(caps, bytes(32), run_id, "pytest"), expect=Welcome)
+def handshake(client, run_id: str, caps: int = 1, scene_hash: bytes = bytes(32)):
+    welcome = client.request(Hello(caps, scene_hash, run_id, "pytest"), expect=Welcome)
     nodes = client.request(GetNodes(), expect=Nodes)
     return welcome, nodes
 

@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import hashlib
 import json
+import socket
 import struct
 import time
 
@@ -27,7 +29,9 @@ def test_coupled_run_end_to_end(srv, engines, door):
     run = srv.create()
     srv.wait_state(run["id"], "waiting_for_client")
     client = _clients(srv, run["id"])[door]()
-    welcome, nodes = handshake(client, run["id"])
+    scene_bytes = srv.http.get(f"/runs/{run['id']}/scene").content
+    assert hashlib.sha256(scene_bytes).hexdigest() == run["scene_hash"]
+    welcome, nodes = handshake(client, run["id"], scene_hash=hashlib.sha256(scene_bytes).digest())
     assert welcome.run_id == run["id"] and welcome.scene_hash.hex() == run["scene_hash"]
     assert welcome.depth == pytest.approx(0.3) and welcome.still_water_level == pytest.approx(0.3)
     assert welcome.n_gauges == 2 and list(nodes.gauge_x) == [0.5, 0.9]
@@ -211,3 +215,19 @@ def test_cancel_during_coupling_sends_cancelled(srv):
     assert info["status"] == "cancelled"
     assert "cancelled" in _expect_error(c, ErrorCode.CANCELLED)
     assert len(srv.http.get(f"/runs/{run['id']}/gauges").text.splitlines()) == 2
+
+
+def test_client_vanishing_during_a_solve_keeps_that_window(tmp_path, factory):
+    with live_server(tmp_path, lambda r, d: factory(r, d, solve_delay=0.5)) as srv:
+        run = srv.create()
+        srv.wait_state(run["id"], "waiting_for_client")
+        c = TcpClient(srv.tcp_port)
+        welcome, nodes = handshake(c, run["id"])
+        n = welcome.n_nodes
+        c.request(Set(0.0, 0.05, np.ones(n), np.zeros(n), np.ones(n)), Solve())
+        c.sock.setsockopt(socket.SOL_SOCKET, socket.SO_LINGER, struct.pack("ii", 1, 0))
+        c.close()  # reset while the engine is busy
+        info = srv.wait_state(run["id"], "failed")
+        assert info["status"] == "failed: client disconnected"
+        rows = srv.http.get(f"/runs/{run['id']}/gauges", params={"format": "json"}).json()["rows"]
+        assert len(rows) == 1 and info["windows"] == 1  # the solved window was written first
