@@ -2,7 +2,7 @@
 
 Equations (i fluid, j neighbour, r_ij = r_i - r_j, grad_i W_ij = -F_ij r_ij, V_j = m_j / rho_j):
 
-continuity + delta-SPH (Fourtakas et al. 2019 dynamic form, fluid-fluid pairs):
+continuity + delta-SPH (Fourtakas et al. 2019 dynamic form, fluid-fluid and fluid-wall pairs):
     drho_i/dt = -rho_i sum_j V_j F_ij (v_ij . r_ij)
                 + 2 delta h c0 sum_j (rho_j - rho_i - rho^H_ji) F_ij V_j,
     rho^H_ji = rho_H(z_j) - rho_H(z_i) = (rho_i g / c_i^2)(z_i - z_j),  c_i^2 = c0^2 (rho_i/rho0)^(gamma-1)
@@ -202,11 +202,12 @@ def fluid_pass(f, kind, cell, cell_start, n, ncx, ncz, prm):
                     cont -= vol * fij * (dvx * dx + dvz * dz)
                     pf = mj * (pi + p[j]) / (rhoi * rhoj)
                     visc = kj != WALL or noslip
-                    if kj != WALL:
-                        # height along gravity: z_i - z_j for g = (0, -g)
-                        up = -(gdir_x * dx + gdir_z * dz)
-                        diff += (rhoj - rhoi - khyd * up) * fij * vol
-                    else:
+                    # height of i above j along gravity (z_i - z_j for g = (0, -g)); wall
+                    # densities come from the Adami extrapolation, so they carry the hydrostatic
+                    # part as the fluid's do and take part in the diffusion
+                    up = -(gdir_x * dx + gdir_z * dz)
+                    diff += (rhoj - rhoi - khyd * up) * fij * vol
+                    if kj == WALL:
                         dvx = vxi - vwx[j]
                         dvz = vzi - vwz[j]
                     if visc:

@@ -1,0 +1,58 @@
+"""Scene configs: the shipped examples load, and bad configs name the offending field."""
+
+import copy
+from pathlib import Path
+
+import pytest
+
+from sph_core.scene import SceneError, load_scene, make_scene
+
+ROOT = Path(__file__).resolve().parents[2]
+BASE = {"dp": 0.01, "t_end": 1.0, "tank": {"x0": 0, "x1": 1, "z0": 0, "z1": 1},
+        "water_blocks": [{"x0": 0, "x1": 0.5, "z0": 0, "z1": 0.5}]}
+
+
+@pytest.mark.parametrize("name", ["still_water_tank.toml", "dambreak_martin_moyce.toml"])
+def test_example_scenes_load(name):
+    scene = load_scene(ROOT / "examples" / "scenes" / name)
+    assert scene.dp > 0 and scene.t_end > 0 and scene.water_blocks
+
+
+def test_default_speed_of_sound():
+    s = make_scene(BASE)
+    assert s.c0 == pytest.approx(10 * (2 * 9.81 * 0.5) ** 0.5)
+    assert s.h == pytest.approx(1.4142 * 0.01)
+
+
+@pytest.mark.parametrize("edit, field", [
+    (lambda d: d["water_blocks"][0].update(z1=-1.0), "water_blocks.0.z1"),
+    (lambda d: d.update(dp=-0.01), "dp"),
+    (lambda d: d["tank"].update(lenght=4.0), "tank.lenght"),
+    (lambda d: d.update(constants={"cfl": 2.0}), "constants.cfl"),
+    (lambda d: d.update(probes=[{"kind": "point", "name": "a", "x": 5.0, "z": 0.1}]), "probes.0.x"),
+    (lambda d: d.update(probes=[{"kind": "elevation", "name": "g", "x": 0.5, "threshold": 2}]),
+     "probes.0.threshold"),
+    (lambda d: d.update(beds=[{"points": [[0.5, 0.0], [0.2, 0.3]]}]), "beds.0.points"),
+    (lambda d: d.pop("dp"), "dp"),
+    (lambda d: d["water_blocks"][0].update(x1=2.0), "water_blocks.0"),
+])
+def test_config_errors_name_the_field(edit, field):
+    data = copy.deepcopy(BASE)
+    edit(data)
+    with pytest.raises(SceneError) as info:
+        make_scene(data)
+    assert f"{field}:" in str(info.value)
+
+
+def test_toml_errors(tmp_path):
+    bad = tmp_path / "bad.toml"
+    bad.write_text("dp = 0.01\n[tank\n")
+    with pytest.raises(SceneError, match="not valid TOML"):
+        load_scene(bad)
+    with pytest.raises(SceneError, match="not found"):
+        load_scene(tmp_path / "missing.toml")
+    typo = tmp_path / "typo.toml"
+    typo.write_text('dp = 0.01\nt_end = 1\n[tank]\nx0=0\nx1=1\nz0=0\nz1=1\n'
+                    '[[water_blocks]]\nx0=0\nx1=1\nz0=0\nz1=0.5\nheigth=2\n')
+    with pytest.raises(SceneError, match=r"water_blocks\.0\.heigth: Extra inputs"):
+        load_scene(typo)
