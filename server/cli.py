@@ -43,5 +43,6 @@ def main(args: argparse.Namespace) -> int:
     print(f"wavesph serve: http://{settings.host}:{settings.port} (docs at /docs), TCP coupling "
           f"port {settings.tcp_port}, runs in {settings.runs_dir.resolve()}", file=sys.stderr)
     uvicorn.run(app, host=settings.host, port=settings.port, log_level="info",
-                ws_max_size=settings.max_frame + 16)
+                ws_max_size=settings.max_frame + 16,
+                ws_per_message_deflate=False)  # float64 arrays do not compress: deflate only costs time
     return 0

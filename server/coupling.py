@@ -73,6 +73,7 @@ async def serve_client(manager: RunManager, run: Run, transport: Transport,
     connected = time.perf_counter()
     solve_time = 0.0
     timeout = settings.hello_timeout
+    window: SetWindow | None = None
     end: _SessionEnd
 
     def sync_limits() -> None:
@@ -95,11 +96,10 @@ async def serve_client(manager: RunManager, run: Run, transport: Transport,
                 if action.close:
                     raise _SessionEnd(FINISHED, None)
             elif isinstance(action, SetWindow):
-                await loop.run_in_executor(manager.executor, engine.set_window, action.t0, action.t1,
-                                           action.u, action.w, action.eta)
+                window = action  # handed to the engine with SOLVE: one worker hop per window
             elif isinstance(action, SolveWindow):
                 tic = time.perf_counter()
-                measured = await loop.run_in_executor(manager.executor, _solve, engine, run,
+                measured = await loop.run_in_executor(manager.executor, _solve, engine, run, window,
                                                       bool(session.capabilities & Capability.GOBACK))
                 solve_time += time.perf_counter() - tic
                 reply = session.result(action, _result(measured))
@@ -111,6 +111,7 @@ async def serve_client(manager: RunManager, run: Run, transport: Transport,
                 measured = await loop.run_in_executor(manager.executor, engine.measure)
                 await transport.send(session.result(action, _result(measured)))
             elif isinstance(action, Restore):
+                window = None
                 measured = await loop.run_in_executor(manager.executor, _goback, engine)
                 run.gauges.rewind()
                 run.info.windows = max(run.info.windows - 1, 0)
@@ -184,11 +185,12 @@ async def _recv(transport: Transport, timeout: float, run: Run) -> list[tuple[in
     raise TimeoutError()
 
 
-def _solve(engine: CouplingEngine, run: Run, checkpoint: bool) -> Measurement:
-    """Worker thread: checkpoint (for GOBACK) then solve one window."""
+def _solve(engine: CouplingEngine, run: Run, window: SetWindow, checkpoint: bool) -> Measurement:
+    """Worker thread: checkpoint (for GOBACK, state at t0), set the window, solve it."""
     if checkpoint:
         engine.checkpoint()
         run.gauges.mark()
+    engine.set_window(window.t0, window.t1, window.u, window.w, window.eta)
     return engine.solve_window()
 
 

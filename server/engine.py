@@ -1,7 +1,9 @@
 """The SPH side of a coupled run, as the coupling doors see it.
 
 A coupled run drives an object with this interface. The doors (WebSocket, TCP) speak the
-protocol and call it from a worker thread, never on the event loop. The adapter over
+protocol and call it from a worker thread, never on the event loop; per window they call
+``checkpoint()`` (when the client may GOBACK), ``set_window(...)`` and ``solve_window()`` in one
+worker call. The adapter over
 sph_core's Simulation with open boundaries fills it once sph_core has open boundaries; until
 then the server refuses coupled runs unless an engine factory is given to ``create_app``
 (the tests give a deterministic double).

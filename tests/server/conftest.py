@@ -36,7 +36,8 @@ class LiveServer:
     def __init__(self, app, settings: Settings) -> None:
         self.app, self.settings = app, settings
         config = uvicorn.Config(app, host="127.0.0.1", port=0, log_level="warning",
-                                ws_max_size=settings.max_frame + 16, lifespan="on")
+                                ws_max_size=settings.max_frame + 16, lifespan="on",
+                                ws_per_message_deflate=False)  # as `wavesph serve`
         self.server = uvicorn.Server(config)
         self.thread = threading.Thread(target=self.server.run, daemon=True)
 
