@@ -1,1 +1,19 @@
-"""wavesph server package."""
+"""wavesph server: HTTP run management + coupling doors (WebSocket and plain TCP) + run store.
+
+    wavesph serve [--host 127.0.0.1] [--port 8765] [--tcp-port 8766] [--runs-dir runs]
+                  [--max-runs 2] [--max-particles 2000000] [--token T]   (or WAVESPH_* env)
+
+HTTP (OpenAPI docs at /docs):
+    POST   /runs                    {scene, mode: coupled|standalone, coupling: {window_max, z_ref}}
+    GET    /runs                    every run, including those of earlier server processes
+    GET    /runs/{id}               status, t, steps, particles, particle_steps_per_s,
+                                    coupling_overhead_share, stability, last_gauges, scene_hash
+    GET    /runs/{id}/scene         canonical scene bytes (protocol scene hash = their SHA-256)
+    GET    /runs/{id}/gauges        ?format=csv|json
+    GET    /runs/{id}/events        Server-Sent Events, one `progress` event per change
+    DELETE /runs/{id}               cancel (data so far kept)
+Coupling: WebSocket /runs/{id}/couple, or the TCP port; frames of protocol/PROTOCOL.md.
+
+Python entry point: ``server.main.create_app(settings, engine_factory=None)``; the coupled
+engine contract is ``server.engine.CouplingEngine`` (see docs/ARCHITECTURE.md).
+"""
