@@ -41,8 +41,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     p.add_argument("--window", type=float, default=None,
                    help="coupling window [s]; default min(server window_max, T/50)")
     p.add_argument("--t-end", type=float, default=None, help="stop at this time [s]")
-    p.add_argument("--no-absorb", action="store_true",
-                   help="do not apply the seed 002 active-absorption correction")
+    p.add_argument("--absorb", action="store_true",
+                   help="apply the seed 002 active-absorption correction on the client side; only "
+                        "for a server whose open boundaries do not absorb themselves")
+    p.add_argument("--absorb-cutoff", type=float, default=None,
+                   help="low-pass cutoff [Hz] of the absorption's measured mismatch (default 3/T)")
     p.add_argument("--x-offset", type=float, default=0.0,
                    help="model x = SPH x + offset [m]")
     p.add_argument("--inlet-gauge", type=int, default=None,
@@ -103,7 +106,8 @@ def main(args: argparse.Namespace) -> int:
                 scene_hash = b""
             if len(scene_hash) != 32:
                 raise ValueError("--scene-hash must be 64 hex digits (SHA-256)")
-        options = CouplingOptions(window=args.window, t_end=args.t_end, absorb=not args.no_absorb,
+        options = CouplingOptions(window=args.window, t_end=args.t_end, absorb=args.absorb,
+                                  absorb_cutoff=args.absorb_cutoff,
                                   x_offset=args.x_offset, inlet_gauge=args.inlet_gauge,
                                   outlet_gauge=args.outlet_gauge)
         if args.url.startswith("tcp://") and not args.run_id:

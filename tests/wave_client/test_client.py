@@ -173,9 +173,10 @@ def test_coupled_run_applies_seed002_correction(transport, tmp_path):
 
     async def scenario():
         async with PeerServer(fake, transport) as peer:
-            report = await run_coupling(peer.url, AiryWave(H, T, DEPTH),
-                                        CouplingOptions(window=WINDOW), run_id="r1", timeout=5.0,
-                                        log_path=log, progress=False)
+            # unfiltered (cutoff = inf): the correction must be the seed 002 formula exactly
+            options = CouplingOptions(window=WINDOW, absorb=True, absorb_cutoff=math.inf)
+            report = await run_coupling(peer.url, AiryWave(H, T, DEPTH), options, run_id="r1",
+                                        timeout=5.0, log_path=log, progress=False)
             await asyncio.wait_for(fake.done.wait(), 5.0)
             return report
 
@@ -207,18 +208,20 @@ def test_coupled_run_applies_seed002_correction(transport, tmp_path):
     # the CSV log has a row per window, with units stated in its header
     lines = log.read_text().splitlines()
     assert lines[0].startswith("# ") and "SI units" in log.read_text()
+    assert "# model: AiryWave(height=0.08" in log.read_text() and "gauge_x [m]: 0.5 5 9.5" in log.read_text()
     rows = [ln for ln in lines if not ln.startswith("#")]
     assert rows[0].startswith("t,steps,eta_0,wet_0") and len(rows) == n + 1
     assert float(rows[-1].split(",")[0]) == pytest.approx(T_END)
 
 
-def test_no_absorb_sends_the_pure_theory():
+def test_by_default_the_pure_theory_is_sent():
+    # the SPH side absorbs by itself unless told otherwise: the client must not add its own
     fake = FakeSph()
 
     async def scenario():
         async with PeerServer(fake, "tcp") as peer:
             await run_coupling(peer.url, AiryWave(H, T, DEPTH),
-                               CouplingOptions(window=WINDOW, absorb=False, t_end=0.2),
+                               CouplingOptions(window=WINDOW, t_end=0.2),
                                run_id="r1", timeout=5.0, progress=False)
 
     run(scenario())
@@ -398,8 +401,38 @@ def test_core_gauge_choice_and_bad_index():
         core.on_nodes(2, make_nodes())
 
 
+def test_core_low_pass_of_the_mismatch():
+    # constant mismatch m at the inlet gauge: after n results m_f = m (1 - (1 - a)^n),
+    # a = dt / (tau + dt), tau = 1 / (2 pi f_c)
+    f_c = 2.0
+    core = CouplingCore(AiryWave(H, T, DEPTH),
+                        CouplingOptions(window=WINDOW, absorb=True, absorb_cutoff=f_c), run_id="r1")
+    handshake(core)
+    tau = 1 / (2 * np.pi * f_c)
+    assert core.filter_tau == pytest.approx(tau)
+    a = WINDOW / (tau + WINDOW)
+    ref = AiryWave(H, T, DEPTH)
+    inlet = NODE_SIDE == 0
+    for n in range(6):
+        set_frame, solve_frame = core.next_window()
+        _, s = decode_frame(set_frame)
+        seq, _ = decode_frame(solve_frame)
+        m_f = OFFSETS[0] * (1 - (1 - a) ** n)
+        np.testing.assert_allclose(s.u[inlet], expected_u(s.t1, NODE_X, NODE_Z)[inlet] - m_f * C,
+                                   atol=1e-14)
+        ref.advance_to(s.t1)
+        core.on_result(seq, Result(s.t1, 10, ref.elevation(GAUGE_X) + OFFSETS,
+                                   np.ones(3, np.uint32), np.zeros(3), np.zeros(3)))
+    # default cutoff: 3 / period of the model
+    core = CouplingCore(AiryWave(H, T, DEPTH), CouplingOptions(absorb=True), run_id="r1")
+    handshake(core)
+    assert core.filter_tau == pytest.approx(T / (2 * np.pi * 3))
+
+
 def test_core_dry_gauge_gives_no_correction_and_result_time_is_checked():
-    core = CouplingCore(AiryWave(H, T, DEPTH), CouplingOptions(window=WINDOW), run_id="r1")
+    core = CouplingCore(AiryWave(H, T, DEPTH),
+                        CouplingOptions(window=WINDOW, absorb=True, absorb_cutoff=math.inf),
+                        run_id="r1")
     handshake(core)
     _, rec = window(core, np.array([0.5, 0.0, 0.5]), wet=(0, 1, 1))  # inlet gauge dry
     s, rec = window(core, np.zeros(3))

@@ -108,6 +108,19 @@ def test_raschii_adapters_match_direct_calls(ours, ref):
         np.testing.assert_allclose(w, v[:, 1], atol=1e-10)
 
 
+def test_stokes2_second_harmonic_matches_textbook():
+    # Dean & Dalrymple (1991) eq. 11.43: second harmonic of eta is
+    # (k H^2 / 16) cosh(kd) (2 + cosh 2kd) / sinh^3(kd), an independent check of raschii's B22
+    wave = StokesWave(0.08, 2.0, 1.0, order=2)
+    x = np.linspace(0.0, wave.length, 512, endpoint=False)
+    harmonics = np.abs(np.fft.rfft(wave.elevation(x))) * 2 / x.size
+    k, d, h = wave.k, 1.0, 0.08
+    assert harmonics[1] == pytest.approx(h / 2, rel=1e-12)
+    expected = k * h**2 / 16 * np.cosh(k * d) * (2 + np.cosh(2 * k * d)) / np.sinh(k * d) ** 3
+    assert harmonics[2] == pytest.approx(expected, rel=1e-9)
+    assert expected > 0.04 * h / 2  # ~5 % of the amplitude: this is not linear theory
+
+
 def test_stream_function_wavelength_matches_reference_readme():
     assert StreamFunctionWave(0.08, 2.0, 1.0).length == pytest.approx(5.229, abs=1e-3)
 

@@ -11,17 +11,31 @@ Per window [t0, t1]:
   4. mismatch at the inlet/outlet gauges: d_eta = eta_measured - eta_model(gauge x, t1);
      ``model.impose(x_gauge_in, eta_measured, u_ref)`` (two-way models use it, theories ignore it).
 
-Correction (seed 002, shallow-water active absorption), applied to the next window's u, with
-c = sqrt(g/d), g and d from WELCOME:
-    inlet:   u_in  = u_model - (eta_in,measured  - eta_model) * c
-    outlet:  u_out = u_model - (eta_model - eta_out,measured) * c
-Only the horizontal velocity is corrected, uniformly over depth. The measurement of window n
-corrects window n+1 (one-window lag, as the exchange is explicit).
+Correction (seed 002, shallow-water active absorption; opt-in, ``absorb=True``), applied to the
+next window's u, with c = sqrt(g/d), g and d from WELCOME, and the mismatch
+m = eta_measured - eta_model at the side's gauge:
+    inlet:   u_in  = u_model - m_f * c        (= u_model - (eta_in,measured - eta_model) c)
+    outlet:  u_out = u_model + m_f * c        (= u_model - (eta_model - eta_out,measured) c)
+Only the horizontal velocity is corrected, uniformly over depth.
+
+m_f is m through a first-order low-pass, tau dm_f/dt = m - m_f, tau = 1 / (2 pi f_c), discretised
+per window as m_f += a (m - m_f), a = dt_w / (tau + dt_w); f_c = ``absorb_cutoff`` (default
+3 / wave period; infinity gives the unfiltered formula). Why: the exchange is explicit, so the
+measurement of window n only corrects window n+1; with the gauge distance this delays the
+absorber by tau_d ~ one window, and an absorber of gain 1 and delay tau_d re-emits a wave of
+frequency f with amplitude |1 - exp(-2 pi i f tau_d)| of the incoming one: > 1 above
+f = 1 / (6 tau_d). In a lossless flume such components grow without bound (test_client_absorption);
+the low-pass keeps the correction at the wave frequencies and starves the amplifying band.
+
+Do not combine with absorption on the SPH side: sph_core's open boundaries apply the same
+correction every sub-step (scene ``open_boundaries[].absorb``, no window lag); both together
+double the gain. The client's correction is for servers whose boundaries impose the values as sent.
 """
 
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
@@ -47,7 +61,10 @@ class CouplingOptions:
               for a model without ``period``). Boundary data are interpolated linearly in time
               over a window, so it must resolve the wave period.
     t_end:    stop at this time [s] (None: the server's t_end).
-    absorb:   apply the seed 002 correction at the inlet and outlet.
+    absorb:   apply the seed 002 correction at the inlet and outlet (off by default: the SPH
+              side normally absorbs itself, see the module docstring).
+    absorb_cutoff: low-pass cutoff f_c [Hz] of the measured mismatch; None: 3 / model period
+              (50 windows' period for a model without ``period``); math.inf: no filter.
     x_offset: model x = SPH x + x_offset [m] (the two codes may use different x origins).
     inlet_gauge, outlet_gauge: index of the gauge that measures eta for that side's correction;
               None: the gauge nearest that side's nodes (and nearer to it than to the other side).
@@ -56,7 +73,8 @@ class CouplingOptions:
 
     window: float | None = None
     t_end: float | None = None
-    absorb: bool = True
+    absorb: bool = False
+    absorb_cutoff: float | None = None
     x_offset: float = 0.0
     inlet_gauge: int | None = None
     outlet_gauge: int | None = None
@@ -117,7 +135,8 @@ class CouplingCore:
         self.times: np.ndarray = np.zeros(0)   # window ends t_1 .. t_n, t_0 = t_start
         self.window_index = 0                  # windows solved so far
         self._sides: dict[Side, _Side] = {}
-        self._mismatch = {Side.INLET: 0.0, Side.OUTLET: 0.0}  # eta_measured - eta_model [m]
+        self._mismatch = {Side.INLET: 0.0, Side.OUTLET: 0.0}  # low-passed eta_meas - eta_model [m]
+        self.filter_tau = 0.0                  # s, low-pass time constant of the mismatch
         self._pending: tuple[float, float, float, float] | None = None  # t0, t1, du_in, du_out
 
     # --- handshake ------------------------------------------------------------------------
@@ -155,6 +174,14 @@ class CouplingCore:
         self.times = welcome.t_start + window * np.arange(1, n + 1)
         self.times[-1] = t_stop  # the last window ends exactly at t_stop
         self.window = window
+        period = getattr(self.model, "period", None) or 50.0 * window
+        f_c = self.options.absorb_cutoff if self.options.absorb_cutoff is not None else 3.0 / period
+        if not f_c > 0:
+            raise CouplingError(f"absorb_cutoff must be > 0 Hz, got {f_c}")
+        self.filter_tau = 1.0 / (2.0 * math.pi * f_c)
+        if self.options.absorb and window > period / 40:
+            warnings.warn(f"window={window:.4g} s is longer than period/40 = {period / 40:.4g} s: "
+                          "the lagged client-side absorption may amplify short waves", stacklevel=2)
         self.model.advance_to(welcome.t_start)
         return self.session.request(GetNodes())
 
@@ -196,6 +223,23 @@ class CouplingCore:
             ok = own < abs(gx - self.nodes.x[self._sides[other_side].index].mean())
         return int(np.flatnonzero(ok)[np.argmin(own[ok])]) if ok.any() else None
 
+    def describe(self) -> list[str]:
+        """Run metadata as text lines (for the log header), after the handshake."""
+        w, n = self.welcome, self.nodes
+        assert w is not None and n is not None
+        return [
+            f"model: {self.model!r}",
+            f"run_id: {w.run_id}; server: {w.server}",
+            f"g = {w.g} m/s^2; depth = {w.depth} m; still_water_level = {w.still_water_level} m "
+            f"(absolute SPH z); z_ref = {w.z_ref} m (up from still water)",
+            f"windows: {self.times.size} of {self.window} s from t = {w.t_start} s to {self.times[-1]} s",
+            f"gauge_x [m]: {' '.join(f'{x:.6g}' for x in n.gauge_x)}",
+            f"client-side correction (seed 002): "
+            f"{f'on, low-pass tau = {self.filter_tau:.4g} s' if self.options.absorb else 'off'}, "
+            f"gauges {self.gauges}; "
+            f"model x = SPH x + {self.options.x_offset} m",
+        ]
+
     @property
     def gauges(self) -> dict[str, int | None]:
         """Gauge index used for each side's correction (None: no correction there)."""
@@ -225,7 +269,7 @@ class CouplingCore:
         c = math.sqrt(self.welcome.g / self.welcome.depth)
         du_in = du_out = 0.0
         if self.options.absorb:
-            du_in = -self._mismatch[Side.INLET] * c    # u_in = u - (eta_meas - eta_model) c
+            du_in = 0.0 - self._mismatch[Side.INLET] * c  # u_in = u - (eta_meas - eta_model) c
             du_out = self._mismatch[Side.OUTLET] * c   # u_out = u - (eta_model - eta_meas) c
             if Side.INLET in self._sides:
                 u[self._sides[Side.INLET].index] += du_in
@@ -251,11 +295,12 @@ class CouplingCore:
         gx = self.nodes.gauge_x
         eta_model = (np.asarray(self.model.elevation(gx + x_off), dtype=float).reshape(gx.size)
                      if gx.size else np.zeros(0))
+        a = (t1 - t0) / (self.filter_tau + (t1 - t0))  # 1 when unfiltered (tau = 0)
         for side, s in self._sides.items():
             g = s.gauge
             # a dry gauge measured nothing: no correction rather than a spurious one
-            self._mismatch[side] = (float(result.eta[g] - eta_model[g])
-                                    if g is not None and result.wet[g] else 0.0)
+            m = float(result.eta[g] - eta_model[g]) if g is not None and result.wet[g] else 0.0
+            self._mismatch[side] += a * (m - self._mismatch[side])
         inlet = self._sides.get(Side.INLET)
         if inlet is not None and inlet.gauge is not None and result.wet[inlet.gauge]:
             g = inlet.gauge

@@ -77,6 +77,11 @@ class GaugeLog:
             self._f.write(f"# {line}\n")
         self._columns_written = False
 
+    def note(self, line: str) -> None:
+        """A '# ' comment line (run metadata), before the first row."""
+        self._f.write(f"# {line}\n")
+        self._f.flush()
+
     def write(self, r: WindowRecord) -> None:
         n = r.eta.size
         if not self._columns_written:
@@ -129,6 +134,9 @@ async def run_coupling(url: str, model: ModelSource, options: CouplingOptions | 
         await transport.send([core.on_welcome(*await transport.recv(timeout))])
         core.on_nodes(*await transport.recv(timeout))
         report.welcome, report.gauges = core.welcome, core.gauges
+        if log is not None:
+            for line in core.describe():
+                log.note(line)
         bar = tqdm(total=core.windows_left, unit="window", desc="coupling", disable=not progress)
         while core.windows_left:
             stage = f"window {core.window_index + 1}/{core.times.size}"

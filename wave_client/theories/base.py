@@ -73,6 +73,7 @@ class WaveTheory:
     depth: float
     period: float
     g: float
+    _repr_fields: tuple[str, ...] = ("height", "period", "depth", "ramp_time")
 
     def __init__(self, ramp_time: float = 0.0) -> None:
         ramp_time = float(ramp_time)
@@ -80,6 +81,10 @@ class WaveTheory:
             raise ValueError(f"ramp_time must be a finite number >= 0 s, got {ramp_time!r}")
         self.ramp_time = ramp_time
         self.t = 0.0
+
+    def __repr__(self) -> str:
+        args = ", ".join(f"{k}={getattr(self, k)!r}" for k in self._repr_fields)
+        return f"{type(self).__name__}({args})"
 
     # --- WaveModel contract -------------------------------------------------------------
     def advance_to(self, t: float) -> None:

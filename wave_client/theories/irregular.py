@@ -47,6 +47,8 @@ class JonswapSea(WaveTheory):
     [``f_min_factor`` fp, ``f_max_factor`` fp], RNG ``seed`` (same seed, same sea).
     """
 
+    _repr_fields = ("hs", "tp", "depth", "gamma", "n_components", "seed", "ramp_time")
+
     def __init__(
         self,
         hs: float,
@@ -93,6 +95,7 @@ class JonswapSea(WaveTheory):
         self.omegas = 2.0 * np.pi * self.frequencies
         self.wavenumbers = wavenumber(self.omegas, self.depth, self.g)
         self.repeat_period = 1.0 / self.df
+        self.n_components = int(n_components)
         self.seed = seed
 
     @property

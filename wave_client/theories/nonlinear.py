@@ -62,6 +62,8 @@ class _RaschiiWave(WaveTheory):
 class StokesWave(_RaschiiWave):
     """Stokes wave of order 2 to 5 (Fenton 1985) through ``raschii.StokesWave``."""
 
+    _repr_fields = ("height", "period", "depth", "order", "ramp_time")
+
     def __init__(
         self,
         height: float,
@@ -88,6 +90,8 @@ class StreamFunctionWave(_RaschiiWave):
 
     ``n_fourier`` is the number of Fourier modes; raise it for steep or shallow-water waves.
     """
+
+    _repr_fields = ("height", "period", "depth", "n_fourier", "ramp_time")
 
     def __init__(
         self,
