@@ -6,13 +6,12 @@ import hashlib
 import json
 import socket
 import struct
-import time
 
 import numpy as np
 import pytest
 
-from protocol import (ErrorCode, GetNodes, GoBack, Hello, ProtocolError, RemoteError, Result, Set,
-                      Solve, encode_frame, scene_hash)
+from protocol import (ErrorCode, GoBack, Hello, RemoteError, Result, Set,
+                      Solve, scene_hash)
 from protocol.wire import HEADER, MAGIC, MessageType
 
 from conftest import live_server

@@ -6,7 +6,6 @@ import json
 import subprocess
 import sys
 
-import httpx
 import pytest
 from fastapi.testclient import TestClient
 from pydantic import ValidationError
