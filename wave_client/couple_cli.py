@@ -12,6 +12,8 @@ from __future__ import annotations
 
 import argparse
 import sys
+from collections.abc import Callable
+from pathlib import Path
 from typing import Any
 
 from protocol import Welcome
@@ -37,7 +39,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     p.add_argument("--components", type=int, default=200, help="wave components (irregular)")
     p.add_argument("--seed", type=int, default=0, help="random phases seed (irregular)")
     p.add_argument("--config", default=None,
-                   help="Boussinesq model configuration file (--model boussinesq)")
+                   help="`wavesph waves` TOML scene of the Boussinesq model (--model boussinesq); "
+                        "its [coupling] x is where the SPH inlet sits")
     p.add_argument("--window", type=float, default=None,
                    help="coupling window [s]; default min(server window_max, T/50)")
     p.add_argument("--t-end", type=float, default=None, help="stop at this time [s]")
@@ -46,8 +49,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         "for a server whose open boundaries do not absorb themselves")
     p.add_argument("--absorb-cutoff", type=float, default=None,
                    help="low-pass cutoff [Hz] of the absorption's measured mismatch (default 3/T)")
-    p.add_argument("--x-offset", type=float, default=0.0,
-                   help="model x = SPH x + offset [m]")
+    p.add_argument("--x-offset", type=float, default=None,
+                   help="model x = SPH x + offset [m]; default: the Boussinesq [coupling] x at "
+                        "the SPH inlet, 0 for the theories")
     p.add_argument("--inlet-gauge", type=int, default=None,
                    help="gauge index measuring the inlet (default: nearest to the inlet)")
     p.add_argument("--outlet-gauge", type=int, default=None,
@@ -61,15 +65,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
 
 
-def model_factory(args: argparse.Namespace):
-    """A callable(Welcome) -> WaveModel for the chosen --model (depth from WELCOME if no --d)."""
+def model_factory(args: argparse.Namespace) -> tuple[Callable[[Welcome], Any], float | None]:
+    """(callable(Welcome) -> WaveModel, wave period [s] or None) for the chosen --model.
+
+    Theories take the depth from WELCOME unless --d is given; everything that can be checked
+    before connecting is checked here, so a bad argument never reaches the server.
+    """
     if args.model == "boussinesq":
-        try:
-            from wave_client.boussinesq import couple_model  # type: ignore[attr-defined]
-        except ImportError as exc:
-            raise ValueError("--model boussinesq is not available in this build: "
-                             f"wave_client.boussinesq provides no couple_model ({exc})") from exc
-        return lambda welcome: couple_model(args, welcome)
+        return _boussinesq_factory(args)
     from wave_client.theories import build_theory
 
     if args.H is None or args.T is None:
@@ -89,15 +92,30 @@ def model_factory(args: argparse.Namespace):
         return build_theory(args.model, height=args.H, period=args.T, depth=depth, **options)
 
     if args.d is not None:  # validate the theory now, before connecting
-        make(None)
-    return make
+        make(None)  # type: ignore[arg-type]
+    return make, args.T
+
+
+def _boussinesq_factory(args: argparse.Namespace) -> tuple[Callable[[Welcome], Any], float | None]:
+    try:  # imported lazily: the theories never need numba
+        from wave_client.boussinesq.scene import build_model, load_scene
+    except ImportError as exc:
+        raise ValueError(f"--model boussinesq is not available in this build ({exc})") from exc
+    if args.config is None:
+        raise ValueError("--model boussinesq needs --config SCENE.toml (a `wavesph waves` scene)")
+    config = Path(args.config)
+    scene = load_scene(config)  # SceneError is a ValueError naming the field
+    return (lambda welcome: build_model(scene, base_dir=config.parent)), getattr(scene.wave, "period", None)
 
 
 def main(args: argparse.Namespace) -> int:
     from wave_client.coupling import CouplingError, CouplingOptions, couple
 
     try:
-        factory = model_factory(args)
+        factory, period = model_factory(args)
+        window = args.window
+        if window is None and args.model == "boussinesq" and period is not None:
+            window = period / 50  # the theories give the core their period themselves
         scene_hash = None
         if args.scene_hash is not None:
             try:
@@ -106,7 +124,7 @@ def main(args: argparse.Namespace) -> int:
                 scene_hash = b""
             if len(scene_hash) != 32:
                 raise ValueError("--scene-hash must be 64 hex digits (SHA-256)")
-        options = CouplingOptions(window=args.window, t_end=args.t_end, absorb=args.absorb,
+        options = CouplingOptions(window=window, t_end=args.t_end, absorb=args.absorb,
                                   absorb_cutoff=args.absorb_cutoff,
                                   x_offset=args.x_offset, inlet_gauge=args.inlet_gauge,
                                   outlet_gauge=args.outlet_gauge)

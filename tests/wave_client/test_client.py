@@ -52,25 +52,30 @@ def make_nodes() -> Nodes:
 
 
 class FakeSph:
-    """Toy SPH peer. behaviour: 'ok', 'refuse_set' (ERROR on the 3rd SET), 'stall' (never
-    answers the 2nd SOLVE), 'hangup' (closes on the 2nd SOLVE)."""
+    """Toy SPH peer. behaviour: 'ok', 'still' (measures still water), 'refuse_set' (ERROR on
+    the 3rd SET), 'stall' (never answers the 2nd SOLVE), 'hangup' (closes on the 2nd SOLVE)."""
 
-    def __init__(self, behaviour: str = "ok", **welcome) -> None:
+    def __init__(self, behaviour: str = "ok", nodes: Nodes | None = None) -> None:
         self.behaviour = behaviour
         self.theory = AiryWave(H, T, DEPTH)
-        self.welcome = make_welcome(**welcome)
+        self.nodes = nodes or make_nodes()
+        self.welcome = make_welcome(n_nodes=self.nodes.x.size, n_gauges=self.nodes.gauge_x.size,
+                                    max_payload=set_payload_size(self.nodes.x.size))
         self.sets: list[SetWindow] = []
         self.peer_errors: list[PeerError] = []
         self.done = asyncio.Event()
 
     def measure(self, t: float, last: SetWindow) -> Result:
         self.theory.advance_to(t)
-        eta = self.theory.elevation(GAUGE_X) + OFFSETS
-        u_ref = np.full(GAUGE_X.size, float(np.mean(last.u)))
-        return Result(t, 40, eta, np.ones(GAUGE_X.size, np.uint32), u_ref, np.zeros(GAUGE_X.size))
+        gx = self.nodes.gauge_x
+        eta = self.theory.elevation(gx) + OFFSETS[:gx.size]
+        u_ref = np.full(gx.size, float(np.mean(last.u)))
+        if self.behaviour == "still":
+            eta, u_ref = 0.0 * eta, 0.0 * u_ref
+        return Result(t, 40, eta, np.ones(gx.size, np.uint32), u_ref, np.zeros(gx.size))
 
     async def serve(self, recv, send) -> None:
-        session = SphSession(self.welcome, make_nodes())
+        session = SphSession(self.welcome, self.nodes)
         try:
             while True:
                 try:
@@ -253,7 +258,7 @@ def test_two_way_feedback_reaches_the_model():
     for (t, x, eta, u_ref), s in zip(model.imposed, fake.sets):
         ref.advance_to(t)
         assert t == pytest.approx(s.t1)
-        assert x == pytest.approx(100.5)  # gauge 0 in model coordinates
+        assert x == pytest.approx(100.01)  # inlet boundary (mean node x) in model coordinates
         assert eta == pytest.approx(float(ref.elevation(0.5)) + OFFSETS[0], abs=1e-15)
         assert u_ref == pytest.approx(float(np.mean(s.u)))
 
@@ -369,6 +374,22 @@ def test_core_model_factory_takes_depth_from_welcome_and_default_window():
     assert core.times[-1] == T_END and core.times.size == math.ceil(T_END / (T / 50) - 1e-9)
 
 
+def test_core_aligns_the_inlet_with_the_models_coupling_point():
+    class Placed(AiryWave):
+        x_couple = 30.0  # like BoussinesqModel: where the SPH inlet sits in model x
+
+    core = CouplingCore(Placed(H, T, DEPTH), CouplingOptions(window=WINDOW), run_id="r1")
+    handshake(core)
+    assert core.x_inlet == pytest.approx(0.01) and core.x_offset == pytest.approx(29.99)
+    _, s = decode_frame(core.next_window()[0])
+    ref = AiryWave(H, T, DEPTH)
+    ref.advance_to(s.t1)
+    np.testing.assert_allclose(s.eta, ref.elevation(NODE_X + 29.99), atol=1e-15)
+    core = CouplingCore(Placed(H, T, DEPTH), CouplingOptions(x_offset=0.0), run_id="r1")
+    handshake(core)
+    assert core.x_offset == 0.0  # an explicit offset wins
+
+
 def test_core_last_window_is_snapped_to_t_end():
     core = CouplingCore(AiryWave(H, T, DEPTH), CouplingOptions(window=0.03, t_end=0.1), run_id="r1")
     handshake(core)
@@ -447,6 +468,19 @@ def test_core_dry_gauge_gives_no_correction_and_result_time_is_checked():
         core.on_result(seq, Result(9.0, 1, np.zeros(3), np.ones(3, np.uint32), np.zeros(3), np.zeros(3)))
 
 
+def test_core_names_the_nodes_a_model_cannot_serve():
+    class Short(AiryWave):  # a model whose grid ends at x = 2 m, like a Boussinesq domain
+        def velocity(self, x, z):
+            if np.any(np.asarray(x) > 2.0):
+                raise ValueError("x outside the model grid [-20.0, 2.0]")
+            return super().velocity(x, z)
+
+    core = CouplingCore(Short(H, T, DEPTH), CouplingOptions(window=WINDOW), run_id="r1")
+    handshake(core)
+    with pytest.raises(CouplingError, match=r"outlet nodes at SPH x = 10.0 m .*outside the model grid"):
+        core.next_window()
+
+
 def test_core_refuses_non_finite_model_output():
     class NaNWave(AiryWave):
         def elevation(self, x):
@@ -485,10 +519,56 @@ def test_cli_couples_over_tcp_and_writes_the_series(tmp_path, capsys):
     assert "refusing to overwrite" in capsys.readouterr().err
 
 
+BOUSSINESQ_SCENE = """
+[grid]
+x_start = -20.0
+x_end = 2.0
+dx = 0.1
+t_end = 10.0
+[bathymetry]
+x = [0.0]
+depth = [1.0]
+[wave]
+kind = "regular"
+height = 0.08
+period = 2.0
+x_source = -12.0
+[sponge]
+left = 4.0
+[gauges]
+x = [0.0]
+[coupling]
+x = 0.0
+"""
+
+
+def test_cli_couples_the_boussinesq_model(tmp_path, capsys):
+    pytest.importorskip("wave_client.boussinesq.scene")
+    config = tmp_path / "bsq.toml"
+    config.write_text(BOUSSINESQ_SCENE)
+    # an SPH zone with an inlet only (a beach at its end): the grid ends 2 m into it
+    fake = FakeSph("still", Nodes(np.zeros(8), Z_COL, np.zeros(8, np.uint32), np.array([0.5, 5.0])))
+
+    async def scenario():
+        async with PeerServer(fake, "ws") as peer:
+            args = cli_args("--url", peer.url, "--model", "boussinesq", "--config", str(config),
+                            "--t-end", "0.2", "--no-progress", "--timeout", "60")
+            return await asyncio.to_thread(couple_cli.main, args)
+
+    assert run(scenario(), limit=90.0) == 0, capsys.readouterr().err
+    assert len(fake.sets) == 5  # default window T/50 = 0.04 s from the scene's wave period
+    assert all(np.all(np.isfinite(s.u)) for s in fake.sets)
+    assert "coupled 5 windows" in capsys.readouterr().out
+    # the waves have not reached x = 0 yet (source at -12 m, ramped) and SPH measures still
+    # water, imposed back on the model (two-way): still water is sent
+    assert max(np.abs(s.u).max() + np.abs(s.eta).max() for s in fake.sets) < 1e-6
+
+
 @pytest.mark.parametrize(
     "argv,message",
     [
         (["--model", "stokes", "--H", "0.08"], "needs --H and --T"),
+        (["--model", "boussinesq"], "needs --config"),
         (["--model", "linear", "--H", "0.9", "--T", "2", "--d", "1"], "height=0.9"),
         (["--model", "linear", "--H", "0.08", "--T", "2"], "--run-id is required"),
     ],

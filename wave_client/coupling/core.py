@@ -9,7 +9,9 @@ Per window [t0, t1]:
   2. sample u, w at the boundary nodes and eta at their x; correct u (below);
   3. SET(t0, t1, u, w, eta) + SOLVE  ->  RESULT(eta, wet, u_ref, w_ref at the gauges, at t1);
   4. mismatch at the inlet/outlet gauges: d_eta = eta_measured - eta_model(gauge x, t1);
-     ``model.impose(x_gauge_in, eta_measured, u_ref)`` (two-way models use it, theories ignore it).
+     ``model.impose(x_b, eta_measured, u_ref)`` at the inlet boundary x_b (mean x of the inlet
+     nodes) with the inlet gauge's readings, Alg. 2 line 4 (two-way models use it, theories
+     ignore it).
 
 Correction (seed 002, shallow-water active absorption; opt-in, ``absorb=True``), applied to the
 next window's u, with c = sqrt(g/d), g and d from WELCOME, and the mismatch
@@ -65,7 +67,8 @@ class CouplingOptions:
               side normally absorbs itself, see the module docstring).
     absorb_cutoff: low-pass cutoff f_c [Hz] of the measured mismatch; None: 3 / model period
               (50 windows' period for a model without ``period``); math.inf: no filter.
-    x_offset: model x = SPH x + x_offset [m] (the two codes may use different x origins).
+    x_offset: model x = SPH x + x_offset [m] (the two codes may use different x origins); None:
+              put the SPH inlet at the model's ``x_couple`` if it has one (Boussinesq), else 0.
     inlet_gauge, outlet_gauge: index of the gauge that measures eta for that side's correction;
               None: the gauge nearest that side's nodes (and nearer to it than to the other side).
     depth_rtol: largest relative difference accepted between the model's depth and WELCOME.depth.
@@ -75,7 +78,7 @@ class CouplingOptions:
     t_end: float | None = None
     absorb: bool = False
     absorb_cutoff: float | None = None
-    x_offset: float = 0.0
+    x_offset: float | None = None
     inlet_gauge: int | None = None
     outlet_gauge: int | None = None
     depth_rtol: float = 0.01
@@ -92,7 +95,7 @@ class WindowRecord:
     wet: np.ndarray            # 1 where the gauge found water
     u_ref: np.ndarray          # measured velocity at z_ref at each gauge [m/s]
     w_ref: np.ndarray
-    eta_model: np.ndarray      # wave-model elevation at each gauge at t1 [m]
+    eta_model: np.ndarray      # wave-model elevation at each gauge at t1 [m] (NaN: outside the model)
     du_inlet: float            # correction added to u at the inlet nodes in this window [m/s]
     du_outlet: float           # ... at the outlet nodes [m/s]
 
@@ -137,6 +140,8 @@ class CouplingCore:
         self._sides: dict[Side, _Side] = {}
         self._mismatch = {Side.INLET: 0.0, Side.OUTLET: 0.0}  # low-passed eta_meas - eta_model [m]
         self.filter_tau = 0.0                  # s, low-pass time constant of the mismatch
+        self.x_offset = 0.0                    # m, model x = SPH x + x_offset
+        self.x_inlet: float | None = None      # m, SPH x of the inlet boundary (mean node x)
         self._pending: tuple[float, float, float, float] | None = None  # t0, t1, du_in, du_out
 
     # --- handshake ------------------------------------------------------------------------
@@ -210,6 +215,13 @@ class CouplingCore:
                 self._sides[side].gauge = chosen
             else:
                 self._sides[side].gauge = self._nearest_gauge(side)
+        if Side.INLET in self._sides:
+            self.x_inlet = float(nodes.x[self._sides[Side.INLET].index].mean())
+        x_couple = getattr(self.model, "x_couple", None)
+        if self.options.x_offset is not None:
+            self.x_offset = float(self.options.x_offset)
+        elif x_couple is not None and self.x_inlet is not None:
+            self.x_offset = float(x_couple) - self.x_inlet
 
     def _nearest_gauge(self, side: Side) -> int | None:
         assert self.nodes is not None
@@ -237,7 +249,7 @@ class CouplingCore:
             f"client-side correction (seed 002): "
             f"{f'on, low-pass tau = {self.filter_tau:.4g} s' if self.options.absorb else 'off'}, "
             f"gauges {self.gauges}; "
-            f"model x = SPH x + {self.options.x_offset} m",
+            f"model x = SPH x + {self.x_offset} m",
         ]
 
     @property
@@ -258,14 +270,19 @@ class CouplingCore:
         t0 = self.welcome.t_start if self.window_index == 0 else float(self.times[self.window_index - 1])
         t1 = float(self.times[self.window_index])
         self.model.advance_to(t1)
-        x_off = self.options.x_offset
+        x_off = self.x_offset
         n = self.nodes.x.size
-        u, w = np.zeros(n), np.zeros(n)
-        for side in self._sides.values():
+        u, w, eta = np.zeros(n), np.zeros(n), np.zeros(n)
+        for key, side in self._sides.items():
             for x, idx in side.columns:
-                uc, wc = self.model.velocity(x + x_off, self.nodes.z[idx])
+                try:
+                    uc, wc = self.model.velocity(x + x_off, self.nodes.z[idx])
+                    eta[idx] = np.asarray(self.model.elevation(np.array([x + x_off])), float)[0]
+                except ValueError as exc:  # e.g. a node outside the model's grid
+                    raise CouplingError(
+                        f"the wave model cannot give the {key.name.lower()} nodes at SPH x = {x} m "
+                        f"(model x = {x + x_off} m): {exc}") from exc
                 u[idx], w[idx] = uc, wc
-        eta = np.asarray(self.model.elevation(self.nodes.x + x_off), dtype=float).reshape(n)
         c = math.sqrt(self.welcome.g / self.welcome.depth)
         du_in = du_out = 0.0
         if self.options.absorb:
@@ -291,24 +308,42 @@ class CouplingCore:
         if abs(result.t - t1) > TIME_RTOL * max(1.0, abs(t1)):
             raise ProtocolError(ErrorCode.TIME_MISMATCH,
                                 f"RESULT.t={result.t} s, the window ended at t1={t1} s")
-        x_off = self.options.x_offset
+        x_off = self.x_offset
         gx = self.nodes.gauge_x
-        eta_model = (np.asarray(self.model.elevation(gx + x_off), dtype=float).reshape(gx.size)
-                     if gx.size else np.zeros(0))
+        eta_model = self._model_at_gauges(gx + x_off)
         a = (t1 - t0) / (self.filter_tau + (t1 - t0))  # 1 when unfiltered (tau = 0)
         for side, s in self._sides.items():
             g = s.gauge
+            if g is not None and not math.isfinite(eta_model[g]):
+                raise CouplingError(f"the {side.name.lower()} gauge {g} at SPH x = {gx[g]} m lies "
+                                    "outside the wave model: choose another gauge")
             # a dry gauge measured nothing: no correction rather than a spurious one
             m = float(result.eta[g] - eta_model[g]) if g is not None and result.wet[g] else 0.0
             self._mismatch[side] += a * (m - self._mismatch[side])
         inlet = self._sides.get(Side.INLET)
         if inlet is not None and inlet.gauge is not None and result.wet[inlet.gauge]:
             g = inlet.gauge
-            self.model.impose(float(gx[g] + x_off), float(result.eta[g]), float(result.u_ref[g]))
+            assert self.x_inlet is not None
+            self.model.impose(self.x_inlet + x_off, float(result.eta[g]), float(result.u_ref[g]))
         self._pending = None
         self.window_index += 1
         return WindowRecord(t0, t1, int(result.steps), result.eta.copy(), result.wet.copy(),
                             result.u_ref.copy(), result.w_ref.copy(), eta_model, du_in, du_out)
+
+    def _model_at_gauges(self, x: np.ndarray) -> np.ndarray:
+        """Model elevation at the gauges; NaN (in the log only) where the model has no value,
+        e.g. SPH-zone gauges beyond a Boussinesq grid."""
+        assert self.model is not None
+        try:
+            return np.asarray(self.model.elevation(x), dtype=float).reshape(x.size)
+        except ValueError:
+            out = np.full(x.size, np.nan)
+            for i, xi in enumerate(x):
+                try:
+                    out[i] = float(np.asarray(self.model.elevation(np.array([xi])), float)[0])
+                except ValueError:
+                    pass
+            return out
 
     # --- ending ---------------------------------------------------------------------------
     def bye(self, reason: str = "done") -> bytes:
