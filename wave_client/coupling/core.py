@@ -43,8 +43,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from protocol import (NO_SCENE_HASH, Capability, ClientSession, Error, ErrorCode, GetNodes, Hello,
-                      Message, Nodes, ProtocolError, Result, Set, Side, Solve, Welcome, Bye)
+from protocol import (NO_SCENE_HASH, Bye, ClientSession, Error, ErrorCode, GetNodes, Hello, Message,
+                      Nodes, ProtocolError, Result, Set, Side, Solve, Welcome)
 from wave_client.model import WaveModel
 
 CLIENT_NAME = "wavesph-couple/0.1"
@@ -136,6 +136,7 @@ class CouplingCore:
         self.welcome: Welcome | None = None
         self.nodes: Nodes | None = None
         self.times: np.ndarray = np.zeros(0)   # window ends t_1 .. t_n, t_0 = t_start
+        self.window = 0.0                      # s, coupling window (the last may be shorter)
         self.window_index = 0                  # windows solved so far
         self._sides: dict[Side, _Side] = {}
         self._mismatch = {Side.INLET: 0.0, Side.OUTLET: 0.0}  # low-passed eta_meas - eta_model [m]
