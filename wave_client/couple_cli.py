@@ -138,6 +138,10 @@ def main(args: argparse.Namespace) -> int:
     except CouplingError as exc:
         print(f"wavesph couple: {exc}", file=sys.stderr)
         return 1
+    except KeyboardInterrupt:
+        print("wavesph couple: interrupted (the server was told; the gauge log keeps every "
+              "window received)", file=sys.stderr)
+        return 130
     n = len(report.records)
     t = report.records[-1].t1 if n else float("nan")
     overhead = report.model_time / report.wall_time if report.wall_time > 0 else 0.0

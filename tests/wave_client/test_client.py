@@ -576,3 +576,15 @@ def test_cli_couples_the_boussinesq_model(tmp_path, capsys):
 def test_cli_bad_arguments_exit_2_with_a_reason(argv, message, capsys):
     assert couple_cli.main(cli_args("--url", "tcp://127.0.0.1:1", *argv)) == 2
     assert message in capsys.readouterr().err
+
+
+def test_core_error_frames_say_why_the_client_leaves():
+    core = CouplingCore(AiryWave(H, T, DEPTH), run_id="r1")
+    handshake(core)
+    cases = [(TimeoutError("no reply"), ErrorCode.TIMEOUT, "no reply"),
+             (KeyboardInterrupt(), ErrorCode.CANCELLED, "interrupted"),
+             (ProtocolError(ErrorCode.MALFORMED, "bad magic"), ErrorCode.MALFORMED, "bad magic"),
+             (RuntimeError("model diverged"), ErrorCode.INTERNAL, "RuntimeError: model diverged")]
+    for exc, code, text in cases:
+        seq, msg = decode_frame(core.error_frame(exc))
+        assert seq == core.session.seq and msg.code == code and text in msg.text

@@ -36,6 +36,7 @@ double the gain. The client's correction is for servers whose boundaries impose 
 
 from __future__ import annotations
 
+import asyncio
 import math
 import warnings
 from collections.abc import Callable
@@ -357,6 +358,8 @@ class CouplingCore:
         """ERROR frame telling the server why the client stops (sent before closing)."""
         if isinstance(exc, ProtocolError):
             code, text = exc.code, exc.text
+        elif isinstance(exc, (KeyboardInterrupt, asyncio.CancelledError)):
+            code, text = ErrorCode.CANCELLED, "client: interrupted by its user"
         elif isinstance(exc, TimeoutError):
             code, text = ErrorCode.TIMEOUT, f"client: {exc}"
         else:
