@@ -22,7 +22,7 @@ from protocol import (ErrorCode, FrameDecoder, Nodes, ProtocolError, Result, Sph
 from protocol.session import PeerError, Reply, SetWindow, SolveWindow, set_payload_size
 from wave_client import couple_cli
 from wave_client.coupling import (CouplingCore, CouplingError, CouplingOptions, CouplingTimeout,
-                                  ServerError, run_coupling)
+                                  ServerEnded, ServerError, run_coupling)
 from wave_client.theories import AiryWave
 
 G, DEPTH = 9.81, 1.0
@@ -53,7 +53,8 @@ def make_nodes() -> Nodes:
 
 class FakeSph:
     """Toy SPH peer. behaviour: 'ok', 'still' (measures still water), 'refuse_set' (ERROR on
-    the 3rd SET), 'stall' (never answers the 2nd SOLVE), 'hangup' (closes on the 2nd SOLVE)."""
+    the 3rd SET), 'stall' (never answers the 2nd SOLVE), 'hangup' (closes on the 2nd SOLVE),
+    'bye' (BYE instead of the 2nd RESULT)."""
 
     def __init__(self, behaviour: str = "ok", nodes: Nodes | None = None) -> None:
         self.behaviour = behaviour
@@ -102,6 +103,9 @@ class FakeSph:
                         await asyncio.sleep(1.0)
                         continue  # swallow the SOLVE; the client must time out
                     if len(self.sets) == 2 and self.behaviour == "hangup":
+                        return
+                    if len(self.sets) == 2 and self.behaviour == "bye":
+                        await send(session.bye_frame("run cancelled by its owner"))
                         return
                     await send(session.result(action, self.measure(action.t1, self.sets[-1])))
                 elif isinstance(action, PeerError):
@@ -306,6 +310,18 @@ def test_peer_hangup_is_connection_lost(transport):
                                run_id="r1", timeout=5.0, progress=False)
 
     with pytest.raises(CouplingError, match="connection lost at window 2/10"):
+        run(scenario())
+
+
+def test_server_bye_mid_run_ends_the_run_clearly():
+    fake = FakeSph("bye")
+
+    async def scenario():
+        async with PeerServer(fake, "ws") as peer:
+            await run_coupling(peer.url, AiryWave(H, T, DEPTH), CouplingOptions(window=WINDOW),
+                               timeout=5.0, progress=False)
+
+    with pytest.raises(ServerEnded, match="ended the run: run cancelled by its owner .at window 2/10"):
         run(scenario())
 
 

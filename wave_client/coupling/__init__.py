@@ -8,10 +8,10 @@
 """
 
 from wave_client.coupling.core import (CouplingCore, CouplingError, CouplingOptions,
-                                       WindowRecord)
+                                       ServerEnded, WindowRecord)
 from wave_client.coupling.runner import (CouplingReport, CouplingTimeout, GaugeLog, ServerError,
                                          couple, run_coupling)
 from wave_client.coupling.transport import parse_url
 
 __all__ = ["CouplingCore", "CouplingError", "CouplingOptions", "CouplingReport", "CouplingTimeout",
-           "GaugeLog", "ServerError", "WindowRecord", "couple", "parse_url", "run_coupling"]
+           "GaugeLog", "ServerEnded", "ServerError", "WindowRecord", "couple", "parse_url", "run_coupling"]

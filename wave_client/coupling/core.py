@@ -41,6 +41,7 @@ import math
 import warnings
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import TypeVar
 
 import numpy as np
 
@@ -49,11 +50,16 @@ from protocol import (NO_SCENE_HASH, Bye, ClientSession, Error, ErrorCode, GetNo
 from wave_client.model import WaveModel
 
 CLIENT_NAME = "wavesph-couple/0.1"
+M = TypeVar("M", bound=Message)
 TIME_RTOL = 1e-9  # relative tolerance when matching the server's clock
 
 
 class CouplingError(RuntimeError):
     """The coupled run could not go on; the message says why and what to change."""
+
+
+class ServerEnded(CouplingError):
+    """The server said BYE before the client was done (run cancelled, server stopping)."""
 
 
 @dataclass(frozen=True)
@@ -152,7 +158,7 @@ class CouplingCore:
 
     def on_welcome(self, seq: int, msg: Message) -> bytes:
         """Check the offer against the model; the GETNODES frame to send."""
-        welcome = self.session.reply(seq, msg, expect=Welcome)
+        welcome = self._reply(seq, msg, Welcome)
         self.welcome = welcome
         if self.model is None:
             self.model = self._model_source(welcome)  # type: ignore[operator]
@@ -194,7 +200,7 @@ class CouplingCore:
 
     def on_nodes(self, seq: int, msg: Message) -> None:
         """Group the boundary nodes by side and column; pick the correction gauges."""
-        nodes = self.session.reply(seq, msg, expect=Nodes)
+        nodes = self._reply(seq, msg, Nodes)
         self.nodes = nodes
         for side in (Side.INLET, Side.OUTLET):
             idx = np.flatnonzero(nodes.side == side)
@@ -305,7 +311,7 @@ class CouplingCore:
         assert self.welcome is not None and self.nodes is not None and self.model is not None
         if self._pending is None:
             raise CouplingError("RESULT without a window in flight")
-        result = self.session.reply(seq, msg, expect=Result)
+        result = self._reply(seq, msg, Result)
         t0, t1, du_in, du_out = self._pending
         if abs(result.t - t1) > TIME_RTOL * max(1.0, abs(t1)):
             raise ProtocolError(ErrorCode.TIME_MISMATCH,
@@ -346,6 +352,11 @@ class CouplingCore:
                 except ValueError:
                     pass
             return out
+
+    def _reply(self, seq: int, msg: Message, expect: type[M]) -> M:
+        if isinstance(msg, Bye):
+            raise ServerEnded(f"the server ended the run: {msg.reason or '(no reason given)'}")
+        return self.session.reply(seq, msg, expect=expect)
 
     # --- ending ---------------------------------------------------------------------------
     def bye(self, reason: str = "done") -> bytes:

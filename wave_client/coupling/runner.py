@@ -24,7 +24,7 @@ from tqdm import tqdm
 
 from protocol import ErrorCode, ProtocolError, RemoteError, Welcome
 from wave_client.coupling.core import (CouplingCore, CouplingError, CouplingOptions, ModelSource,
-                                       WindowRecord)
+                                       ServerEnded, WindowRecord)
 from wave_client.coupling.transport import TransportClosed, open_transport, parse_url
 
 
@@ -168,6 +168,8 @@ async def run_coupling(url: str, model: ModelSource, options: CouplingOptions | 
                               "it is stuck or gone") from exc
     except TransportClosed as exc:
         raise CouplingError(f"connection lost at {stage}: {exc}") from exc
+    except ServerEnded as exc:
+        raise ServerEnded(f"{exc} (at {stage})") from exc
     except BaseException as exc:  # protocol violation, model failure, Ctrl-C: tell the server
         await _send_error(transport, core, exc)
         if isinstance(exc, ProtocolError):
