@@ -22,7 +22,7 @@ from protocol import (ErrorCode, FrameDecoder, Nodes, ProtocolError, Result, Sph
 from protocol.session import PeerError, Reply, SetWindow, SolveWindow, set_payload_size
 from wave_client import couple_cli
 from wave_client.coupling import (CouplingCore, CouplingError, CouplingOptions, CouplingTimeout,
-                                  ServerEnded, ServerError, run_coupling)
+                                  GaugeLog, ServerEnded, ServerError, parse_url, run_coupling)
 from wave_client.theories import AiryWave
 
 G, DEPTH = 9.81, 1.0
@@ -604,3 +604,23 @@ def test_core_error_frames_say_why_the_client_leaves():
     for exc, code, text in cases:
         seq, msg = decode_frame(core.error_frame(exc))
         assert seq == core.session.seq and msg.code == code and text in msg.text
+
+
+@pytest.mark.parametrize(
+    "url,message",
+    [("http://127.0.0.1:1/runs/a/couple", "ws://, wss:// or tcp://"),
+     ("tcp://127.0.0.1", "needs a port"), ("ws:///runs/a/couple", "no host")],
+)
+def test_bad_urls_are_refused_before_connecting(url, message):
+    with pytest.raises(ValueError, match=message):
+        parse_url(url)
+
+
+def test_url_gives_the_run_id():
+    assert parse_url("ws://h:8000/runs/r7/couple") == ("ws", "h", 8000, "r7")
+    assert parse_url("tcp://h:8766") == ("tcp", "h", 8766, "")
+
+
+def test_log_in_a_missing_directory_is_a_clear_error(tmp_path):
+    with pytest.raises(ValueError, match="log_path .*cannot create it"):
+        GaugeLog(tmp_path / "no" / "such" / "dir.csv", "header")

@@ -72,7 +72,10 @@ class GaugeLog:
         self.path = Path(path)
         if self.path.exists():
             raise ValueError(f"log_path {self.path} exists: refusing to overwrite a run's data")
-        self._f: TextIO = self.path.open("x", encoding="utf-8")
+        try:
+            self._f: TextIO = self.path.open("x", encoding="utf-8")
+        except OSError as exc:
+            raise ValueError(f"log_path {self.path}: cannot create it ({exc.strerror})") from exc
         for line in header.splitlines():
             self._f.write(f"# {line}\n")
         self._columns_written = False
