@@ -7,8 +7,9 @@
 
 On any failure the client sends an ERROR frame (when the connection still stands) and closes,
 then raises: `ServerError` (the server sent ERROR), `CouplingTimeout` (no reply in time),
-`CouplingError` (anything else, connection lost included). Every window is appended to the CSV
-log and flushed as it arrives, so a failed run keeps what it measured.
+`ServerEnded` (the server said BYE early), `CouplingError` (anything else, connection lost
+included); each carries ``.report``, the windows received so far. Every window is also appended
+to the CSV log and flushed as it arrives, so a failed run keeps what it measured.
 """
 
 from __future__ import annotations
@@ -164,19 +165,21 @@ async def run_coupling(url: str, model: ModelSource, options: CouplingOptions | 
         except (TimeoutError, TransportClosed, ProtocolError):
             pass  # the work is done and logged; a missing BYE echo loses nothing
     except RemoteError as exc:
-        raise ServerError(exc.code, exc.text) from exc
+        raise _keep(report, ServerError(exc.code, exc.text)) from exc
     except TimeoutError as exc:
         await _send_error(transport, core, TimeoutError(f"no reply within {timeout} s at {stage}"))
-        raise CouplingTimeout(f"the server did not answer within {timeout} s ({stage}); "
-                              "it is stuck or gone") from exc
+        raise _keep(report, CouplingTimeout(f"the server did not answer within {timeout} s "
+                                            f"({stage}); it is stuck or gone")) from exc
     except TransportClosed as exc:
-        raise CouplingError(f"connection lost at {stage}: {exc}") from exc
+        raise _keep(report, CouplingError(f"connection lost at {stage}: {exc}")) from exc
     except ServerEnded as exc:
-        raise ServerEnded(f"{exc} (at {stage})") from exc
+        raise _keep(report, ServerEnded(f"{exc} (at {stage})")) from exc
     except BaseException as exc:  # protocol violation, model failure, Ctrl-C: tell the server
         await _send_error(transport, core, exc)
         if isinstance(exc, ProtocolError):
-            raise CouplingError(f"bad reply from the server at {stage}: {exc}") from exc
+            raise _keep(report, CouplingError(f"bad reply from the server at {stage}: {exc}")) from exc
+        exc.add_note(f"wavesph couple: {len(report.records)} windows were received before this "
+                     f"({stage})" + (f"; they are in {log_path}" if log_path else ""))
         raise
     finally:
         report.wall_time = time.perf_counter() - start
@@ -186,6 +189,12 @@ async def run_coupling(url: str, model: ModelSource, options: CouplingOptions | 
             log.close()
         await _close_quietly(transport)
     return report
+
+
+def _keep(report: CouplingReport, err: CouplingError) -> CouplingError:
+    """Attach what was received so far: a failed run still hands back its windows."""
+    err.report = report  # type: ignore[attr-defined]
+    return err
 
 
 async def _send_error(transport, core: CouplingCore, exc: BaseException) -> None:
