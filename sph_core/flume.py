@@ -59,6 +59,12 @@ class OpenFlume(Simulation):
                              f"got {scene.constants.integrator!r}")
         if not (math.isfinite(window) and window > 0):
             raise ValueError(f"window: must be a positive number of seconds, got {window}")
+        cells = (scene.tank.x1 - scene.tank.x0) / scene.dp
+        if "right" in {o.side for o in scene.open_boundaries} and abs(cells - round(cells)) > 1e-6:
+            # the right buffer continues the fluid lattice laid out from x0: a partial spacing
+            # would leave a gap (or an overlap) of particles at the face
+            raise ValueError(f"tank.x1: x1 - x0 = {scene.tank.x1 - scene.tank.x0} m must be a whole "
+                             f"number of particle spacings dp = {scene.dp} m with a right open end")
         super().__init__(scene, run_dir=run_dir, spare=spare)
         self.window = float(window)
         self.open_sides = tuple(o.side for o in scene.open_boundaries)

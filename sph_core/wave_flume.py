@@ -1,0 +1,109 @@
+"""A numerical wave flume: open ends driven by a wave model, gauges mid-flume, results vs theory.
+
+    scene = wave_flume_scene(depth=0.3, wavelength=3.26, height=0.06, dp=0.01, t_end=10.0)
+    run = run_wave_flume(scene, model, window=T / 50)     # model: WaveModel duck type
+    run.eta["mid"], run.theory["mid"]                      # gauge records [m] vs the model
+
+The model is any object with the WaveModel duck type of ``wave_client`` (sph_core never imports
+it): the left face stands at the model's abscissa ``x_model_left``, the right face at
+``x_model_left + tank length``; both ends sample the same model. The theory at the gauges is
+read back from the model after the run, so the model must be analytic (it is rewound).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .boundary_data import WaveModelBoundary
+from .flume import OpenFlume, flume_nodes
+from .scene import Scene, make_scene
+
+# gauges of the reflection analysis: L/8 either side of mid-flume (spacing L/4)
+GAUGE_OFFSETS = {"mid": 0.0, "refl_a": -0.125, "refl_b": 0.125}
+
+
+def wave_flume_scene(*, depth: float, wavelength: float, height: float, dp: float, t_end: float,
+                     length: float | None = None, absorb: tuple[bool, bool] = (True, True),
+                     right_elevation: str = "extrapolated", probe_every: float = 0.02,
+                     c0: float | None = None, g: float = 9.81, name: str = "wave_flume",
+                     **constants: Any) -> Scene:
+    """A flat-bed flume [0, length] x [0, top] (floor z = 0, still water at z = depth) with open
+    ends and elevation gauges mid-flume and L/8 either side of it.
+
+    length defaults to one wavelength; the tank top leaves 2H + 4dp above still water. c0
+    defaults to 10 sqrt(g d): the shallow-water celerity bounds the orbital speeds, and the
+    hydrostatic density variation g d / c0^2 stays at 1 %."""
+    # whole number of particle spacings: the right buffer continues the fluid lattice
+    length = dp * round((wavelength if length is None else length) / dp)
+    top = depth + 2.0 * height + 4.0 * dp
+    mid = 0.5 * length
+    probes = [{"kind": "elevation", "name": nm, "x": mid + off * wavelength}
+              for nm, off in GAUGE_OFFSETS.items() if 0.0 < mid + off * wavelength < length]
+    cst = {"c0": c0 if c0 is not None else 10.0 * math.sqrt(g * depth), "g": g, **constants}
+    return make_scene({
+        "name": name, "dp": dp, "t_end": t_end, "still_water_level": depth,
+        "tank": {"x0": 0.0, "x1": length, "z0": 0.0, "z1": top},
+        "water_blocks": [{"x0": 0.0, "x1": length, "z0": 0.0, "z1": depth}],
+        "constants": cst, "output": {"probe_every": probe_every},
+        "probes": probes,
+        "open_boundaries": [
+            {"side": "left", "elevation": "imposed", "absorb": absorb[0]},
+            {"side": "right", "elevation": right_elevation, "absorb": absorb[1]}],
+    })
+
+
+@dataclass
+class FlumeRun:
+    """Records of one flume run: gauge x [m], times [s], measured and model elevation [m]."""
+
+    gauge_x: dict[str, float]
+    t: np.ndarray
+    eta: dict[str, np.ndarray]
+    theory: dict[str, np.ndarray]
+    wall_s: float
+    steps: int
+    particles: int
+    n_fluid: np.ndarray
+    counts: dict[str, dict[str, int]] = field(default_factory=dict)
+    flume: OpenFlume | None = None
+
+
+def run_wave_flume(scene: Scene, model: Any, *, window: float, x_model_left: float = 0.0,
+                   run_dir: str | Path | None = None, t_end: float | None = None,
+                   keep_flume: bool = False) -> FlumeRun:
+    """Run ``scene`` driven at both ends by ``model``; return gauge records and model values."""
+    nodes_x0 = scene.tank.x0
+    flume_probe = {p.name: p.x for p in scene.probes if p.kind == "elevation"}
+    nodes = flume_nodes(scene)
+    sources = {side: WaveModelBoundary(model, nd, scene.still_water_level,
+                                       x_model_left + (nd.x_face - nodes_x0))
+               for side, nd in nodes.items()}
+    flume = OpenFlume(scene, sources=sources, run_dir=run_dir, window=window)
+    t_end = scene.t_end if t_end is None else t_end
+    n_fluid = [(flume.t, flume.n_fluid)]
+    tic = time.perf_counter()
+    while flume.t < t_end - 1e-9 * window:
+        flume.advance_to(min(flume.t + 10 * window, t_end))
+        n_fluid.append((flume.t, flume.n_fluid))
+    wall = time.perf_counter() - tic
+    hist = flume.history
+    t = np.array([row["t"] for row in hist])
+    eta = {nm: np.array([np.nan if row[f"{nm}_eta"] is None else row[f"{nm}_eta"] for row in hist])
+           for nm in flume_probe}
+    theory = {nm: np.empty(t.size) for nm in flume_probe}
+    xm = np.array([x_model_left + (x - nodes_x0) for x in flume_probe.values()])
+    for k, tk in enumerate(t):
+        model.advance_to(float(tk))
+        vals = np.asarray(model.elevation(xm), dtype=float)
+        for j, nm in enumerate(flume_probe):
+            theory[nm][k] = vals[j]
+    run = FlumeRun(flume_probe, t, eta, theory, wall, flume.steps, flume.n_particles,
+                   np.array(n_fluid), flume.boundary_counts(), flume if keep_flume else None)
+    flume.close()
+    return run

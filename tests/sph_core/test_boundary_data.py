@@ -1,0 +1,103 @@
+"""Boundary-data sources: validation, the wave-model adapter's datum, pushed windows."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from sph_core.boundary_data import (BoundaryData, BoundaryDataError, BoundaryNodes,
+                                    BoundarySample, StillWater, WaveModelBoundary, WindowBoundary,
+                                    validate_sample)
+
+SWL = 0.5
+
+
+def nodes(n: int = 6) -> BoundaryNodes:
+    return BoundaryNodes("left", 0.0, np.linspace(0.0, 0.8, n), 0.0, 0.8, x_gauge=0.05)
+
+
+class LinearShallowModel:
+    """A WaveModel duck type with known values: eta = a x + b t, u = z (z from still water)."""
+
+    def __init__(self, depth: float = SWL) -> None:
+        self.t = 0.0
+        self.depth = depth
+
+    def advance_to(self, t: float) -> None:
+        self.t = t
+
+    def elevation(self, x):
+        return 0.01 * np.asarray(x, dtype=float) + 0.001 * self.t
+
+    def velocity(self, x, z):
+        z = np.asarray(z, dtype=float)
+        return z.copy(), np.full(z.shape, self.t)
+
+    def impose(self, x, eta, u_ref):
+        pass
+
+
+def test_nodes_reject_unordered_levels_and_bad_side():
+    with pytest.raises(BoundaryDataError, match="z: levels"):
+        BoundaryNodes("left", 0.0, np.array([0.0, 0.2, 0.1]), 0.0, 1.0)
+    with pytest.raises(BoundaryDataError, match="side"):
+        BoundaryNodes("top", 0.0, np.array([0.0, 0.1]), 0.0, 1.0)  # type: ignore[arg-type]
+    with pytest.raises(BoundaryDataError, match="within"):
+        BoundaryNodes("left", 0.0, np.array([0.0, 1.5]), 0.0, 1.0)
+
+
+@pytest.mark.parametrize("bad, match", [
+    (dict(u=np.array([0, 0, np.nan, 0, 0, 0.0])), r"left\.u: non-finite value nan at node 2"),
+    (dict(w=np.zeros(5)), r"left\.w: expected 6 values"),
+    (dict(eta=math.inf), r"left\.eta: must be finite"),
+    (dict(eta=0.4), r"left\.eta: surface z = 0\.9.* outside the tank"),
+    (dict(eta=-0.6), r"left\.eta: surface .* outside the tank"),
+    (dict(t=math.nan), r"left\.t: must be finite"),
+])
+def test_bad_samples_name_what_is_wrong(bad, match):
+    nd = nodes()
+    good = dict(t=1.0, u=np.zeros(6), w=np.zeros(6), eta=0.0)
+    with pytest.raises(BoundaryDataError, match=match):
+        validate_sample(BoundarySample(**{**good, **bad}), nd, SWL, where="left")
+
+
+def test_wave_model_adapter_converts_the_datum_and_reads_the_gauge():
+    nd = nodes()
+    src = WaveModelBoundary(LinearShallowModel(), nd, SWL, x_model=2.0)
+    assert isinstance(src, BoundaryData)
+    s = src.sample(3.0)
+    # u = z measured from still water: node z (absolute) minus the still-water level
+    np.testing.assert_allclose(s.u, nd.z - SWL)
+    np.testing.assert_allclose(s.w, 3.0)
+    assert s.eta == pytest.approx(0.01 * 2.0 + 0.003)
+    # the gauge stands 0.05 m inside the face: the model is read there too
+    assert s.gauge_eta == pytest.approx(0.01 * 2.05 + 0.003)
+
+
+def test_wave_model_adapter_refuses_a_depth_mismatch():
+    with pytest.raises(BoundaryDataError, match="model.depth"):
+        WaveModelBoundary(LinearShallowModel(depth=0.7), nodes(), SWL, x_model=0.0)
+
+
+def test_window_boundary_interpolates_between_pushed_samples_and_refuses_the_future():
+    nd = nodes()
+    src = WindowBoundary(nd, SWL)
+    src.push(BoundarySample(0.5, np.ones(6), np.full(6, 2.0), 0.1, 0.2))
+    mid = src.sample(0.25)
+    np.testing.assert_allclose(mid.u, 0.5)
+    np.testing.assert_allclose(mid.w, 1.0)
+    assert mid.eta == pytest.approx(0.05) and mid.gauge_eta == pytest.approx(0.1)
+    assert src.sample(0.5).eta == pytest.approx(0.1)
+    with pytest.raises(BoundaryDataError, match="no data for t = 0.6"):
+        src.sample(0.6)
+    with pytest.raises(BoundaryDataError, match="does not follow"):
+        src.push(BoundarySample(0.5, np.ones(6), np.ones(6), 0.0))
+    with pytest.raises(BoundaryDataError, match="left.u: non-finite"):
+        src.push(BoundarySample(0.7, np.full(6, np.nan), np.ones(6), 0.0))
+
+
+def test_still_water_source_is_at_rest():
+    s = StillWater(nodes()).sample(4.0)
+    assert s.t == 4.0 and s.eta == 0.0 and not s.u.any() and not s.w.any()
