@@ -38,13 +38,15 @@ def dispersion() -> None:
 
 
 def solitary() -> None:
-    r = solitary_run(0.1, depth=1.0, distance=50.0)
-    half = len(r["t"]) // 2
-    speed = float(np.polyfit(r["t"][half:], r["x"][half:], 1)[0])
-    emit(bench="boussinesq_solitary", H_over_d=0.1, distance_depths=50.0,
-         height_rel_error_max=float(np.max(np.abs(r["height"] / r["H"] - 1))),
-         height_rel_error_end=float(r["height"][-1] / r["H"] - 1),
-         speed_rel_error=speed / r["c"] - 1, c_reference=r["c"])
+    for profile in ("kdv", "nwogu"):
+        r = solitary_run(0.1, depth=1.0, distance=50.0, profile=profile)
+        half = len(r["t"]) // 2
+        speed = float(np.polyfit(r["t"][half:], r["x"][half:], 1)[0])
+        emit(bench="boussinesq_solitary", initial_profile=profile, H_over_d=0.1, distance_depths=50.0,
+             height_rel_error_max=float(np.max(np.abs(r["height"] / r["H"] - 1))),
+             height_rel_error_end=float(r["height"][-1] / r["H"] - 1),
+             speed_rel_error=speed / r["c"] - 1, c_reference=r["c"],
+             speed_rel_error_vs_profile=speed / r["c_profile"] - 1, c_profile=r["c_profile"])
 
 
 def throughput(nodes: int = 4000, steps: int = 2000, repeats: int = 5) -> None:

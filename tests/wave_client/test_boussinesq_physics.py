@@ -12,6 +12,8 @@ import pytest
 
 from wave_client.boussinesq import BoussinesqModel, airy_celerity, nwogu_celerity, nwogu_wavenumber
 from wave_client.boussinesq.checks import solitary_run, standing_wave_speed
+from wave_client.boussinesq.dispersion import alpha
+from wave_client.boussinesq.solitary import nwogu_solitary
 
 G = 9.81
 
@@ -69,6 +71,34 @@ def test_solitary_wave_keeps_height_and_speed():
     speed = np.polyfit(t[20:], xc[20:], 1)[0]
     assert speed == pytest.approx(r["c"], rel=0.01)
     assert abs(hc[-1] / hc[20] - 1) < 0.002
+
+
+def test_exact_nwogu_solitary_wave_is_steady():
+    """The model's own solitary wave (travelling-wave equations solved numerically, not the
+    scheme): over 50 depths the discrete model keeps its height within 0.1 % and moves at its
+    speed C within 0.1 %; C itself is within 1 % of sqrt(g (d + H))."""
+    r = solitary_run(0.1, depth=1.0, distance=50.0, profile="nwogu")
+    assert r["c_profile"] == pytest.approx(r["c"], rel=0.01)
+    assert np.all(np.abs(r["height"] / r["H"] - 1) < 1e-3)
+    speed = np.polyfit(r["t"], r["x"], 1)[0]
+    assert speed == pytest.approx(r["c_profile"], rel=1e-3)
+
+
+def test_exact_solitary_profile_solves_travelling_wave_equations():
+    """Residuals of the once-integrated mass and momentum equations (module docstring of
+    `solitary`) on the returned profile, by finite differences: small against the terms."""
+    d, height = 1.0, 0.2
+    c, shape = nwogu_solitary(height, d)
+    xi = np.linspace(-20, 20, 8001)
+    eta, u = shape(xi)
+    assert eta.max() == pytest.approx(height, rel=1e-9)
+    h = xi[1] - xi[0]
+    upp = np.gradient(np.gradient(u, h), h)
+    a = alpha()
+    mass = -c * eta + (d + eta) * u + (a + 1 / 3) * d**3 * upp
+    mom = -c * u + G * eta + 0.5 * u * u - a * d * d * c * upp
+    assert np.max(np.abs(mass[5:-5])) < 1e-5 * c * height
+    assert np.max(np.abs(mom[5:-5])) < 1e-5 * G * height
 
 
 def standing_wave_run(kd: float, ppw: int, n_steps: int) -> tuple[np.ndarray, np.ndarray]:

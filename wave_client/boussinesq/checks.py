@@ -10,6 +10,7 @@ import numpy as np
 from scipy.optimize import curve_fit
 
 from .dispersion import G, nwogu_celerity
+from .solitary import kdv_solitary, nwogu_solitary
 from .solver import BoussinesqModel
 
 
@@ -34,22 +35,28 @@ def standing_wave_speed(kd: float, depth: float, ppw: int = 32, courant: float =
 
 
 def solitary_run(height_ratio: float = 0.1, depth: float = 1.0, distance: float = 50.0,
-                 dx_ratio: float = 0.05, samples: int = 40) -> dict[str, np.ndarray | float]:
+                 dx_ratio: float = 0.05, samples: int = 40, profile: str = "kdv") -> dict[str, np.ndarray | float]:
     """A solitary wave over a flat bed, `distance` depths; crest tracked by a parabola through the
     three highest nodes.
 
-    Initial profile (KdV type): eta = H sech^2(sqrt(3H/(4d^3)) (x - x0)), u_alpha = c eta/(d + eta),
-    c = sqrt(g (d + H)). It is not the exact solitary wave of Nwogu's equations: the crest settles
-    within the first depths of travel and sheds a small dispersive tail. Returns the crest times
-    [s], positions [m], heights [m] and c.
+    profile="kdv": the KdV-type initial profile (`solitary.kdv_solitary`), not the exact solitary
+    wave of Nwogu's equations: the crest settles within the first depths of travel and sheds a
+    small dispersive tail. profile="nwogu": the model's exact solitary wave
+    (`solitary.nwogu_solitary`). Returns crest times [s], positions [m], heights [m], the
+    reference c = sqrt(g (d + H)) and the profile's own speed c_profile.
     """
     d, height = depth, height_ratio * depth
-    kappa = np.sqrt(3 * height / (4 * d**3))
     c = float(np.sqrt(G * (d + height)))
-    x0 = 15.0 * d
+    x0 = 20.0 * d
     m = BoussinesqModel(0.0, x0 + distance * d + 25.0 * d, dx_ratio * d, d)
-    eta = height / np.cosh(kappa * (m.x - x0)) ** 2
-    m.set_state(eta, c * eta / (d + eta))
+    if profile == "kdv":
+        eta, u, c_profile = kdv_solitary(m.x, height, d, x0)
+    elif profile == "nwogu":
+        c_profile, shape = nwogu_solitary(height, d)
+        eta, u = shape(m.x - x0)
+    else:
+        raise ValueError(f"profile must be 'kdv' or 'nwogu', got {profile!r}")
+    m.set_state(eta, u)
     t_end = distance * d / c
     rec = np.empty((samples, 3))
     for i in range(samples):
@@ -57,4 +64,5 @@ def solitary_run(height_ratio: float = 0.1, depth: float = 1.0, distance: float 
         j = int(np.argmax(m.eta_nodes))
         a2, a1, a0 = np.polyfit(m.x[j - 1:j + 2] - m.x[j], m.eta_nodes[j - 1:j + 2], 2)
         rec[i] = (m.t, m.x[j] - a1 / (2 * a2), a0 - a1 * a1 / (4 * a2))
-    return {"t": rec[:, 0], "x": rec[:, 1], "height": rec[:, 2], "c": c, "H": height, "d": d}
+    return {"t": rec[:, 0], "x": rec[:, 1], "height": rec[:, 2], "c": c, "c_profile": c_profile,
+            "H": height, "d": d}
