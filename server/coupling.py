@@ -50,11 +50,9 @@ def error_frame(code: ErrorCode, text: str, seq: int = 0) -> bytes:
 
 def welcome_for(run: Run, engine: CouplingEngine, idle_timeout: float) -> tuple[Welcome, Nodes]:
     s, nodes = engine.summary, engine.nodes()
-    opts = run.request.coupling
-    z_ref = s.z_ref if opts.z_ref is None else opts.z_ref
     welcome = Welcome(int(Capability.GOBACK), bytes.fromhex(run.info.scene_hash), g=s.g, depth=s.depth,
-                      still_water_level=s.still_water_level, z_ref=z_ref, t_start=s.t_start,
-                      t_end=s.t_end, dt_sph=s.dt_sph, window_max=opts.window_max,
+                      still_water_level=s.still_water_level, z_ref=s.z_ref, t_start=s.t_start,
+                      t_end=s.t_end, dt_sph=s.dt_sph, window_max=run.request.coupling.window_max,
                       idle_timeout=idle_timeout, n_nodes=nodes.x.size, n_gauges=nodes.gauge_x.size,
                       max_payload=0, run_id=run.info.id, server=SERVER_NAME)
     return welcome, Nodes(nodes.x, nodes.z, nodes.side, nodes.gauge_x)

@@ -3,10 +3,9 @@
 A coupled run drives an object with this interface. The doors (WebSocket, TCP) speak the
 protocol and call it from a worker thread, never on the event loop; per window they call
 ``checkpoint()`` (when the client may GOBACK), ``set_window(...)`` and ``solve_window()`` in one
-worker call. The adapter over
-sph_core's Simulation with open boundaries fills it once sph_core has open boundaries; until
-then the server refuses coupled runs unless an engine factory is given to ``create_app``
-(the tests give a deterministic double).
+worker call. The production engine is server/flume_engine.py (sph_core's OpenFlume); the tests
+of the doors use a deterministic double. ``solve_window`` raises protocol.ProtocolError
+(BAD_VALUE) for boundary data the solver cannot use, UnstableError when the run blows up.
 """
 
 from __future__ import annotations

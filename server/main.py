@@ -8,6 +8,7 @@ from contextlib import asynccontextmanager
 from fastapi import FastAPI
 
 from .engine import EngineFactory
+from .flume_engine import flume_engine
 from .routers import couple, runs
 from .runs import RunManager
 from .settings import Settings
@@ -16,9 +17,10 @@ from .tcp import start_tcp_server
 log = logging.getLogger("wavesph.server")
 
 
-def create_app(settings: Settings | None = None, engine_factory: EngineFactory | None = None) -> FastAPI:
-    """The app. ``engine_factory`` builds the SPH side of coupled runs (none yet: coupled runs
-    are refused until sph_core has open boundaries; tests pass a deterministic double)."""
+def create_app(settings: Settings | None = None,
+               engine_factory: EngineFactory = flume_engine) -> FastAPI:
+    """The app. ``engine_factory`` builds the SPH side of coupled runs: by default sph_core's
+    OpenFlume (server/flume_engine.py); tests of the doors pass a deterministic double."""
     settings = settings or Settings.from_env()
 
     @asynccontextmanager

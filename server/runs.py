@@ -57,7 +57,7 @@ class Run:
 
 
 class RunManager:
-    def __init__(self, settings: Settings, engine_factory: EngineFactory | None = None) -> None:
+    def __init__(self, settings: Settings, engine_factory: EngineFactory) -> None:
         self.settings = settings
         self.engine_factory = engine_factory
         self.store = RunStore(settings.runs_dir)
@@ -219,8 +219,6 @@ class RunManager:
         """Build the engine, then hold the slot until the client's session ends (see coupling.py)."""
         loop = asyncio.get_running_loop()
         try:
-            if self.engine_factory is None:
-                raise RuntimeError("no coupled engine in this build")
             run.engine = await loop.run_in_executor(self.executor, self.engine_factory,
                                                     run.request, run.dir)
             run.info.particles = run.engine.n_particles

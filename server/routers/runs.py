@@ -34,10 +34,13 @@ async def create_run(body: RunRequest, manager: Manager) -> RunInfo:
         raise _unprocessable(["body", "scene", "dp"],
                              f"the scene needs about {n:.3g} particles, the server's cap is {cap:.3g}: "
                              f"increase dp or shrink the tank and water blocks")
-    if body.mode == "coupled" and manager.engine_factory is None:
+    if body.mode == "coupled" and not body.scene.open_boundaries:
+        raise _unprocessable(["body", "scene", "open_boundaries"],
+                             "a coupled run needs at least one open end for the client to drive")
+    if body.mode == "standalone" and body.scene.open_boundaries:
         raise _unprocessable(["body", "mode"],
-                             "coupled runs need the open-boundary SPH engine, which this build of "
-                             "sph_core does not have yet; use mode 'standalone'")
+                             "standalone runs of scenes with open boundaries (a built-in wave "
+                             "source) are not available yet: use mode 'coupled' with a client")
     return manager.submit(body).info
 
 

@@ -66,6 +66,8 @@ class LiveServer:
         self.thread.join(timeout=20)
 
     def create(self, mode: str = "coupled", **scene_overrides) -> dict:
+        if mode == "coupled":
+            scene_overrides.setdefault("open_boundaries", [{"side": "left"}])
         r = self.http.post("/runs", json={"scene": scene(**scene_overrides), "mode": mode})
         assert r.status_code == 201, r.text
         return r.json()
@@ -84,7 +86,7 @@ class LiveServer:
 @contextmanager
 def live_server(tmp_path: Path, engine_factory=None, **settings):
     s = Settings(runs_dir=tmp_path / "runs", tcp_port=0, port=0, **settings)
-    app = create_app(s, engine_factory)
+    app = create_app(s) if engine_factory is None else create_app(s, engine_factory)
     with LiveServer(app, s) as srv:
         yield srv
 

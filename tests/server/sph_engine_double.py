@@ -28,7 +28,8 @@ class EngineDouble:
             b.z1 for b in scene.water_blocks)
         depth = swl - scene.tank.z0
         self.summary = SceneSummary(g=scene.constants.g, depth=depth, still_water_level=swl,
-                                    z_ref=-depth / 2, t_start=0.0, t_end=scene.t_end, dt_sph=dt_sph)
+                                    z_ref=request.coupling.z_ref if request.coupling.z_ref is not None
+                                    else -depth / 2, t_start=0.0, t_end=scene.t_end, dt_sph=dt_sph)
         n = max(int(round(depth / scene.dp)), 2)
         gauges = [p for p in scene.probes if p.kind == "elevation"]
         self._nodes = BoundaryNodes(np.full(n, scene.tank.x0), np.linspace(-depth, 0.0, n),

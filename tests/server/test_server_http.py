@@ -43,12 +43,13 @@ def test_unknown_request_field_and_bad_mode(srv):
     assert r.status_code == 422 and r.json()["detail"][0]["loc"] == ["body", "coupling", "window_max"]
 
 
-def test_coupled_runs_are_refused_without_a_coupled_engine(tmp_path):
-    with live_server(tmp_path) as srv:
-        r = srv.http.post("/runs", json={"scene": scene(), "mode": "coupled"})
-        assert r.status_code == 422
-        assert r.json()["detail"][0]["loc"] == ["body", "mode"]
-        assert "open-boundary" in r.json()["detail"][0]["msg"]
+def test_mode_and_open_boundaries_must_agree(srv):
+    r = srv.http.post("/runs", json={"scene": scene(), "mode": "coupled"})
+    assert r.status_code == 422
+    assert r.json()["detail"][0]["loc"] == ["body", "scene", "open_boundaries"]
+    r = srv.http.post("/runs", json={"scene": scene(open_boundaries=[{"side": "left"}]),
+                                     "mode": "standalone"})
+    assert r.status_code == 422 and r.json()["detail"][0]["loc"] == ["body", "mode"]
 
 
 def test_concurrency_cap_queues_runs(tmp_path, factory):

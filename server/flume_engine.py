@@ -1,0 +1,159 @@
+"""The coupled engine over sph_core's OpenFlume: what a coupling client actually drives.
+
+Protocol view of the flume (PROTOCOL.md):
+- nodes: every open end's z levels, the left end first; x = the end's face, z up from the
+  still-water level, side 0 = left end (the inlet), 1 = right end (the outlet).
+- SET u, w at the nodes become the end's velocity profile at t1; eta (equal at the nodes of one
+  end, which share their x) becomes the end's target elevation. The flume interpolates linearly
+  in time inside the window, from the values in force at t0 (seed 001, Algorithm 2).
+- gauges: each open end's boundary gauge (`left_boundary`, `right_boundary`, measured by the
+  flume at x_gauge) then the scene's elevation probes; u_ref, w_ref at z_ref below still water
+  at each gauge's x come from point probes the engine adds to its copy of the scene.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+
+from protocol import ErrorCode, ProtocolError
+from sph_core.boundary_data import BoundaryDataError, BoundarySample
+from sph_core.flume import SIDES, OpenFlume
+from sph_core.scene import PointProbe, Scene
+
+from .engine import BoundaryNodes, Measurement, SceneSummary
+from .schemas import RunRequest
+
+REF = "_ref"  # suffix of the point probes the engine adds at z_ref
+
+
+def ref_scene(scene: Scene, z_ref: float) -> tuple[Scene, list[str], list[float]]:
+    """The scene with a point probe at (gauge x, still water + z_ref) per gauge; gauge names, x."""
+    swl = float(scene.still_water_level)
+    t = scene.tank
+    names, xs = [], []
+    for o in scene.open_boundaries:
+        off = o.gauge_offset if o.gauge_offset is not None else 2.0 * scene.h
+        names.append(f"{o.side}_boundary")
+        xs.append(t.x0 + off if o.side == "left" else t.x1 - off)
+    for p in scene.probes:
+        if p.kind == "elevation":
+            names.append(p.name)
+            xs.append(p.x)
+    extra = [PointProbe(kind="point", name=f"{n}{REF}", x=x, z=swl + z_ref) for n, x in zip(names, xs)]
+    return scene.model_copy(update={"probes": [*scene.probes, *extra]}), names, xs
+
+
+class FlumeEngine:
+    """CouplingEngine (server/engine.py) of a scene with open boundaries."""
+
+    def __init__(self, request: RunRequest, run_dir: Path | None) -> None:
+        scene = request.scene
+        if not scene.open_boundaries:
+            raise ValueError("scene.open_boundaries: a coupled run needs at least one open end")
+        swl = float(scene.still_water_level)
+        depth = swl - scene.tank.z0
+        z_ref = request.coupling.z_ref if request.coupling.z_ref is not None else -0.5 * depth
+        if not -depth < z_ref <= 0:
+            raise ValueError(f"coupling.z_ref: {z_ref} m is not in the water column (-{depth}, 0]")
+        sim_scene, self.gauge_names, gauge_x = ref_scene(scene, z_ref)
+        self.flume = OpenFlume(sim_scene, run_dir=None if run_dir is None else Path(run_dir) / "sph",
+                               window=request.coupling.window_max)
+        f = self.flume
+        self.sides = [s for s in SIDES if s in f.open_sides]
+        self._slices: dict[str, slice] = {}
+        xs, zs, side_ids, k = [], [], [], 0
+        for s in self.sides:
+            nd = f.nodes[s]
+            self._slices[s] = slice(k, k + nd.size)
+            k += nd.size
+            xs.append(np.full(nd.size, nd.x_face))
+            zs.append(nd.z - swl)
+            side_ids.append(np.full(nd.size, SIDES.index(s), dtype=np.uint32))
+        self._nodes = BoundaryNodes(np.concatenate(xs), np.concatenate(zs), np.concatenate(side_ids),
+                                    np.array(gauge_x), list(self.gauge_names))
+        self.summary = SceneSummary(g=scene.constants.g, depth=depth, still_water_level=swl,
+                                    z_ref=z_ref, t_start=f.t, t_end=scene.t_end, dt_sph=f.dt)
+        self._window: tuple[float, float, dict[str, BoundarySample]] | None = None
+        self._saved = None
+        self._window_steps = 0
+
+    # -- clock and size --------------------------------------------------------------------
+    @property
+    def t(self) -> float:
+        return self.flume.t
+
+    @property
+    def steps(self) -> int:
+        return self.flume.steps
+
+    @property
+    def n_particles(self) -> int:
+        return self.flume.n_particles
+
+    # -- contract --------------------------------------------------------------------------
+    def nodes(self) -> BoundaryNodes:
+        return self._nodes
+
+    def set_window(self, t0: float, t1: float, u: np.ndarray, w: np.ndarray, eta: np.ndarray) -> None:
+        samples = {}
+        for s in self.sides:
+            sl = self._slices[s]
+            samples[s] = BoundarySample(t1, np.asarray(u[sl]), np.asarray(w[sl]),
+                                        float(np.mean(eta[sl])))
+        self._window = (t0, t1, samples)
+
+    def solve_window(self) -> Measurement:
+        if self._window is None:
+            raise RuntimeError("solve_window before set_window")
+        _, t1, samples = self._window
+        before = self.flume.steps
+        try:
+            self.flume.advance_window(t1, **samples)
+        except BoundaryDataError as exc:  # the client's data, not our failure
+            raise ProtocolError(ErrorCode.BAD_VALUE, f"SET: {exc}") from None
+        finally:
+            self._window = None
+        m = self.measure()
+        return Measurement(m.eta, m.wet, m.u_ref, m.w_ref, steps=self.flume.steps - before)
+
+    def measure(self) -> Measurement:
+        values = self.flume.probe_values()
+        boundary = self.flume.boundary_gauges()
+        n = len(self.gauge_names)
+        eta, u, w = np.zeros(n), np.zeros(n), np.zeros(n)
+        wet = np.zeros(n, dtype=bool)
+        for j, name in enumerate(self.gauge_names):
+            side = name.removesuffix("_boundary")
+            e = boundary.get(side) if name.endswith("_boundary") else values.get(f"{name}_eta")
+            uu, ww = values.get(f"{name}{REF}_u"), values.get(f"{name}{REF}_w")
+            if e is not None and math.isfinite(e):
+                wet[j], eta[j] = True, e
+                u[j] = uu if uu is not None else 0.0
+                w[j] = ww if ww is not None else 0.0
+        return Measurement(eta, wet, u, w)
+
+    def checkpoint(self) -> None:
+        self._saved = self.flume.checkpoint()
+
+    def goback(self) -> None:
+        if self._saved is None:
+            raise RuntimeError("goback without a checkpoint")
+        self.flume.restore(self._saved)
+        self._window = None
+
+    def stability(self) -> dict[str, float]:
+        f = self.flume
+        mass0 = f.fluid_mass0
+        return {"dt": f.dt, "v_max": f.v_max, "c0": f.c0, "mach": f.v_max / f.c0 if f.c0 else 0.0,
+                "fluid_mass_ratio": f.fluid_mass() / mass0 if mass0 else 1.0}
+
+    def close(self) -> None:
+        self.flume.close()
+
+
+def flume_engine(request: RunRequest, run_dir: Path) -> FlumeEngine:
+    """The server's default engine factory for coupled runs."""
+    return FlumeEngine(request, run_dir)

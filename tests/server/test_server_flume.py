@@ -1,0 +1,93 @@
+"""The production coupled engine (sph_core's OpenFlume) behind the real server doors.
+
+The server must be transparent: a flume driven over TCP gives exactly the gauge readings of the
+same flume driven in-process with the same boundary data. The wave data are linear (Airy)
+theory, computed here; the physics of the open boundaries is sph_core's to validate.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.optimize import brentq
+
+from protocol import Result, Set, Solve
+from server.flume_engine import FlumeEngine
+from server.main import create_app  # noqa: F401  (default engine factory: the flume)
+from server.schemas import RunRequest
+
+from conftest import live_server
+from coupling_client import TcpClient, bye, handshake
+
+G, DEPTH, H, T, WINDOW = 9.81, 0.3, 0.02, 1.0, 0.05
+FLUME = {"name": "flume", "dp": 0.04, "t_end": 1.0, "still_water_level": DEPTH,
+         "tank": {"x0": 0.0, "x1": 1.2, "z0": 0.0, "z1": 0.45},
+         "water_blocks": [{"x0": 0.0, "x1": 1.2, "z0": 0.0, "z1": DEPTH}],
+         "open_boundaries": [{"side": "left", "elevation": "imposed", "absorb": True},
+                             {"side": "right", "elevation": "extrapolated", "absorb": True}],
+         "probes": [{"kind": "elevation", "name": "g1", "x": 0.6}],
+         "output": {"probe_every": 0.05}}
+
+
+def airy(x: np.ndarray, z: np.ndarray, t: float):
+    """Linear wave at nodes (z up from still water; no extrapolation above it)."""
+    omega = 2 * np.pi / T
+    k = brentq(lambda k: omega**2 - G * k * np.tanh(k * DEPTH), 1e-6, 100.0, xtol=1e-15)
+    a, phase, zc = H / 2, k * x - omega * t, np.minimum(z, 0.0)
+    u = a * omega * np.cosh(k * (zc + DEPTH)) / np.sinh(k * DEPTH) * np.cos(phase)
+    w = a * omega * np.sinh(k * (zc + DEPTH)) / np.sinh(k * DEPTH) * np.sin(phase)
+    return u, w, a * np.cos(phase)
+
+
+def test_flume_over_tcp_equals_the_flume_in_process(tmp_path):
+    body = {"scene": FLUME, "mode": "coupled", "coupling": {"window_max": WINDOW}}
+    sent, got = [], []
+    with live_server(tmp_path) as srv:
+        r = srv.http.post("/runs", json=body)
+        assert r.status_code == 201, r.text
+        run = r.json()
+        srv.wait_state(run["id"], "waiting_for_client", timeout=120)
+        c = TcpClient(srv.tcp_port, timeout=120)
+        welcome, nodes = handshake(c, run["id"], scene_hash=bytes.fromhex(run["scene_hash"]))
+        assert welcome.depth == pytest.approx(DEPTH) and welcome.z_ref == pytest.approx(-DEPTH / 2)
+        assert sorted(set(nodes.side.tolist())) == [0, 1] and nodes.gauge_x.size == 3
+        assert nodes.x[nodes.side == 0].max() == 0.0 and nodes.x[nodes.side == 1].min() == 1.2
+        t = 0.0
+        for _ in range(4):
+            u, w, eta = airy(nodes.x, nodes.z, t + WINDOW)
+            sent.append((t, t + WINDOW, u, w, eta))
+            got.append(c.request(Set(t, t + WINDOW, u, w, eta), Solve(), expect=Result))
+            t += WINDOW
+        bye(c)
+        info = srv.wait_state(run["id"], "finished")
+        rows = srv.http.get(f"/runs/{run['id']}/gauges", params={"format": "json"}).json()
+    assert info["windows"] == 4 and info["steps"] > 4 and info["particles"] > 300
+    assert info["stability"]["fluid_mass_ratio"] > 0.9
+    assert rows["columns"][2:5] == ["left_boundary_eta", "left_boundary_u_ref", "left_boundary_w_ref"]
+    assert all(r.wet[0] == 1 for r in got)  # the inlet gauge is in the water
+    # the same flume, in this process, with the same boundary data
+    engine = FlumeEngine(RunRequest.model_validate(body), None)
+    for (t0, t1, u, w, eta), res in zip(sent, got):
+        engine.set_window(t0, t1, u, w, eta)
+        m = engine.solve_window()
+        assert res.steps == m.steps and res.t == pytest.approx(engine.t, abs=1e-12)
+        np.testing.assert_allclose(res.eta, np.where(m.wet, m.eta, 0.0), rtol=1e-12, atol=1e-15)
+        np.testing.assert_allclose(res.u_ref, np.where(m.wet, m.u_ref, 0.0), rtol=1e-12, atol=1e-15)
+    engine.close()
+
+
+def test_flume_refuses_boundary_data_outside_the_tank(tmp_path):
+    body = {"scene": FLUME, "mode": "coupled", "coupling": {"window_max": WINDOW}}
+    with live_server(tmp_path) as srv:
+        run = srv.http.post("/runs", json=body).json()
+        srv.wait_state(run["id"], "waiting_for_client", timeout=120)
+        c = TcpClient(srv.tcp_port, timeout=120)
+        welcome, nodes = handshake(c, run["id"])
+        n = welcome.n_nodes
+        c.request(Set(0.0, WINDOW, np.zeros(n), np.zeros(n), np.full(n, 5.0)), Solve())
+        from protocol import ErrorCode, RemoteError
+        with pytest.raises(RemoteError, match="outside the tank") as exc:
+            c.session.reply(*c.recv(), expect=Result)
+        assert exc.value.code is ErrorCode.BAD_VALUE
+        info = srv.wait_state(run["id"], "failed")
+        assert "outside the tank" in info["status"]
