@@ -12,7 +12,8 @@ import pytest
 
 from wave_client.boussinesq import BoussinesqModel, airy_celerity, nwogu_celerity, nwogu_wavenumber
 from wave_client.boussinesq.checks import solitary_run, standing_wave_speed
-from wave_client.boussinesq.dispersion import alpha
+from wave_client.boussinesq import kernels as K
+from wave_client.boussinesq.dispersion import airy_wavenumber, alpha
 from wave_client.boussinesq.solitary import nwogu_solitary
 
 G = 9.81
@@ -140,3 +141,62 @@ def test_convergence_order_space_and_time():
     ref, _ = standing_wave_run(1.0, 40, 16 * n1)
     et = [np.max(np.abs(standing_wave_run(1.0, 40, r * n1)[0] - ref)) for r in (1, 2)]
     assert np.log2(et[0] / et[1]) > 3.7, et
+
+
+def test_linear_shoaling_on_a_mild_slope():
+    """Small regular waves (T = 2 s) shoal up a 1:30 slope from 0.6 m to 0.2 m depth: the
+    amplitude ratio equals the linear shoaling coefficient sqrt(cg_deep / cg_shallow) of Airy
+    theory within 1 % (energy-flux conservation; tests the variable-depth terms)."""
+    period, d0, d1 = 2.0, 0.6, 0.2
+    omega = 2 * np.pi / period
+    wl0 = 2 * np.pi / float(nwogu_wavenumber(omega, d0))
+    wl1 = 2 * np.pi / float(nwogu_wavenumber(omega, d1))
+    m = BoussinesqModel(-3 * wl0, 22 + 4 * wl1, wl1 / 40, ([5.0, 17.0], [d0, d1]),
+                        sponge_left=1.5 * wl0, sponge_right=1.5 * wl1)
+    m.set_regular_wave(0.0, 0.002, period, ramp_periods=2)
+    xg = np.array([2.0, 3.0, 20.0, 21.0, 22.0])
+    m.advance_to(30 * period)
+    n = int(round(10 * period / m.dt / 4))
+    ts, es = np.empty(n), np.empty((n, xg.size))
+    for i in range(n):
+        m.advance_steps(4)
+        ts[i], es[i] = m.t, m.elevation(xg)
+    amps = np.array([fit_harmonic(ts, es[:, j], omega)[0] for j in range(xg.size)])
+    ratio = amps[2:].mean() / amps[:2].mean()
+
+    def group_velocity(d: float) -> float:
+        dw = 1e-6 * omega
+        return 2 * dw / float(airy_wavenumber(omega + dw, d) - airy_wavenumber(omega - dw, d))
+
+    assert ratio == pytest.approx(np.sqrt(group_velocity(d0) / group_velocity(d1)), rel=0.01)
+
+
+def test_shapiro_filter_removes_grid_noise_only():
+    """The 4th-order Shapiro filter removes the 2dx mode and changes a 40-points-per-wavelength
+    wave by (k dx)^4 / 16 at most (here 2.4e-4)."""
+    n = 200
+    x = np.arange(n + 2 * K.NG) - K.NG
+    smooth = np.cos(2 * np.pi * x / 40)
+    noisy = smooth + 0.01 * (-1.0) ** x
+    work = np.zeros_like(noisy)
+    K.shapiro_filter(noisy, work, n + K.NG)
+    inner = slice(K.NG, n + K.NG)
+    assert np.max(np.abs(noisy[inner] - smooth[inner])) < 2.5e-4
+    assert np.max(np.abs(noisy[inner] - smooth[inner])) > 1e-5  # it does act on the wave a little
+
+
+def test_filtered_run_keeps_generated_amplitude():
+    """With the filter every 10 steps, regular waves keep their target amplitude within 1 %."""
+    depth, period, height = 0.5, 2.0, 0.002
+    omega = 2 * np.pi / period
+    wl = 2 * np.pi / float(nwogu_wavenumber(omega, depth))
+    m = BoussinesqModel(-3 * wl, 6 * wl, wl / 40, depth, sponge_left=1.5 * wl, sponge_right=1.5 * wl,
+                        filter_every=10)
+    m.set_regular_wave(0.0, height, period, ramp_periods=2)
+    m.advance_to(15 * period)
+    n = int(round(10 * period / m.dt / 4))
+    ts, es = np.empty(n), np.empty(n)
+    for i in range(n):
+        m.advance_steps(4)
+        ts[i], es[i] = m.t, m.elevation(3 * wl)
+    assert fit_harmonic(ts, es, omega)[0] == pytest.approx(height / 2, rel=0.01)
