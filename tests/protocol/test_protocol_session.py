@@ -4,10 +4,13 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 
 from protocol import (Bye, Capability, ClientSession, Error, ErrorCode, Get, GetNodes, GoBack, Hello,
                       Nodes, ProtocolError, RemoteError, Result, Set, Solve, SphSession, Welcome,
                       decode_frame, scene_hash)
+from protocol_strategies import messages
 from protocol.session import Measure, PeerError, Reply, Restore, SetWindow, SolveWindow, State
 
 HASH = scene_hash(b'{"scene": 1}')
@@ -199,3 +202,27 @@ def test_get_is_allowed_any_time_after_hello_and_does_not_move_the_clock():
     action = peer.send(Get())
     assert isinstance(action, Measure)
     assert peer.expect(s.result(action, result(t=99.0)), Result).t == 0.0
+
+
+_windows = st.builds(window, st.sampled_from([0.0, 0.05, 0.1, 0.3]), st.sampled_from([0.05, 0.1, 0.2]))
+
+
+@given(st.lists(st.tuples(st.one_of(st.none(), st.integers(0, 12)),
+                          st.one_of(messages, _windows, st.sampled_from([Hello(1), Solve(), GoBack()]))),
+                max_size=12))
+def test_any_message_sequence_gives_actions_or_protocol_errors(seq_msgs):
+    """Whatever a client sends, in any order with any seq (None: the right one), the session
+    answers with an action or a ProtocolError -- never another exception -- and stays closed."""
+    s = make_session()
+    for i, (seq, msg) in enumerate(seq_msgs):
+        seq = i + 1 if seq is None else seq
+        try:
+            action = s.receive(seq, msg)
+        except ProtocolError:
+            s.error_frame(ProtocolError(ErrorCode.OUT_OF_ORDER, "x"))
+            assert s.state is State.CLOSED
+            break
+        if isinstance(action, (SolveWindow, Measure, Restore)):
+            decode_frame(s.result(action, result()))
+        elif isinstance(action, Reply):
+            decode_frame(action.data)
