@@ -41,6 +41,8 @@ class BoussinesqUnstableError(RuntimeError):
 @dataclass
 class _Checkpoint:
     step: int
+    t: float
+    dt: float
     n_hist: int
     arrays: tuple[np.ndarray, ...]
     pins: dict[int, tuple[float, float]]
@@ -84,11 +86,13 @@ class BoussinesqModel:
         Still-water depth h [m]: a constant, or (x_points, depth_points) of a piecewise-linear
         profile (held constant beyond the end points). Must be > 0 everywhere (no dry land).
     dt:
-        Time step [s]; default courant * dx / sqrt(g h_max).
+        Largest time step [s] (default courant * dx / sqrt(g h_max)); `advance_to` may use a
+        slightly shorter one so that windows end exactly on their times.
     sponge_left, sponge_right:
         Widths [m] of the sponge layers at the ends (0: a reflective wall).
     sponge_damping:
-        Peak damping rate of the sponges [1/s]; default 2 sqrt(g / h_max) / ... see `_default_damping`.
+        Peak damping rate of the sponges [1/s]; default 1.5 * 2 pi sqrt(g h_max) / width
+        (`_default_damping`).
     filter_every:
         Apply the Shapiro filter to eta and u every this many steps (0: never).
     tol, max_iter:
@@ -126,9 +130,10 @@ class BoussinesqModel:
             raise ValueError("bathymetry: depth must be > 0 on the whole grid (no dry land)")
         self.h_nodes = h
         h_max = float(h.max())
-        self.dt = float(dt) if dt is not None else courant * self.dx / math.sqrt(g * h_max)
-        if not self.dt > 0:
-            raise ValueError(f"dt must be > 0, got {self.dt}")
+        self.dt_max = float(dt) if dt is not None else courant * self.dx / math.sqrt(g * h_max)
+        if not self.dt_max > 0:
+            raise ValueError(f"dt must be > 0, got {self.dt_max}")
+        self.dt = self.dt_max  # the step in use; advance_to may shorten it to end exactly on t
         self.filter_every = int(filter_every)
         self.tol, self.max_iter = float(tol), int(max_iter)
         self.two_way = bool(two_way)
@@ -160,6 +165,7 @@ class BoussinesqModel:
         self._scratch = [z() for _ in range(9)]
         self._stats = np.zeros(3)
         self._step = 0
+        self._t = 0.0
         self._n_hist = 0
         self._pins: dict[int, tuple[float, float]] = {}  # coupling-boundary node -> (eta, u_alpha)
         self._pin_idx, self._pin_eta, self._pin_u = np.zeros(0, np.int64), np.zeros(0), np.zeros(0)
@@ -175,8 +181,8 @@ class BoussinesqModel:
 
     @property
     def t(self) -> float:
-        """Model time [s] (a whole number of steps)."""
-        return self._step * self.dt
+        """Model time [s]."""
+        return self._t
 
     def depth_at(self, x: ArrayLike) -> np.ndarray:
         """Still-water depth h(x) [m] of the piecewise-linear bathymetry."""
@@ -294,17 +300,28 @@ class BoussinesqModel:
             s[0], s[1], s[2], s[3], s[4], s[5], s[6], s[7], s[8], self._stats)
         if res < 0:
             self._step += -res
+            self._t += -res * self.dt
             raise BoussinesqUnstableError(self._step, self.t, "non-finite elevation or velocity")
         self._step += n_steps
+        self._t += n_steps * self.dt
         self._n_hist = res
 
     def advance_to(self, t: float, progress: bool = False) -> None:
-        """Advance to the step nearest to t [s] (the step dt is fixed: choose coupling windows
-        that are multiples of `dt` for exact window ends)."""
-        target = int(round(t / self.dt))
-        todo = target - self._step
-        if todo <= 0:
+        """Advance to exactly time t [s].
+
+        If the interval to t is not a whole number of steps, the step becomes interval/n with
+        n = ceil(interval / dt_max) and the multistep history restarts (RK4 start); with
+        equal coupling windows this happens once, at the first window.
+        """
+        interval = float(t) - self._t
+        if interval <= 1e-9 * self.dt:
             return
+        n = int(round(interval / self.dt))
+        if n < 1 or abs(n * self.dt - interval) > 1e-9 * self.dt:
+            n = max(1, math.ceil(interval / self.dt_max * (1 - 1e-12)))
+            self.dt = interval / n
+            self._refresh_rhs()
+        todo = n
         chunk = max(1, min(todo, 2000))
         with tqdm(total=todo, disable=not progress, unit="step", desc="boussinesq") as bar:
             while todo > 0:
@@ -312,6 +329,7 @@ class BoussinesqModel:
                 self.advance_steps(m)
                 todo -= m
                 bar.update(m)
+        self._t = float(t)  # no round-off drift across windows
 
     @property
     def corrector_stats(self) -> dict[str, float]:
@@ -335,6 +353,14 @@ class BoussinesqModel:
         """Cubic Lagrange interpolation of a padded nodal field at positions x."""
         if np.any((x < self.x0 - 1e-9 * self.dx) | (x > self.x1 + 1e-9 * self.dx)):
             raise ValueError(f"x outside the model grid [{self.x0}, {self.x1}]")
+        if self._pin_idx.size:
+            x_b = self.x0 + self._pin_idx[-1] * self.dx
+            if np.any(x >= x_b - 1e-9 * self.dx):
+                raise ValueError(
+                    f"x = {np.max(x):.6g} m is at or beyond the two-way coupling boundary x_b = {x_b:.6g} m "
+                    "set by impose(): there the model only holds the SPH values it was given. Impose SPH "
+                    "readings downstream of the points where the model drives SPH (an overlap, seed 001 "
+                    "Alg. 2), or use the absorption-only mode (two_way=False)")
         r = (x - self.x0) / self.dx
         j = np.clip(np.floor(r).astype(int), 0, self.n_nodes - 2)
         w = _lagrange_weights(r - j)
@@ -416,7 +442,7 @@ class BoussinesqModel:
         """An exact copy of the state, for the protocol's `goback`."""
         arrays = (self._eta.copy(), self._u.copy(), self._uu.copy(), self._e_hist.copy(),
                   self._f_hist.copy(), self._stats.copy())
-        return _Checkpoint(self._step, self._n_hist, arrays, dict(self._pins))
+        return _Checkpoint(self._step, self._t, self.dt, self._n_hist, arrays, dict(self._pins))
 
     def restore(self, cp: _Checkpoint) -> None:
         """Return to a state saved by `checkpoint`."""
@@ -425,5 +451,5 @@ class BoussinesqModel:
         self._sync_pins(refactor)
         for dst, src in zip((self._eta, self._u, self._uu, self._e_hist, self._f_hist, self._stats), cp.arrays):
             dst[...] = src
-        self._step, self._n_hist = cp.step, cp.n_hist
+        self._step, self._t, self.dt, self._n_hist = cp.step, cp.t, cp.dt, cp.n_hist
 
