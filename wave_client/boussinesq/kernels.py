@@ -79,12 +79,21 @@ def rhs(eta: np.ndarray, u: np.ndarray, h: np.ndarray, coef_a: np.ndarray, coef_
 
 
 @njit(cache=True)
-def apply_pins(eta: np.ndarray, uu: np.ndarray, pin_idx: np.ndarray, pin_eta: np.ndarray,
-               pin_u: np.ndarray) -> None:
-    """Hold eta and U (= u: identity row of M) at the coupling-boundary node, if any."""
+def apply_pins(eta: np.ndarray, uu: np.ndarray, pin_idx: np.ndarray, pin_in: np.ndarray,
+               pin_ratio: np.ndarray) -> None:
+    """Characteristic coupling boundary at node b (two-way coupling, seed 001 Alg. 2 line 4).
+
+    Of the state just computed at b, keep the model's outgoing (right-going) part
+    R = (eta + u / r) / 2 and replace the incoming (left-going) part by the one SPH measured,
+    L = (eta_sph - u_sph / r) / 2:  eta_b = R + L,  u_b = r (R - L).  r = u/eta of a progressive
+    wave (linear Nwogu, at the wave's frequency). U = u at b (identity row of M).
+    """
     for p in range(pin_idx.size):
-        eta[pin_idx[p] + NG] = pin_eta[p]
-        uu[pin_idx[p] + NG] = pin_u[p]
+        b = pin_idx[p] + NG
+        r = pin_ratio[p]
+        right = 0.5 * (eta[b] + uu[b] / r)
+        eta[b] = right + pin_in[p]
+        uu[b] = r * (right - pin_in[p])
 
 
 @njit(cache=True)
@@ -169,7 +178,7 @@ def rk4_step(t0: float, dt: float, eta: np.ndarray, u: np.ndarray, uu: np.ndarra
              e0: np.ndarray, f0: np.ndarray, h: np.ndarray, coef_a: np.ndarray, coef_b: np.ndarray,
              lower: np.ndarray, cprime: np.ndarray, minv: np.ndarray, sponge: np.ndarray,
              src_shape: np.ndarray, src_amp: np.ndarray, src_omega: np.ndarray, src_phase: np.ndarray,
-             src_ramp: float, g: float, dx: float, pin_idx: np.ndarray, pin_eta: np.ndarray, pin_u: np.ndarray,
+             src_ramp: float, g: float, dx: float, pin_idx: np.ndarray, pin_in: np.ndarray, pin_ratio: np.ndarray,
              eta_s: np.ndarray, u_s: np.ndarray, uu_s: np.ndarray, ke: np.ndarray, kf: np.ndarray,
              acc_e: np.ndarray, acc_f: np.ndarray, work_q: np.ndarray, work_d: np.ndarray) -> None:
     """One classical Runge-Kutta step of (eta, U) from t0; starts the multistep history.
@@ -188,7 +197,7 @@ def rk4_step(t0: float, dt: float, eta: np.ndarray, u: np.ndarray, uu: np.ndarra
         for i in range(NG, n - NG):
             eta_s[i] = eta[i] + frac * dt * ke[i]
             uu_s[i] = uu[i] + frac * dt * kf[i]
-        apply_pins(eta_s, uu_s, pin_idx, pin_eta, pin_u)
+        apply_pins(eta_s, uu_s, pin_idx, pin_in, pin_ratio)
         thomas_solve(lower, cprime, minv, uu_s, u_s, NG)
         fill_ghosts(eta_s, u_s)
         close_boundary(eta_s, u_s, uu_s, pin_idx)
@@ -201,7 +210,7 @@ def rk4_step(t0: float, dt: float, eta: np.ndarray, u: np.ndarray, uu: np.ndarra
     for i in range(NG, n - NG):
         eta[i] += dt / 6.0 * acc_e[i]
         uu[i] += dt / 6.0 * acc_f[i]
-    apply_pins(eta, uu, pin_idx, pin_eta, pin_u)
+    apply_pins(eta, uu, pin_idx, pin_in, pin_ratio)
     thomas_solve(lower, cprime, minv, uu, u, NG)
     fill_ghosts(eta, u)
     close_boundary(eta, u, uu, pin_idx)
@@ -216,7 +225,7 @@ def advance_steps(n_steps: int, t0: float, dt: float, n_hist: int, tol: float, m
                   cprime: np.ndarray, minv: np.ndarray,
                   sponge: np.ndarray, src_shape: np.ndarray, src_amp: np.ndarray, src_omega: np.ndarray,
                   src_phase: np.ndarray, src_ramp: float, g: float, dx: float,
-                  pin_idx: np.ndarray, pin_eta: np.ndarray, pin_u: np.ndarray,
+                  pin_idx: np.ndarray, pin_in: np.ndarray, pin_ratio: np.ndarray,
                   eta_new: np.ndarray, u_new: np.ndarray, uu_new: np.ndarray,
                   e_new: np.ndarray, f_new: np.ndarray,
                   eta_prev: np.ndarray, u_prev: np.ndarray,
@@ -230,7 +239,8 @@ def advance_steps(n_steps: int, t0: float, dt: float, n_hist: int, tol: float, m
     three levels (start, or after the state was set), classical RK4 steps fill it.
 
     e_hist, f_hist: (3, n) with rows R^n, R^{n-1}, R^{n-2}, filled for the first n_hist rows.
-    pin_idx, pin_eta, pin_u: the coupling-boundary node (empty, or one node) and its held eta, u.
+    pin_idx, pin_in, pin_ratio: the coupling-boundary node (empty, or one), the incoming
+    characteristic L measured by SPH and u/eta ratio r (`apply_pins`).
     stats: [corrector iterations summed, max iterations of one step, non-converged steps].
     Returns the new history length.
     """
@@ -243,7 +253,7 @@ def advance_steps(n_steps: int, t0: float, dt: float, n_hist: int, tol: float, m
             # start (or restart) the history with 4th-order Runge-Kutta steps
             rk4_step(t1 - dt, dt, eta, u, uu, e_hist[0], f_hist[0], h, coef_a, coef_b, lower, cprime,
                      minv, sponge, src_shape, src_amp, src_omega, src_phase, src_ramp, g, dx,
-                     pin_idx, pin_eta, pin_u, eta_new, u_new, uu_new, e_new, f_new, eta_prev, u_prev,
+                     pin_idx, pin_in, pin_ratio, eta_new, u_new, uu_new, e_new, f_new, eta_prev, u_prev,
                      work_q, work_d)
             src = source_signal(t1, src_amp, src_omega, src_phase, src_ramp)
             rhs(eta, u, h, coef_a, coef_b, sponge, src_shape, src, g, dx,
@@ -263,7 +273,7 @@ def advance_steps(n_steps: int, t0: float, dt: float, n_hist: int, tol: float, m
         for i in range(NG, n - NG):
             eta_new[i] = eta[i] + dt * (p0 * e_hist[0, i] + p1 * e_hist[1, i] + p2 * e_hist[2, i])
             uu_new[i] = uu[i] + dt * (p0 * f_hist[0, i] + p1 * f_hist[1, i] + p2 * f_hist[2, i])
-        apply_pins(eta_new, uu_new, pin_idx, pin_eta, pin_u)
+        apply_pins(eta_new, uu_new, pin_idx, pin_in, pin_ratio)
         thomas_solve(lower, cprime, minv, uu_new, u_new, NG)
         fill_ghosts(eta_new, u_new)
         close_boundary(eta_new, u_new, uu_new, pin_idx)
@@ -281,7 +291,7 @@ def advance_steps(n_steps: int, t0: float, dt: float, n_hist: int, tol: float, m
                                             + c2 * e_hist[2, i])
                 uu_new[i] = uu[i] + dt * (c_new * f_new[i] + c0 * f_hist[0, i] + c1 * f_hist[1, i]
                                           + c2 * f_hist[2, i])
-            apply_pins(eta_new, uu_new, pin_idx, pin_eta, pin_u)
+            apply_pins(eta_new, uu_new, pin_idx, pin_in, pin_ratio)
             thomas_solve(lower, cprime, minv, uu_new, u_new, NG)
             fill_ghosts(eta_new, u_new)
             close_boundary(eta_new, u_new, uu_new, pin_idx)
@@ -320,7 +330,7 @@ def advance_steps(n_steps: int, t0: float, dt: float, n_hist: int, tol: float, m
         if filter_every > 0 and (step0 + step + 1) % filter_every == 0:
             shapiro_filter(eta, work_q, n - NG)
             shapiro_filter(u, work_q, n - NG)
-            apply_pins(eta, u, pin_idx, pin_eta, pin_u)
+            apply_pins(eta, u, pin_idx, pin_in, pin_ratio)
             fill_ghosts(eta, u)
             close_boundary(eta, u, uu, pin_idx)
             apply_operator(lower, diag, upper, u, uu, NG)

@@ -167,8 +167,9 @@ class BoussinesqModel:
         self._step = 0
         self._t = 0.0
         self._n_hist = 0
-        self._pins: dict[int, tuple[float, float]] = {}  # coupling-boundary node -> (eta, u_alpha)
-        self._pin_idx, self._pin_eta, self._pin_u = np.zeros(0, np.int64), np.zeros(0), np.zeros(0)
+        self._pins: dict[int, tuple[float, float]] = {}  # coupling-boundary node -> (L, r)
+        self._pin_idx, self._pin_in, self._pin_ratio = np.zeros(0, np.int64), np.zeros(0), np.zeros(0)
+        self.coupling_omega: float | None = None  # frequency of the u/eta split at the boundary
         self._lower, self._diag, self._upper = np.zeros(nm), np.zeros(nm), np.zeros(nm)
         self._cprime, self._minv = np.zeros(nm), np.zeros(nm)
         self._factor()
@@ -262,6 +263,7 @@ class BoussinesqModel:
         omega = 2.0 * math.pi / period
         wl = 2.0 * math.pi / self._k(omega, x_s)
         d = self._check_source_site(x_s, wl, delta)
+        self.coupling_omega = omega
         self.set_source(make_source(self.x, x_s, d, np.array([height / 2]), np.array([omega]),
                                     np.array([phase]), wl, delta, ramp_periods * period,
                                     self.beta, self.g))
@@ -279,6 +281,7 @@ class BoussinesqModel:
             raise ValueError("wave series: no component within the model's dispersion range")
         wl = 2.0 * math.pi / float(nwogu_wavenumber(omega[np.argmax(a)], d, self.beta, self.g))
         d = self._check_source_site(x_s, wl, delta)
+        self.coupling_omega = float(omega[np.argmax(a)])
         self.set_source(make_source(self.x, x_s, d, a, omega, phi, wl, delta, ramp, self.beta, self.g))
 
     def _k(self, omega: float, x: float) -> float:
@@ -296,7 +299,7 @@ class BoussinesqModel:
             self._h, self._coef_a, self._coef_b, self._lower, self._diag, self._upper,
             self._cprime, self._minv, self._sponge, self._src_shape, self._src_amp, self._src_omega,
             self._src_phase, self._src_ramp, self.g, self.dx,
-            self._pin_idx, self._pin_eta, self._pin_u,
+            self._pin_idx, self._pin_in, self._pin_ratio,
             s[0], s[1], s[2], s[3], s[4], s[5], s[6], s[7], s[8], self._stats)
         if res < 0:
             self._step += -res
@@ -355,12 +358,10 @@ class BoussinesqModel:
             raise ValueError(f"x outside the model grid [{self.x0}, {self.x1}]")
         if self._pin_idx.size:
             x_b = self.x0 + self._pin_idx[-1] * self.dx
-            if np.any(x >= x_b - 1e-9 * self.dx):
+            if np.any(x > x_b + 1e-9 * self.dx):
                 raise ValueError(
-                    f"x = {np.max(x):.6g} m is at or beyond the two-way coupling boundary x_b = {x_b:.6g} m "
-                    "set by impose(): there the model only holds the SPH values it was given. Impose SPH "
-                    "readings downstream of the points where the model drives SPH (an overlap, seed 001 "
-                    "Alg. 2), or use the absorption-only mode (two_way=False)")
+                    f"x = {np.max(x):.6g} m lies beyond the two-way coupling boundary x_b = {x_b:.6g} m "
+                    "set by impose(): the grid beyond it is inactive")
         r = (x - self.x0) / self.dx
         j = np.clip(np.floor(r).astype(int), 0, self.n_nodes - 2)
         w = _lagrange_weights(r - j)
@@ -401,15 +402,20 @@ class BoussinesqModel:
 
     # ------------------------------------------------------------------ coupling
     def impose(self, x: float, eta: float, u_ref: float) -> None:
-        """Two-way feedback (seed 001 Alg. 2, line 4): eta and u_alpha measured by SPH at x become
-        the right-hand boundary of the model, held for the following steps.
+        """Two-way feedback (seed 001 Alg. 2, line 4): the elevation eta [m] and velocity u_ref
+        [m/s] measured by SPH at x become the right-hand boundary of the model for the
+        following steps.
 
-        The grid node nearest x is held at (eta, u_ref) and ends the active grid; its two ghost
-        nodes beyond take the odd reflection about the held values (`kernels.close_boundary`), the
-        grid further right is inactive. A later call moves the boundary if x differs. The SPH
-        zone thus lies at the x > x_b end of the Boussinesq grid, overlapping it. u_ref is the
-        velocity measured at the reference depth z_alpha = beta h, the model's own variable.
-        Ignored when the model was built with two_way=False (absorption-only coupling).
+        The grid node nearest x, b, ends the active grid (ghosts beyond: `kernels.close_boundary`;
+        further right the grid is inactive). It is a characteristic boundary (`kernels.apply_pins`):
+        the model keeps its own outgoing, right-going wave there and takes from SPH only the
+        incoming, left-going part L = (eta - u_ref / r) / 2, r = u/eta of a progressive wave
+        (linear Nwogu, at `coupling_omega`: the generated wave's (peak) frequency; long-wave
+        r = sqrt(g/h) if none). So the model at b carries the far-field incident wave plus the
+        reflection SPH saw, and driving SPH's inlet from b is not a closed loop. u_ref is the
+        velocity at the reference depth z_alpha = beta h, the model's own variable. A later call
+        moves the boundary if x differs. Ignored when the model was built with two_way=False
+        (absorption-only coupling).
         """
         if not self.two_way:
             return
@@ -419,9 +425,20 @@ class BoussinesqModel:
                              f"and 2 from x1 ([{self.x0}, {self.x1}])")
         if not (math.isfinite(eta) and math.isfinite(u_ref)):
             raise ValueError(f"impose: eta ({eta}) and u_ref ({u_ref}) must be finite")
+        r = self.progressive_ratio(float(self.h_nodes[i]))
         moved = i not in self._pins
-        self._pins = {i: (float(eta), float(u_ref))}
+        self._pins = {i: (0.5 * (float(eta) - float(u_ref) / r), r)}
         self._sync_pins(refactor=moved)
+
+    def progressive_ratio(self, h: float) -> float:
+        """u_alpha / eta [1/s] of a linear progressive Nwogu wave at `coupling_omega` in depth h:
+        g k / (omega (1 - alpha (kh)^2)); sqrt(g/h) (long waves) when no frequency is known."""
+        if self.coupling_omega is None:
+            return math.sqrt(self.g / h)
+        w = self.coupling_omega
+        k = float(nwogu_wavenumber(w, h, self.beta, self.g))
+        al = 0.5 * self.beta**2 + self.beta
+        return self.g * k / (w * (1.0 - al * (k * h) ** 2))
 
     def release(self) -> None:
         """Remove the coupling boundary; the grid beyond it restarts from rest."""
@@ -432,8 +449,8 @@ class BoussinesqModel:
     def _sync_pins(self, refactor: bool) -> None:
         idx = np.array(sorted(self._pins), dtype=np.int64)
         self._pin_idx = idx
-        self._pin_eta = np.array([self._pins[i][0] for i in idx], float)
-        self._pin_u = np.array([self._pins[i][1] for i in idx], float)
+        self._pin_in = np.array([self._pins[i][0] for i in idx], float)
+        self._pin_ratio = np.array([self._pins[i][1] for i in idx], float)
         if refactor:
             self._factor()
             self._refresh_rhs()
