@@ -17,6 +17,7 @@ The ends of the grid are reflective walls; put sponge layers in front of them to
 
 from __future__ import annotations
 
+import copy
 import math
 from dataclasses import dataclass
 
@@ -46,6 +47,7 @@ class _Checkpoint:
     n_hist: int
     arrays: tuple[np.ndarray, ...]
     pins: dict[int, tuple[float, float]]
+    free: "BoussinesqModel | None"
 
 
 def sponge_profile(x: np.ndarray, x0: float, x1: float, width_left: float, width_right: float,
@@ -170,6 +172,7 @@ class BoussinesqModel:
         self._pins: dict[int, tuple[float, float]] = {}  # coupling-boundary node -> (L, r)
         self._pin_idx, self._pin_in, self._pin_ratio = np.zeros(0, np.int64), np.zeros(0), np.zeros(0)
         self.coupling_omega: float | None = None  # frequency of the u/eta split at the boundary
+        self._free: BoussinesqModel | None = None  # uncoupled twin, answers beyond the boundary
         self._lower, self._diag, self._upper = np.zeros(nm), np.zeros(nm), np.zeros(nm)
         self._cprime, self._minv = np.zeros(nm), np.zeros(nm)
         self._factor()
@@ -292,6 +295,8 @@ class BoussinesqModel:
         """Advance n_steps time steps; raises BoussinesqUnstableError on a non-finite state."""
         if n_steps <= 0:
             return
+        if self._free is not None:
+            self._free.advance_steps(n_steps)
         s = self._scratch
         res = K.advance_steps(
             n_steps, self.t, self.dt, self._n_hist, self.tol, self.max_iter, self.filter_every, self._step,
@@ -322,8 +327,10 @@ class BoussinesqModel:
         n = int(round(interval / self.dt))
         if n < 1 or abs(n * self.dt - interval) > 1e-9 * self.dt:
             n = max(1, math.ceil(interval / self.dt_max * (1 - 1e-12)))
-            self.dt = interval / n
-            self._refresh_rhs()
+            for m in (self, self._free):
+                if m is not None:
+                    m.dt = interval / n
+                    m._refresh_rhs()
         todo = n
         chunk = max(1, min(todo, 2000))
         with tqdm(total=todo, disable=not progress, unit="step", desc="boussinesq") as bar:
@@ -333,6 +340,8 @@ class BoussinesqModel:
                 todo -= m
                 bar.update(m)
         self._t = float(t)  # no round-off drift across windows
+        if self._free is not None:
+            self._free._t = self._t
 
     @property
     def corrector_stats(self) -> dict[str, float]:
@@ -368,9 +377,29 @@ class BoussinesqModel:
         jp = j + K.NG
         return w[0] * f_padded[jp - 1] + w[1] * f_padded[jp] + w[2] * f_padded[jp + 1] + w[3] * f_padded[jp + 2]
 
+    def _beyond(self, x: np.ndarray) -> np.ndarray | None:
+        """Mask of x beyond the two-way boundary (answered by the uncoupled twin), or None."""
+        if self._free is None or not self._pin_idx.size:
+            return None
+        x_b = self.x0 + self._pin_idx[-1] * self.dx
+        mask = x > x_b + 1e-9 * self.dx
+        return mask if mask.any() else None
+
     def elevation(self, x: ArrayLike) -> np.ndarray:
-        """eta(x) [m] above the still-water level at self.t (cubic interpolation)."""
-        return self._interp(self._eta, np.asarray(x, float))
+        """eta(x) [m] above the still-water level at self.t (cubic interpolation).
+
+        Beyond a two-way coupling boundary (inside the SPH zone) the model reports its free,
+        uncoupled field there (the incident wave it predicts: the reference of the seed 002
+        mismatch), computed by a twin that never received SPH data.
+        """
+        x = np.asarray(x, float)
+        beyond = self._beyond(x)
+        if beyond is None:
+            return self._interp(self._eta, x)
+        out = np.empty(x.shape)
+        out[beyond] = self._free.elevation(x[beyond])
+        out[~beyond] = self._interp(self._eta, x[~beyond])
+        return out
 
     def velocity(self, x: ArrayLike, z: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
         """(u, w) [m/s] at (x, z), z up from the still-water level, from Nwogu's profile.
@@ -379,6 +408,13 @@ class BoussinesqModel:
         the surface value is returned, below the bed the bed value.
         """
         x, z = np.broadcast_arrays(np.asarray(x, float), np.asarray(z, float))
+        beyond = self._beyond(x)
+        if beyond is not None:
+            u_out, w_out = np.empty(x.shape), np.empty(x.shape)
+            u_out[beyond], w_out[beyond] = self._free.velocity(x[beyond], z[beyond])
+            if (~beyond).any():
+                u_out[~beyond], w_out[~beyond] = self.velocity(x[~beyond], z[~beyond])
+            return u_out, w_out
         dx = self.dx
         u = self._u
         hu = self._h * u
@@ -414,8 +450,10 @@ class BoussinesqModel:
         r = sqrt(g/h) if none). So the model at b carries the far-field incident wave plus the
         reflection SPH saw, and driving SPH's inlet from b is not a closed loop. u_ref is the
         velocity at the reference depth z_alpha = beta h, the model's own variable. A later call
-        moves the boundary if x differs. Ignored when the model was built with two_way=False
-        (absorption-only coupling).
+        moves the boundary if x differs. Beyond the boundary `elevation`/`velocity` answer from
+        an uncoupled twin of the model (started at the first call), i.e. the model's own
+        incident-wave prediction inside the SPH zone. Ignored when the model was built with
+        two_way=False (absorption-only coupling).
         """
         if not self.two_way:
             return
@@ -426,6 +464,8 @@ class BoussinesqModel:
         if not (math.isfinite(eta) and math.isfinite(u_ref)):
             raise ValueError(f"impose: eta ({eta}) and u_ref ({u_ref}) must be finite")
         r = self.progressive_ratio(float(self.h_nodes[i]))
+        if self._free is None:  # the uncoupled twin starts from the state before any feedback
+            self._free = copy.deepcopy(self)
         moved = i not in self._pins
         self._pins = {i: (0.5 * (float(eta) - float(u_ref) / r), r)}
         self._sync_pins(refactor=moved)
@@ -442,6 +482,7 @@ class BoussinesqModel:
 
     def release(self) -> None:
         """Remove the coupling boundary; the grid beyond it restarts from rest."""
+        self._free = None
         if self._pins:
             self._pins.clear()
             self._sync_pins(refactor=True)
@@ -459,7 +500,8 @@ class BoussinesqModel:
         """An exact copy of the state, for the protocol's `goback`."""
         arrays = (self._eta.copy(), self._u.copy(), self._uu.copy(), self._e_hist.copy(),
                   self._f_hist.copy(), self._stats.copy())
-        return _Checkpoint(self._step, self._t, self.dt, self._n_hist, arrays, dict(self._pins))
+        return _Checkpoint(self._step, self._t, self.dt, self._n_hist, arrays, dict(self._pins),
+                           copy.deepcopy(self._free))
 
     def restore(self, cp: _Checkpoint) -> None:
         """Return to a state saved by `checkpoint`."""
@@ -469,4 +511,5 @@ class BoussinesqModel:
         for dst, src in zip((self._eta, self._u, self._uu, self._e_hist, self._f_hist, self._stats), cp.arrays):
             dst[...] = src
         self._step, self._t, self.dt, self._n_hist = cp.step, cp.t, cp.dt, cp.n_hist
+        self._free = copy.deepcopy(cp.free)
 
