@@ -1,0 +1,88 @@
+"""How close does the open-boundary SPH flume come to wave theory, and at what cost?
+
+    python bench/flume_accuracy.py --case III [--dp 0.01] [--periods 5] [--no-absorb]
+    python bench/flume_accuracy.py --theory stokes --H 0.08 --T 2.0 --d 1.0 --dp 0.01
+
+Runs one case of the seed 002 validation table (tests/data/wave_cases_seed002.csv, cases I-VI)
+or any regular wave through a flume one wavelength long (standing wave: half a wavelength, faces
+at the nodes of eta) with open ends driven by the theory. Prints one JSON line:
+case, theory, H, T, d, dp, H_over_dp, periods, rmse_over_H (mid-flume gauge vs theory over the
+periods after the ramp), reflection (least squares over the gauges L/8 either side of mid-flume,
+first harmonic; incident/reflected separation, so not for the standing wave), wall_s,
+particles, steps, particle_steps_per_s, boundary counts and the mean water level drift.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import json
+import math
+import sys
+from pathlib import Path
+
+from sph_core.wave_flume import flume_case
+from wave_client.theories import build_theory, wavenumber
+
+CASES_CSV = Path(__file__).resolve().parents[1] / "tests" / "data" / "wave_cases_seed002.csv"
+THEORY_OF = {"standing": ("standing", {}), "linear": ("linear", {}),
+             "stokes2": ("stokes", {"order": 2}), "stokes3": ("stokes", {"order": 3}),
+             "stream_function": ("stream", {"n_fourier": 16}), "irregular": ("irregular", {})}
+
+
+def read_cases(path: Path = CASES_CSV) -> dict[str, dict]:
+    with open(path) as fh:
+        rows = csv.DictReader(line for line in fh if not line.startswith("#"))
+        return {r["test"]: r for r in rows}
+
+
+def build_model(theory: str, height: float, period: float, depth: float, ramp: float):
+    name, opts = THEORY_OF.get(theory, (theory, {}))
+    return build_theory(name, height=height, period=period, depth=depth, ramp_time=ramp, **opts)
+
+
+def run(theory: str, height: float, period: float, depth: float, dp: float, periods: float,
+        ramp_periods: float = 1.0, absorb: bool = True, case: str | None = None) -> dict:
+    ramp = ramp_periods * period
+    model = build_model(theory, height, period, depth, ramp)
+    if theory == "irregular":  # flume length and gauges from the peak wave
+        wavelength = 2 * math.pi / float(wavenumber(2 * math.pi / period, depth))
+    else:
+        wavelength = float(model.length)
+    out = flume_case(model, height=height, period=period, depth=depth, wavelength=wavelength,
+                     dp=dp, periods=periods, ramp=ramp, standing=theory == "standing",
+                     absorb=(absorb, absorb), name=f"flume_{case or theory}")
+    return {"case": case, "theory": theory, **out}
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--case", choices=["I", "II", "III", "IV", "V", "VI"])
+    ap.add_argument("--theory", help="regular wave instead of a case: linear, stokes2..5, "
+                                     "stream_function, standing")
+    ap.add_argument("--H", type=float)
+    ap.add_argument("--T", type=float)
+    ap.add_argument("--d", type=float)
+    ap.add_argument("--dp", type=float, help="particle spacing [m] (default: H/10)")
+    ap.add_argument("--periods", type=float, default=5.0, help="periods measured after the ramp")
+    ap.add_argument("--ramp-periods", type=float, default=1.0)
+    ap.add_argument("--no-absorb", action="store_true", help="switch the seed 002 correction off")
+    a = ap.parse_args(argv)
+    if a.case:
+        row = read_cases()[a.case]
+        theory, height, period, depth = row["theory"], float(row["H"]), float(row["T"]), float(row["d"])
+    elif a.theory and a.H and a.T and a.d:
+        theory, height, period, depth = a.theory, a.H, a.T, a.d
+        if theory.startswith("stokes") and theory not in THEORY_OF:
+            THEORY_OF[theory] = ("stokes", {"order": int(theory[-1])})
+    else:
+        ap.error("give --case, or --theory with --H --T --d")
+    dp = a.dp if a.dp else height / 10.0
+    out = run(theory, height, period, depth, dp, a.periods, a.ramp_periods, not a.no_absorb,
+              a.case)
+    print(json.dumps(out), flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
