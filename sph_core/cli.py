@@ -55,7 +55,12 @@ def main(args: argparse.Namespace) -> int:
     except SceneError as exc:
         print(f"wavesph run: {exc}", file=sys.stderr)
         return 2
-    t_end = args.t_end if args.t_end is not None else scene.t_end
+    if args.t_end is not None:
+        if not args.t_end > 0:
+            print("wavesph run: --t-end must be > 0", file=sys.stderr)
+            return 2
+        scene = scene.model_copy(update={"t_end": args.t_end})   # meta.json records the real end
+    t_end = scene.t_end
     out = args.out or Path("runs") / f"{scene.name}-{time.strftime('%Y%m%dT%H%M%SZ', time.gmtime())}"
     print(f"building particles for '{scene.name}' (dp = {scene.dp} m) ...", file=sys.stderr)
     sim = Simulation(scene, run_dir=out)

@@ -28,9 +28,18 @@ def martin_moyce_table(path: str | Path | None = None) -> tuple[np.ndarray, np.n
     return data[:, 0], data[:, 1]
 
 
+# Monaghan artificial viscosity of the case: DualSPHysics' CaseDambreak value (its docs recommend
+# 0.01 only for near-irrotational flows, the sph_core default meant for waves). Measured at
+# a/dp = 20: max front error vs Martin & Moyce 8.4 % with 0.1, 13.8 % with 0.01.
+DAMBREAK_ALPHA = 0.1
+
+
 def dambreak_scene(a: float = 1.0, dp: float = 0.01, t_end: float = 1.0, tank_length: float | None = None,
                    probe_every: float | None = None, snapshot_every: float = 0.0, **constants) -> Scene:
-    """Column a x 2a at the left wall of a tank (default length 4a, height 3a) with a front probe."""
+    """Column a x 2a at the left wall of a tank (default length 4a, height 3a) with a front probe.
+
+    ``constants`` override the scene constants; alpha defaults to DAMBREAK_ALPHA."""
+    constants.setdefault("alpha", DAMBREAK_ALPHA)
     length = 4.0 * a if tank_length is None else tank_length
     every = probe_every if probe_every is not None else 0.02 * math.sqrt(a / (2 * 9.81))
     return make_scene({

@@ -85,8 +85,10 @@ class Simulation:
         prm[wcsph.PR_CFL] = c.cfl
         prm[wcsph.PR_RHO_LO], prm[wcsph.PR_RHO_HI] = c.density_band
         prm[wcsph.PR_NOSLIP] = 1.0 if c.wall_slip == "no_slip" else 0.0
-        prm[wcsph.PR_FX0], prm[wcsph.PR_FX1] = t.x0, t.x1
-        prm[wcsph.PR_FZ0], prm[wcsph.PR_FZ1] = t.z0, t.z1
+        # a fluid particle whose centre passes the first dummy layer (dp/2 behind the wall face)
+        # has gone through the wall; the top z1 is open
+        prm[wcsph.PR_FX0], prm[wcsph.PR_FX1] = t.x0 - 0.5 * dp, t.x1 + 0.5 * dp
+        prm[wcsph.PR_FZ0], prm[wcsph.PR_FZ1] = t.z0 - 0.5 * dp, t.z1
         prm[wcsph.PR_XMIN], prm[wcsph.PR_ZMIN] = self.grid.xmin, self.grid.zmin
         prm[wcsph.PR_INV_CS] = 1.0 / self.grid.cs
         self.prm = prm
@@ -289,6 +291,20 @@ class Simulation:
         if self.writer:
             self.writer.update_meta(**self._meta_fields())
 
+    def advance_steps(self, n_steps: int) -> None:
+        """Take exactly ``n_steps`` steps without recording outputs (benchmarks, tests)."""
+        ps = self.particles
+        tic = time.perf_counter()
+        t, dt, steps, status, swapped, n_flag, vmax = wcsph.advance(
+            *self._arrays(), ps.n, self.prm, self.grid.ncx, self.grid.ncz, self.integrator,
+            self.t, self.dt, math.inf, int(n_steps))
+        self.wall_time += time.perf_counter() - tic
+        if swapped:
+            self._swap()
+        self.t, self.dt, self.steps, self.v_max = float(t), float(dt), self.steps + steps, vmax
+        if status not in (wcsph.ST_REACHED_T, wcsph.ST_STEP_LIMIT):
+            self._fail_unstable(status, n_flag)
+
     def _fail_unstable(self, status: int, n_flag: int) -> None:
         ps = self.particles
         sel = ps.mask(FLUID)
@@ -301,7 +317,8 @@ class Simulation:
             cause += f" [{lo}, {hi}] rho0"
         elif status == wcsph.ST_LEFT_DOMAIN:
             t = self.scene.tank
-            bad = np.nonzero(~((x >= t.x0) & (x <= t.x1) & (z >= t.z0) & (z <= t.z1)))[0]
+            hd = 0.5 * self.scene.dp
+            bad = np.nonzero(~((x >= t.x0 - hd) & (x <= t.x1 + hd) & (z >= t.z0 - hd) & (z <= t.z1)))[0]
         else:
             v = np.hypot(ps.field(VX)[sel], ps.field(VZ)[sel])
             bad = np.nonzero(~(np.isfinite(v) & np.isfinite(rho)))[0]

@@ -1,0 +1,132 @@
+"""SPH throughput on the standard 2D dam break (DualSPHysics / PySPH reference case).
+
+Question: how many particle-steps per second does the WCSPH core sustain on this machine, and
+where does the time go (neighbour search vs interactions vs integration)?
+
+Case: water column 1 m x 2 m at the left wall of a 4 m tank, dp = 0.01 m (20,000 fluid particles)
+and the 4x larger dp = 0.005 m variant. Each size runs a fixed number of steps after a short
+warm-up; particles counts all active particles (fluid + wall), as the DualSPHysics and PySPH
+anchors do. Also measures the one-off numba compile time, cold (empty cache) and cached.
+
+Output: one JSON object per line.
+    python bench/sph_throughput.py [--steps 400] [--dps 0.01 0.005] [--integrator kdk] [--diagnostics]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+
+COMPILE_PROBE = """
+import time
+t0 = time.perf_counter()
+from sph_core.dambreak import dambreak_scene
+from sph_core.simulation import Simulation
+sim = Simulation(dambreak_scene(a=0.05, dp=0.005, t_end=0.01, integrator="{integrator}"))
+sim.advance_to(0.002)
+sim.probe_values()
+print(time.perf_counter() - t0)
+"""
+
+
+def compile_times(integrator: str) -> dict:
+    """Import + build + first steps in a fresh interpreter, with an empty and a warm numba cache."""
+    with tempfile.TemporaryDirectory() as cache:
+        env = dict(os.environ, NUMBA_CACHE_DIR=cache)
+        out = []
+        for _ in range(2):
+            res = subprocess.run([sys.executable, "-c", COMPILE_PROBE.format(integrator=integrator)],
+                                 env=env, capture_output=True, text=True, check=True)
+            out.append(float(res.stdout.strip().splitlines()[-1]))
+    return {"bench": "numba_compile", "integrator": integrator, "compile_cold_s": round(out[0], 2),
+            "compile_cached_s": round(out[1], 2)}
+
+
+def time_components(sim, repeats: int) -> dict:
+    """Seconds per call of each phase of a step, timed on the current state."""
+    from sph_core import wcsph
+    from sph_core.particles import N_SORTED_KDK
+
+    ps, g, prm = sim.particles, sim.grid, sim.prm
+    args = (ps.f, ps.f2, N_SORTED_KDK, ps.kind, ps.kind2, ps.ids, ps.ids2, sim.cell, sim.cell2,
+            sim.order, sim.cell_start, sim.cursor, ps.n, prm, g.ncx, g.ncz)
+
+    def clock(fn) -> float:
+        fn()
+        t0 = time.perf_counter()
+        for _ in range(repeats):
+            fn()
+        return (time.perf_counter() - t0) / repeats
+
+    # sorting an already sorted set costs the same as a real step's sort (O(N) counting sort)
+    t_sort = clock(lambda: wcsph._sort(*args))
+    t_wall = clock(lambda: wcsph.wall_pass(ps.f, ps.kind, sim.cell, sim.cell_start, ps.n, g.ncx, g.ncz, prm))
+    t_fluid = clock(lambda: wcsph.fluid_pass(ps.f, ps.kind, sim.cell, sim.cell_start, ps.n, g.ncx, g.ncz, prm))
+    t_kick = clock(lambda: wcsph.kdk_kick(ps.f, ps.kind, ps.n, 0.0, prm))
+    return {"sort": t_sort, "wall": t_wall, "fluid": t_fluid, "kick": t_kick}
+
+
+def run_size(dp: float, steps: int, integrator: str, diagnostics: bool) -> dict:
+    import numba
+
+    from sph_core.dambreak import dambreak_scene
+    from sph_core.simulation import Simulation
+
+    scene = dambreak_scene(a=1.0, dp=dp, t_end=1.0, integrator=integrator)
+    sim = Simulation(scene)
+    sim.advance_steps(20)                     # warm-up (compiled already, touches memory)
+    sim.wall_time = 0.0
+    s0 = sim.steps
+    t0 = time.perf_counter()
+    sim.advance_steps(steps)
+    wall = time.perf_counter() - t0
+    n = sim.n_particles
+    parts = time_components(sim, repeats=20)
+    kick_calls = 2 if integrator == "kdk" else 2   # kdk: drift+kick; pc: predict+correct
+    per_step = {
+        "neighbour_search": parts["sort"] * (1 if integrator == "kdk" else 1),
+        "interactions": (parts["wall"] + parts["fluid"]) * sim.passes_per_step,
+        "integration": parts["kick"] * kick_calls,
+    }
+    total = sum(per_step.values())
+    out = {
+        "bench": "sph_throughput", "case": "dambreak_2d_1x2m_tank4m", "dp": dp,
+        "integrator": integrator, "particles": n, "fluid_particles": sim.n_fluid,
+        "steps": sim.steps - s0, "passes_per_step": sim.passes_per_step,
+        "wall_s": round(wall, 3),
+        "particle_steps_per_s": round(n * (sim.steps - s0) / wall),
+        "particle_passes_per_s": round(n * (sim.steps - s0) * sim.passes_per_step / wall),
+        "threads": numba.get_num_threads(), "threading_layer": numba.threading_layer(),
+        "share_neighbour_search": round(per_step["neighbour_search"] / total, 3),
+        "share_interactions": round(per_step["interactions"] / total, 3),
+        "share_integration": round(per_step["integration"] / total, 3),
+        "ms_per_call": {k: round(1e3 * v, 3) for k, v in parts.items()},
+        "simulated_t_s": round(sim.t, 5), "dt_s": sim.dt,
+    }
+    if diagnostics:
+        from sph_core import wcsph
+        wcsph.fluid_pass.parallel_diagnostics(level=1)
+    return out
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--steps", type=int, default=400)
+    ap.add_argument("--dps", type=float, nargs="+", default=[0.01, 0.005])
+    ap.add_argument("--integrator", choices=["kdk", "symplectic_pc"], default="kdk")
+    ap.add_argument("--diagnostics", action="store_true", help="print numba parallel diagnostics")
+    ap.add_argument("--no-compile", action="store_true", help="skip the compile-time measurement")
+    args = ap.parse_args()
+    if not args.no_compile:
+        print(json.dumps(compile_times(args.integrator)), flush=True)
+    for dp in args.dps:
+        print(json.dumps(run_size(dp, args.steps, args.integrator, args.diagnostics)), flush=True)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,102 @@
+"""Dam break (Martin & Moyce geometry) against the measured surge front.
+
+Scaled column a = 0.1 m (height 2a) in a 5a tank, a/dp = 20, run to T = t sqrt(2g/a) = 3.1.
+References, copied into tests/data with their sources:
+- Martin & Moyce (1952), the case's own experiment;
+- Koshizuka & Oka (1996), a second measurement of the same 2:1 column.
+Front = largest x of fluid particles with at least 3 fluid neighbours within 2h.
+"""
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from sph_core.dambreak import dambreak_scene, front_errors, martin_moyce_table
+from sph_core.simulation import Simulation
+
+DATA = Path(__file__).resolve().parents[1] / "data"
+A = 0.1
+T_END = 3.1
+
+
+def run_dambreak(resolution: int, **constants):
+    t_end = T_END / math.sqrt(2 * 9.81 / A)
+    scene = dambreak_scene(a=A, dp=A / resolution, t_end=t_end, tank_length=5 * A, **constants)
+    sim = Simulation(scene)
+    m0, n0 = sim.fluid_state()["m"], sim.n_fluid
+    sim.advance_to(t_end)
+    hist = [(r["t"], r["front_x"]) for r in sim.history]
+    t, x = np.array(hist).T
+    return sim, t, x, m0, n0
+
+
+@pytest.fixture(scope="module")
+def coarse():
+    return run_dambreak(20)
+
+
+def test_tables_are_the_shipped_copies():
+    mine = martin_moyce_table(DATA / "dambreak_martin_moyce_1952.csv")
+    shipped = martin_moyce_table()
+    np.testing.assert_array_equal(mine[0], shipped[0])
+    np.testing.assert_array_equal(mine[1], shipped[1])
+
+
+def test_mass_exactly_conserved_and_fluid_stays_in_tank(coarse):
+    sim, t, x, m0, n0 = coarse
+    assert sim.n_fluid == n0
+    st = sim.fluid_state()
+    np.testing.assert_array_equal(st["m"], m0)      # each particle's mass, compared by id
+    tank = sim.scene.tank
+    hd = 0.5 * sim.scene.dp   # the first dummy layer: a centre beyond it went through the wall
+    assert np.all((st["x"] >= tank.x0 - hd) & (st["x"] <= tank.x1 + hd) & (st["z"] >= tank.z0 - hd))
+
+
+def test_front_within_10_percent_of_koshizuka_oka(coarse):
+    _, t, x, *_ = coarse
+    table = martin_moyce_table(DATA / "dambreak_koshizuka_oka_1996.csv")
+    keep = table[0] > 0  # T = 0 is the initial column itself
+    err = front_errors(t, x, A, t_max=3.0, table=(table[0][keep], table[1][keep]))
+    assert err["max_rel_error"] < 0.10, err
+
+
+def test_front_within_10_percent_of_martin_moyce(coarse):
+    """With the case's alpha = 0.1 (DualSPHysics CaseDambreak); with alpha = 0.01 the front leads
+    by up to 13.8 % at T = 1.2 (measured, reported, not tuned away)."""
+    _, t, x, *_ = coarse
+    err = front_errors(t, x, A, t_max=3.0, table=martin_moyce_table(DATA / "dambreak_martin_moyce_1952.csv"))
+    assert err["max_rel_error"] < 0.10, err
+
+
+@pytest.mark.slow
+def test_finer_resolution_stays_within_10_percent_of_koshizuka_oka():
+    sim, t, x, m0, n0 = run_dambreak(40)
+    assert sim.n_fluid == n0
+    np.testing.assert_array_equal(sim.fluid_state()["m"], m0)
+    table = martin_moyce_table(DATA / "dambreak_koshizuka_oka_1996.csv")
+    keep = table[0] > 0
+    err = front_errors(t, x, A, t_max=3.0, table=(table[0][keep], table[1][keep]))
+    assert err["max_rel_error"] < 0.10, err
+
+
+@pytest.mark.slow
+@pytest.mark.xfail(strict=True, reason=(
+    "measured: refining a/dp 20 -> 40 moves the front AWAY from Martin & Moyce (max error 8.4 % -> "
+    "12.3 %, rms 4.1 % -> 6.3 %): less numerical viscosity, a faster early surge than the "
+    "experiment, whose gate release delays it. Spec asked for 'closer at finer resolution'."))
+def test_finer_resolution_closer_to_martin_moyce(coarse):
+    table = martin_moyce_table(DATA / "dambreak_martin_moyce_1952.csv")
+    _, t20, x20, *_ = coarse
+    _, t40, x40, *_ = run_dambreak(40)
+    e20 = front_errors(t20, x20, A, t_max=3.0, table=table)
+    e40 = front_errors(t40, x40, A, t_max=3.0, table=table)
+    assert e40["rms_rel_error"] < e20["rms_rel_error"]
+
+
+def test_front_moves_monotonically_and_ahead_of_column(coarse):
+    _, t, x, *_ = coarse
+    assert x[0] == pytest.approx(A - 0.5 * A / 20)      # the column's last particle row
+    assert np.all(np.diff(x) > -0.5 * A / 20)            # no jumps back by more than dp/2
+    assert x[-1] / A > 3.0

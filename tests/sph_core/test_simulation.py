@@ -1,0 +1,116 @@
+"""Run life: outputs on disk, checkpoint/restore, stability guard, CLI."""
+
+import csv
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import wavesph_cli
+from sph_core.dambreak import dambreak_scene
+from sph_core.scene import make_scene
+from sph_core.simulation import Simulation, UnstableError
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def small_dambreak(**kw):
+    return dambreak_scene(a=0.05, dp=0.005, t_end=0.05, probe_every=0.01, **kw)
+
+
+def test_run_directory_outputs(tmp_path):
+    scene = dambreak_scene(a=0.05, dp=0.005, t_end=0.04, probe_every=0.01, snapshot_every=0.02)
+    sim = Simulation(scene, run_dir=tmp_path)
+    sim.advance_to(scene.t_end)
+    sim.close()
+    meta = json.loads((tmp_path / "meta.json").read_text())
+    assert meta["status"] == "completed" and meta["steps"] == sim.steps > 0
+    assert meta["config"]["dp"] == 0.005 and "numba" in meta["versions"]
+    assert meta["passes_per_step"] == 1 and meta["wall_time_s"] > 0
+    rows = list(csv.reader((tmp_path / "probes.csv").open()))
+    assert rows[0] == ["t", "step", "front_x"]
+    times = [float(r[0]) for r in rows[1:]]
+    assert times == pytest.approx([0.0, 0.01, 0.02, 0.03, 0.04])
+    snaps = sorted((tmp_path / "snapshots").glob("*.vtu"))
+    assert len(snaps) == 3
+    head = snaps[-1].read_bytes()[:200]
+    assert b"VTKFile" in head and b"UnstructuredGrid" in head
+    assert "particles_00002.vtu" in (tmp_path / "run.pvd").read_text()
+
+
+def test_checkpoint_restore_is_exact():
+    scene = small_dambreak()
+    sim = Simulation(scene)
+    sim.advance_to(0.01)
+    cp = sim.checkpoint()
+    sim.advance_to(0.03)
+    first = sim.fluid_state()
+    sim.restore(cp)
+    assert sim.t == 0.01
+    sim.advance_to(0.03)
+    second = sim.fluid_state()
+    for key in first:
+        np.testing.assert_array_equal(first[key], second[key])
+
+
+def test_kdk_and_predictor_corrector_agree():
+    runs = []
+    for integrator in ("kdk", "symplectic_pc"):
+        sim = Simulation(small_dambreak(integrator=integrator))
+        sim.advance_to(0.05)
+        runs.append(sim.probe_values()["front_x"])
+    assert runs[0] == pytest.approx(runs[1], abs=0.5 * 0.005)
+
+
+def test_unstable_run_stops_with_cause_and_keeps_outputs(tmp_path):
+    # c0 = 0.5 m/s is far below sqrt(2 g H) = 1.4 m/s: the column compresses beyond the band
+    scene = small_dambreak(c0=0.5, density_band=(0.9, 1.1))
+    sim = Simulation(scene, run_dir=tmp_path)
+    with pytest.raises(UnstableError) as info:
+        sim.advance_to(scene.t_end)
+    err = info.value
+    assert err.step > 0 and 0 < err.t < scene.t_end and "density" in err.cause
+    meta = json.loads((tmp_path / "meta.json").read_text())
+    assert meta["status"] == "unstable" and meta["unstable_step"] == err.step
+    assert "density" in meta["cause"]
+    text = (tmp_path / "probes.csv").read_text().lower()
+    assert "nan" not in text and len(text.splitlines()) >= 2
+    with pytest.raises(RuntimeError):
+        sim.advance_to(scene.t_end)
+
+
+def test_dry_gauge_reports_dry(tmp_path):
+    scene = make_scene({
+        "dp": 0.01, "t_end": 0.01, "still_water_level": 0.1,
+        "tank": {"x0": 0, "x1": 0.6, "z0": 0, "z1": 0.3},
+        "water_blocks": [{"x0": 0, "x1": 0.2, "z0": 0, "z1": 0.1}],
+        "output": {"probe_every": 0.01},
+        "probes": [{"kind": "elevation", "name": "dry", "x": 0.5},
+                   {"kind": "elevation", "name": "wet", "x": 0.1},
+                   {"kind": "point", "name": "air", "x": 0.5, "z": 0.2}],
+    })
+    sim = Simulation(scene, run_dir=tmp_path)
+    v = sim.probe_values()
+    assert v["dry_z_surface"] is None and v["dry_eta"] is None and v["air_p"] is None
+    assert v["wet_z_surface"] == pytest.approx(0.1, abs=0.25 * scene.dp)
+    sim.close()
+    row = list(csv.DictReader((tmp_path / "probes.csv").open()))[0]
+    assert row["dry_z_surface"] == "dry" and row["air_u"] == "dry"
+
+
+def test_cli_run(tmp_path, capsys):
+    scene = ROOT / "examples" / "scenes" / "still_water_tank.toml"
+    out = tmp_path / "run"
+    code = wavesph_cli.main(["run", str(scene), "--t-end", "0.005", "--out", str(out)])
+    assert code == 0
+    meta = json.loads((out / "meta.json").read_text())
+    assert meta["status"] == "completed" and meta["t"] == pytest.approx(0.005)
+
+
+def test_cli_run_bad_scene(tmp_path, capsys):
+    bad = tmp_path / "bad.toml"
+    bad.write_text("dp = -1\nt_end = 1\n")
+    assert wavesph_cli.main(["run", str(bad)]) == 2
+    assert "dp:" in capsys.readouterr().err
