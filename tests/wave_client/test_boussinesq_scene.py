@@ -127,3 +127,20 @@ def test_build_model_from_example_scene():
     assert isinstance(scene, WaveScene)
     m = build_model(scene, BAR.parent)
     assert m.depth_at(13.0) == pytest.approx(0.1) and m.depth_at(9.0) == pytest.approx(0.25)
+
+
+def test_unstable_run_is_reported_and_writes_no_nan(tmp_path, capsys):
+    """A time step far beyond stability: the CLI exits 1 naming the step, and the CSV keeps
+    only finite rows plus a line saying where the run stopped."""
+    scene = tmp_path / "unstable.toml"
+    scene.write_text(FLAT.format(wave='kind = "regular"\nheight = 0.05\nperiod = 2.0\nx_source = 0.0')
+                     .replace("dx = 0.05", "dx = 0.5\ndt = 0.5").replace("every = 0.05", "every = 0.5"))
+    out = tmp_path / "g.csv"
+    parser = argparse.ArgumentParser()
+    waves_cli.add_arguments(parser)
+    assert waves_cli.main(parser.parse_args([str(scene), "-o", str(out), "--no-progress"])) == 1
+    assert "unstable at step" in capsys.readouterr().err
+    text = out.read_text()
+    assert "# run stopped: unstable" in text
+    _, eta, _ = read_csv(out)
+    assert np.all(np.isfinite(eta))

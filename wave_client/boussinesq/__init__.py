@@ -5,7 +5,8 @@ alone (`scene.py`, `wave_client/waves_cli.py`).
 """
 
 from .dispersion import airy_celerity, nwogu_celerity, nwogu_wavenumber
+from .solitary import kdv_solitary, nwogu_solitary
 from .solver import BoussinesqModel, BoussinesqUnstableError
 
-__all__ = ["BoussinesqModel", "BoussinesqUnstableError", "airy_celerity", "nwogu_celerity",
-           "nwogu_wavenumber"]
+__all__ = ["BoussinesqModel", "BoussinesqUnstableError", "airy_celerity", "kdv_solitary",
+           "nwogu_celerity", "nwogu_solitary", "nwogu_wavenumber"]

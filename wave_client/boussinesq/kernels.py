@@ -12,6 +12,9 @@ Equations (Nwogu 1993; discretisation of Wei & Kirby 1995), with z_alpha = beta 
 
     A = (z_alpha^2/2 - h^2/6) h,  B = (z_alpha + h/2) h,  a2 = z_alpha^2/2,  b2 = z_alpha
 
+(the weakly nonlinear, mild-slope form of Nwogu: gradients of z_alpha are neglected; u is the
+horizontal velocity at z = z_alpha, U its dispersive combination that the time stepping evolves).
+
 First derivatives use 5-point 4th-order central differences; the dispersive (second and third
 derivative) terms use 3-point 2nd-order differences, so that U(u) is tridiagonal. The truncation
 error is O(dx^4, dx^2 mu^2), as in Wei & Kirby (1995). w_s is the sponge damping rate [1/s]
