@@ -17,6 +17,8 @@ from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 from typing import Any
 
+from protocol.session import set_payload_size
+
 from .engine import CouplingEngine, EngineFactory
 from .schemas import RunInfo, RunRequest, canonical_scene
 from .settings import Settings
@@ -222,6 +224,10 @@ class RunManager:
             run.engine = await loop.run_in_executor(self.executor, self.engine_factory,
                                                     run.request, run.dir)
             run.info.particles = run.engine.n_particles
+            need = set_payload_size(run.engine.nodes().x.size)
+            if need > self.settings.max_frame:
+                raise ValueError(f"the scene's {run.engine.nodes().x.size} boundary nodes need SET frames "
+                                 f"of {need} bytes, above the server's max_frame {self.settings.max_frame}")
             names = run.engine.nodes().gauge_names or [f"g{j}" for j in range(run.engine.nodes().gauge_x.size)]
             run.gauges = GaugeWriter(run.dir / "gauges.csv", names)
             run.info.started = time.time()

@@ -230,3 +230,10 @@ def test_client_vanishing_during_a_solve_keeps_that_window(tmp_path, factory):
         assert info["status"] == "failed: client disconnected"
         rows = srv.http.get(f"/runs/{run['id']}/gauges", params={"format": "json"}).json()["rows"]
         assert len(rows) == 1 and info["windows"] == 1  # the solved window was written first
+
+
+def test_scene_too_big_for_the_frame_cap_fails_clearly(tmp_path, factory):
+    with live_server(tmp_path, factory, max_frame=4104) as srv:
+        run = srv.create(dp=0.001)  # 300 nodes: a SET of 7228 bytes
+        info = srv.wait_state(run["id"], "failed")
+        assert "above the server's max_frame 4104" in info["status"]
