@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from wave_client import waves_cli
+from wave_client.boussinesq import nwogu_wavenumber
 from wave_client.boussinesq.run import run_scene
 from wave_client.boussinesq.scene import SceneError, WaveScene, build_model, load_scene
 
@@ -43,10 +44,15 @@ def read_csv(path: Path) -> tuple[np.ndarray, np.ndarray, list[str]]:
     return data[:, 0], data[:, 1:], header
 
 
-def harmonic_amplitudes(t: np.ndarray, y: np.ndarray, omegas: list[float]) -> np.ndarray:
+def harmonic_fit(t: np.ndarray, y: np.ndarray, omegas: list[float]) -> np.ndarray:
+    """Complex amplitudes A_n e^{i phi_n} of y = mean + sum A_n cos(omega_n t - phi_n)."""
     cols = [f(w * t) for w in omegas for f in (np.cos, np.sin)] + [np.ones_like(t)]
     c, *_ = np.linalg.lstsq(np.column_stack(cols), y, rcond=None)
-    return np.hypot(c[0:-1:2], c[1:-1:2])
+    return c[0:-1:2] + 1j * c[1:-1:2]
+
+
+def harmonic_amplitudes(t: np.ndarray, y: np.ndarray, omegas: list[float]) -> np.ndarray:
+    return np.abs(harmonic_fit(t, y, omegas))
 
 
 def test_scene_errors_name_the_field(tmp_path):
@@ -81,7 +87,8 @@ def test_cli_writes_gauge_csv_and_reports_bad_scene(tmp_path, capsys):
 
 
 def test_series_wave_reproduces_its_components(tmp_path):
-    """A bichromatic series given as a CSV is generated with each component's amplitude."""
+    """A bichromatic series given as a CSV is generated with each component's amplitude and
+    phase (the series is the elevation at the source, carried downstream)."""
     periods, amps = (2.0, 1.25), (0.002, 0.001)
     t = np.arange(0, 40.0, 0.05)  # 20 and 32 periods: whole periods, a periodic series
     eta = sum(a * np.cos(2 * np.pi * t / p - 0.3 * i) for i, (a, p) in enumerate(zip(amps, periods)))
@@ -93,9 +100,13 @@ def test_series_wave_reproduces_its_components(tmp_path):
     run_scene(load_scene(scene), out, base_dir=tmp_path, progress=False)
     tt, ee, _ = read_csv(out)
     sel = tt > 20.0
-    for j in range(2):
-        a = harmonic_amplitudes(tt[sel], ee[sel, j], [2 * np.pi / p for p in periods])
-        np.testing.assert_allclose(a, amps, rtol=0.02)
+    omegas = [2 * np.pi / p for p in periods]
+    k = np.array([float(nwogu_wavenumber(w, 0.5)) for w in omegas])
+    for j, x in enumerate((5.0, 10.0)):
+        c = harmonic_fit(tt[sel], ee[sel, j], omegas)
+        np.testing.assert_allclose(np.abs(c), amps, rtol=0.02)
+        expected_phase = 0.3 * np.arange(2) + k * x  # the series' phases, carried at speed omega/k
+        assert np.all(np.abs(np.angle(np.exp(1j * (np.angle(c) - expected_phase)))) < 0.03)
 
 
 def test_submerged_bar_is_stable_and_releases_harmonics(tmp_path):
