@@ -237,3 +237,32 @@ def test_scene_too_big_for_the_frame_cap_fails_clearly(tmp_path, factory):
         run = srv.create(dp=0.001)  # 300 nodes: a SET of 7228 bytes
         info = srv.wait_state(run["id"], "failed")
         assert "above the server's max_frame 4104" in info["status"]
+
+
+def test_concurrent_runs_one_bad_client_does_not_disturb_the_other(srv):
+    import threading
+
+    good, bad = srv.create(), srv.create()
+    srv.wait_state(good["id"], "waiting_for_client")
+    srv.wait_state(bad["id"], "waiting_for_client")
+    errors: list[BaseException] = []
+
+    def couple_well() -> None:
+        try:
+            c = WsClient(f"ws://127.0.0.1:{srv.port}/runs/{good['id']}/couple")
+            welcome, nodes = handshake(c, good["id"])
+            run_windows(c, welcome, nodes, 10)
+            bye(c)
+        except BaseException as exc:  # noqa: BLE001 -- reported below
+            errors.append(exc)
+
+    thread = threading.Thread(target=couple_well)
+    thread.start()
+    c = TcpClient(srv.tcp_port)
+    welcome, nodes = handshake(c, bad["id"])
+    c.send_raw(b"\x00" * 64)  # garbage mid-session
+    _expect_error(c, ErrorCode.MALFORMED)
+    thread.join(timeout=30)
+    assert not errors, errors
+    assert srv.wait_state(good["id"], "finished")["windows"] == 10
+    assert srv.wait_state(bad["id"], "failed")["status"].startswith("failed: protocol error: MALFORMED")
