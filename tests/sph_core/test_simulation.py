@@ -114,3 +114,13 @@ def test_cli_run_bad_scene(tmp_path, capsys):
     bad.write_text("dp = -1\nt_end = 1\n")
     assert wavesph_cli.main(["run", str(bad)]) == 2
     assert "dp:" in capsys.readouterr().err
+
+
+def test_demo_writes_run_and_figure(tmp_path):
+    out = tmp_path / "demo"
+    code = wavesph_cli.main(["demo", "--resolution", "10", "--T-end", "1.0", "--out", str(out)])
+    assert code == 0
+    assert (out / "dambreak.png").stat().st_size > 10_000
+    meta = json.loads((out / "meta.json").read_text())
+    assert meta["status"] == "completed"
+    assert len(list((out / "snapshots").glob("*.vtu"))) >= 2
