@@ -72,6 +72,8 @@ async def serve_client(manager: RunManager, run: Run, transport: Transport,
     solve_time = 0.0
     timeout = settings.hello_timeout
     window: SetWindow | None = None
+    at_boundary = True          # engine state is a window boundary (safe to save for resuming)
+    saved_at = time.monotonic()
     end: _SessionEnd
 
     def sync_limits() -> None:
@@ -97,20 +99,27 @@ async def serve_client(manager: RunManager, run: Run, transport: Transport,
                 window = action  # handed to the engine with SOLVE: one worker hop per window
             elif isinstance(action, SolveWindow):
                 tic = time.perf_counter()
+                at_boundary = False
                 measured = await loop.run_in_executor(manager.executor, _solve, engine, run, window,
                                                       bool(session.capabilities & Capability.GOBACK))
+                at_boundary = True
                 solve_time += time.perf_counter() - tic
                 reply = session.result(action, _result(measured))
                 values = _gauge_values(names, measured)
                 run.gauges.row(engine.t, measured.steps, values)
                 _progress(manager, run, engine, values, connected, solve_time)
                 await transport.send(reply)
+                if time.monotonic() - saved_at >= settings.checkpoint_every:
+                    await _save_state(manager, run)
+                    saved_at = time.monotonic()
             elif isinstance(action, Measure):
                 measured = await loop.run_in_executor(manager.executor, engine.measure)
                 await transport.send(session.result(action, _result(measured)))
             elif isinstance(action, Restore):
                 window = None
+                at_boundary = False
                 measured = await loop.run_in_executor(manager.executor, _goback, engine)
+                at_boundary = True
                 run.gauges.rewind()
                 run.info.windows = max(run.info.windows - 1, 0)
                 _progress(manager, run, engine, {}, connected, solve_time)
@@ -151,6 +160,8 @@ async def serve_client(manager: RunManager, run: Run, transport: Transport,
         await asyncio.wait_for(transport.close(), 5.0)
     except Exception:  # noqa: BLE001
         pass
+    if at_boundary and end.state != UNSTABLE and run.info.windows > 0:
+        await _save_state(manager, run)  # what a resumed session starts from
     _progress(manager, run, engine, None, connected, solve_time)
     manager._set_state(run, end.state, end.reason)
     run.session_done.set()
@@ -190,6 +201,17 @@ def _solve(engine: CouplingEngine, run: Run, window: SetWindow, checkpoint: bool
         run.gauges.mark()
     engine.set_window(window.t0, window.t1, window.u, window.w, window.eta)
     return engine.solve_window()
+
+
+async def _save_state(manager: RunManager, run: Run) -> None:
+    """Engine state to the run directory, in a worker; a failure is logged, never fatal."""
+    save = getattr(run.engine, "save_state", None)
+    if save is None:
+        return
+    try:
+        await asyncio.get_running_loop().run_in_executor(manager.executor, save, run.state_file)
+    except Exception:  # noqa: BLE001 -- the run's data are in gauges.csv; only resuming is lost
+        log.exception("run %s: could not save the engine state", run.info.id)
 
 
 def _goback(engine: CouplingEngine) -> Measurement:

@@ -71,6 +71,10 @@ class CouplingEngine(Protocol):
     def goback(self) -> None: ...
     def stability(self) -> dict[str, float]:
         """Figures such as dt, v_max/c0, mass drift, for GET /runs/{id}."""
+    def save_state(self, path: Path) -> None:
+        """Write the state at the current window boundary to ``path`` (for resuming the run)."""
+    def load_state(self, path: Path) -> None:
+        """Continue from a state written by ``save_state`` (t, particles, boundary values)."""
     def close(self) -> None: ...
 
 

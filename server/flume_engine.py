@@ -14,6 +14,9 @@ Protocol view of the flume (PROTOCOL.md):
 from __future__ import annotations
 
 import math
+import os
+import pickle
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -59,7 +62,7 @@ class FlumeEngine:
         if not -depth < z_ref <= 0:
             raise ValueError(f"coupling.z_ref: {z_ref} m is not in the water column (-{depth}, 0]")
         sim_scene, self.gauge_names, gauge_x = ref_scene(scene, z_ref)
-        self.flume = OpenFlume(sim_scene, run_dir=None if run_dir is None else Path(run_dir) / "sph",
+        self.flume = OpenFlume(sim_scene, run_dir=None if run_dir is None else _fresh_dir(Path(run_dir)),
                                window=request.coupling.window_max)
         f = self.flume
         self.sides = [s for s in SIDES if s in f.open_sides]
@@ -150,8 +153,31 @@ class FlumeEngine:
         return {"dt": f.dt, "v_max": f.v_max, "c0": f.c0, "mach": f.v_max / f.c0 if f.c0 else 0.0,
                 "fluid_mass_ratio": f.fluid_mass() / mass0 if mass0 else 1.0}
 
+    def save_state(self, path: Path) -> None:
+        # our own file, read back only by load_state: pickle of plain dataclasses and arrays
+        tmp = Path(path).with_name(Path(path).name + ".tmp")
+        with open(tmp, "wb") as f:
+            pickle.dump(self.flume.checkpoint(), f, protocol=pickle.HIGHEST_PROTOCOL)
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(tmp, path)
+
+    def load_state(self, path: Path) -> None:
+        with open(path, "rb") as f:
+            self.flume.restore(pickle.load(f))
+        self.summary = replace(self.summary, t_start=self.flume.t)
+
     def close(self) -> None:
         self.flume.close()
+
+
+def _fresh_dir(run_dir: Path) -> Path:
+    """sph/ for the first session, sph.1/, sph.2/ ... for resumed ones: never overwrite outputs."""
+    k, d = 0, run_dir / "sph"
+    while d.exists():
+        k += 1
+        d = run_dir / f"sph.{k}"
+    return d
 
 
 def flume_engine(request: RunRequest, run_dir: Path) -> FlumeEngine:

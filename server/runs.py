@@ -51,7 +51,20 @@ class Run:
         self.gauges: GaugeWriter | None = None
         self.task: asyncio.Task | None = None
         self.client_attached = False
+        self.resume_from: Path | None = None
         self._saved_at = 0.0
+
+    @property
+    def state_file(self) -> Path:
+        return self.dir / "state.pkl"
+
+    def reset_live_parts(self) -> None:
+        """Fresh events and engine slots for a resumed session."""
+        self.cancel_flag = threading.Event()
+        self.cancelled = asyncio.Event()
+        self.attached = asyncio.Event()
+        self.session_done = asyncio.Event()
+        self.engine, self.gauges, self.task, self.client_attached = None, None, None, False
 
     @property
     def terminal(self) -> bool:
@@ -93,6 +106,8 @@ class RunManager:
         run.info.state = state
         run.info.reason = reason
         run.info.status = f"{state}: {reason}" if reason and state in (FAILED, UNSTABLE) else state
+        run.info.resumable = (state in (FAILED, CANCELLED) and run.request.mode == "coupled"
+                              and run.state_file.exists())
         if state in TERMINAL:
             run.info.ended = time.time()
             run.info.queue_position = None
@@ -120,6 +135,20 @@ class RunManager:
         self.save(run)
         self._schedule()
         return run
+
+    def resume(self, run: Run) -> None:
+        """Queue a failed or cancelled coupled run again, from its saved state."""
+        if not run.info.resumable:
+            raise ValueError(f"run {run.info.id} is {run.info.status}: only a failed or cancelled "
+                             f"coupled run with a saved state can be resumed")
+        run.reset_live_parts()
+        run.resume_from = run.state_file
+        run.info.resumed += 1
+        run.info.ended = None
+        self._set_state(run, QUEUED)
+        self.queue.append(run.info.id)
+        self._queue_positions()
+        self._schedule()
 
     def _schedule(self) -> None:
         while self.queue and len(self.active) < self.settings.max_runs:
@@ -223,13 +252,18 @@ class RunManager:
         try:
             run.engine = await loop.run_in_executor(self.executor, self.engine_factory,
                                                     run.request, run.dir)
+            if run.resume_from is not None:
+                await loop.run_in_executor(self.executor, run.engine.load_state, run.resume_from)
             run.info.particles = run.engine.n_particles
+            run.info.t, run.info.steps = run.engine.t, run.engine.steps
             need = set_payload_size(run.engine.nodes().x.size)
             if need > self.settings.max_frame:
                 raise ValueError(f"the scene's {run.engine.nodes().x.size} boundary nodes need SET frames "
                                  f"of {need} bytes, above the server's max_frame {self.settings.max_frame}")
             names = run.engine.nodes().gauge_names or [f"g{j}" for j in range(run.engine.nodes().gauge_x.size)]
-            run.gauges = GaugeWriter(run.dir / "gauges.csv", names)
+            run.gauges = GaugeWriter(run.dir / "gauges.csv", names,
+                                     resume_at=run.engine.t if run.resume_from is not None else None)
+            run.info.windows = run.gauges.rows_kept
             run.info.started = time.time()
             self._set_state(run, WAITING)
             woke = await _first_of(run.attached, run.cancelled, self.settings.client_wait_timeout)

@@ -54,6 +54,8 @@ class RunInfo(BaseModel):
     stability: dict[str, Any] = {}
     last_gauges: dict[str, float | None] = {}
     client: str | None = None
+    resumable: bool = False     # a coupled run that stopped early with its state saved
+    resumed: int = 0            # how many times the run was resumed
     scene_hash: str
     gauges_file: str | None = None
 

@@ -26,6 +26,8 @@ class Settings(BaseModel):
     idle_timeout: float = Field(600.0, gt=0, description="[s] between client frames")
     client_wait_timeout: float = Field(3600.0, gt=0, description="[s] a coupled run waits for its client")
     meta_interval: float = Field(0.5, ge=0, description="[s] least time between meta.json rewrites")
+    checkpoint_every: float = Field(60.0, gt=0, description="[s] wall time between saved states of "
+                                                            "a coupled run (for resuming it)")
 
     @property
     def loopback_only(self) -> bool:

@@ -5,6 +5,7 @@
         scene.json     the canonical scene bytes (the protocol's scene hash is their SHA-256)
         meta.json      RunInfo: status, progress, speed, stability, last gauges (atomic rewrite)
         gauges.csv     coupled runs: one row per solved window, flushed at once
+        state.pkl      coupled runs: the engine state at a window boundary (to resume the run)
         sph/           standalone runs: sph_core's own outputs (probes.csv, meta.json, snapshots/)
 """
 
@@ -61,11 +62,20 @@ class GaugeWriter:
     Each row is flushed as written. ``mark()`` before a window and ``rewind()`` on GOBACK drop
     the rows of a window that is being redone, so the file always holds one row per window."""
 
-    def __init__(self, path: Path, gauge_names: list[str]) -> None:
+    def __init__(self, path: Path, gauge_names: list[str], resume_at: float | None = None) -> None:
         self.columns = ["t", "steps"] + [f"{g}_{q}" for g in gauge_names for q in ("eta", "u_ref", "w_ref")]
+        keep: list[list[str]] = []
+        if resume_at is not None and path.exists():
+            # a resumed run continues the file: rows after the resumed state are dropped
+            with open(path, newline="") as f:
+                rows = list(csv.reader(f))[1:]
+            keep = [r for r in rows if r and float(r[0]) <= resume_at * (1 + 1e-12) + 1e-12]
+            os.replace(path, path.with_name(path.name + ".before-resume"))
         self._f = open(path, "w", newline="")
         self._csv = csv.writer(self._f)
         self._csv.writerow(self.columns)
+        self._csv.writerows(keep)
+        self.rows_kept = len(keep)
         self._f.flush()
         self._mark = self._f.tell()
 

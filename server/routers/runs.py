@@ -84,6 +84,17 @@ async def cancel_run(run: RunDep, manager: Manager) -> RunInfo:
     return run.info
 
 
+@router.post("/{run_id}/resume", status_code=202, response_model=RunInfo)
+async def resume_run(run: RunDep, manager: Manager) -> RunInfo:
+    """Queue a coupled run that failed or was cancelled again, from its last saved window
+    boundary (`resumable` in its record); a client then couples from WELCOME's t_start."""
+    try:
+        manager.resume(run)
+    except ValueError as exc:
+        raise HTTPException(409, str(exc)) from None
+    return run.info
+
+
 @router.get("/{run_id}/events")
 async def run_events(run: RunDep) -> StreamingResponse:
     """Server-Sent Events: a `progress` event with the run record whenever it changes; the

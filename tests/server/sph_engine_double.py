@@ -10,7 +10,9 @@ force at t0 and those set for t1; checkpoint/goback restore clock and boundary v
 from __future__ import annotations
 
 import copy
+import dataclasses
 import math
+import pickle
 import time
 
 import numpy as np
@@ -78,6 +80,15 @@ class EngineDouble:
         self.t, self.steps, self.in_force, n = copy.deepcopy(self._saved)
         del self.imposed[n:]
         self.pending = None
+
+    def save_state(self, path) -> None:
+        with open(path, "wb") as f:
+            pickle.dump((self.t, self.steps, self.in_force), f)
+
+    def load_state(self, path) -> None:
+        with open(path, "rb") as f:
+            self.t, self.steps, self.in_force = pickle.load(f)
+        self.summary = dataclasses.replace(self.summary, t_start=self.t)
 
     def stability(self) -> dict[str, float]:
         return {"dt": self.summary.dt_sph}

@@ -266,3 +266,32 @@ def test_concurrent_runs_one_bad_client_does_not_disturb_the_other(srv):
     assert not errors, errors
     assert srv.wait_state(good["id"], "finished")["windows"] == 10
     assert srv.wait_state(bad["id"], "failed")["status"].startswith("failed: protocol error: MALFORMED")
+
+
+def test_a_run_whose_client_vanished_resumes_from_its_last_window(srv, engines):
+    run = srv.create()
+    assert srv.http.post(f"/runs/{run['id']}/resume").status_code == 409  # nothing to resume yet
+    srv.wait_state(run["id"], "waiting_for_client")
+    c = TcpClient(srv.tcp_port)
+    welcome, nodes = handshake(c, run["id"])
+    run_windows(c, welcome, nodes, 3)
+    c.close()
+    info = srv.wait_state(run["id"], "failed")
+    assert info["resumable"] and info["status"] == "failed: client disconnected"
+    r = srv.http.post(f"/runs/{run['id']}/resume")
+    assert r.status_code == 202 and r.json()["resumed"] == 1
+    info = srv.wait_state(run["id"], "waiting_for_client")
+    assert info["t"] == pytest.approx(0.15) and info["windows"] == 3
+    c = WsClient(f"ws://127.0.0.1:{srv.port}/runs/{run['id']}/couple")
+    welcome, nodes = handshake(c, run["id"])
+    assert welcome.t_start == pytest.approx(0.15)
+    results = run_windows(c, welcome, nodes, 2, t0=0.15, amplitude=0.1)
+    assert results[-1].t == pytest.approx(0.25)
+    bye(c)
+    info = srv.wait_state(run["id"], "finished")
+    assert info["windows"] == 5 and info["steps"] == 250 and not info["resumable"]
+    # the resumed engine started from the saved boundary values (eta = 0.03 in force at 0.15)
+    _, _, eta = np.array(engines[1].imposed).T
+    np.testing.assert_allclose(eta[:50], 0.03 + (0.1 - 0.03) * np.arange(1, 51) / 50)
+    rows = srv.http.get(f"/runs/{run['id']}/gauges", params={"format": "json"}).json()["rows"]
+    assert [r["t"] for r in rows] == pytest.approx([0.05, 0.1, 0.15, 0.2, 0.25])
