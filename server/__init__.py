@@ -12,6 +12,7 @@ HTTP (OpenAPI docs at /docs):
     GET    /runs/{id}/gauges        ?format=csv|json
     GET    /runs/{id}/events        Server-Sent Events, one `progress` event per change
     DELETE /runs/{id}               cancel (data so far kept)
+    POST   /runs/{id}/resume        a failed/cancelled coupled run continues from its saved state
 Coupling: WebSocket /runs/{id}/couple, or the TCP port; frames of protocol/PROTOCOL.md.
 
 Python entry point: ``server.main.create_app(settings, engine_factory=None)``; the coupled

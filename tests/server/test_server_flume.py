@@ -91,3 +91,34 @@ def test_flume_refuses_boundary_data_outside_the_tank(tmp_path):
         assert exc.value.code is ErrorCode.BAD_VALUE
         info = srv.wait_state(run["id"], "failed")
         assert "outside the tank" in info["status"]
+
+
+def test_resumed_flume_continues_exactly(tmp_path):
+    """Disconnect after 2 windows, resume, 2 more: the same as 4 windows without a break."""
+    body = {"scene": FLUME, "mode": "coupled", "coupling": {"window_max": WINDOW}}
+    got = []
+    with live_server(tmp_path) as srv:
+        run = srv.http.post("/runs", json=body).json()
+        for session in range(2):
+            srv.wait_state(run["id"], "waiting_for_client", timeout=120)
+            c = TcpClient(srv.tcp_port, timeout=120)
+            welcome, nodes = handshake(c, run["id"])
+            t = welcome.t_start
+            for _ in range(2):
+                got.append(c.request(Set(t, t + WINDOW, *airy(nodes.x, nodes.z, t + WINDOW)), Solve(),
+                                     expect=Result))
+                t += WINDOW
+            c.close()
+            assert srv.wait_state(run["id"], "failed")["resumable"]
+            if session == 0:
+                assert srv.http.post(f"/runs/{run['id']}/resume").status_code == 202
+    assert (tmp_path / "runs" / run["id"] / "sph.1" / "probes.csv").exists()  # nothing overwritten
+    engine = FlumeEngine(RunRequest.model_validate(body), None)
+    t = 0.0
+    for res in got:
+        engine.set_window(t, t + WINDOW, *airy(nodes.x, nodes.z, t + WINDOW))
+        m = engine.solve_window()
+        t += WINDOW
+        assert res.steps == m.steps
+        np.testing.assert_allclose(res.eta, np.where(m.wet, m.eta, 0.0), rtol=1e-12, atol=1e-15)
+    engine.close()

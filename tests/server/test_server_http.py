@@ -167,3 +167,24 @@ def test_settings_from_environment(tmp_path):
     assert s.max_runs == 3 and s.tcp_port is None and s.port == 9999 and s.runs_dir == tmp_path
     with pytest.raises(ValidationError, match="max_runs"):
         Settings.from_env({"WAVESPH_MAX_RUNS": "zero"})
+
+
+def test_run_interrupted_by_a_server_stop_resumes_after_restart(tmp_path, factory):
+    with live_server(tmp_path, factory) as srv:
+        run = srv.create()
+        srv.wait_state(run["id"], "waiting_for_client")
+        c = TcpClient(srv.tcp_port)
+        welcome, nodes = handshake(c, run["id"])
+        run_windows(c, welcome, nodes, 2)
+    # the server stopped under the connected client: the run says so, and kept its state
+    with live_server(tmp_path, factory) as srv:
+        info = srv.http.get(f"/runs/{run['id']}").json()
+        assert info["status"] == "failed: server stopped before the run ended" and info["resumable"]
+        assert srv.http.post(f"/runs/{run['id']}/resume").status_code == 202
+        srv.wait_state(run["id"], "waiting_for_client")
+        c = TcpClient(srv.tcp_port)
+        welcome, nodes = handshake(c, run["id"])
+        assert welcome.t_start == pytest.approx(0.1)
+        run_windows(c, welcome, nodes, 1, t0=0.1)
+        bye(c)
+        assert srv.wait_state(run["id"], "finished")["windows"] == 3
