@@ -2,7 +2,8 @@
 
 Questions: (1) how far is the model's linear phase speed from Nwogu's relation and from Airy
 at kd = 0.5, 1, 2, 3; (2) does a solitary wave (H/d = 0.1, 50 depths) keep its height and speed;
-(3) how many grid-point updates per second does a step do (4000-point flume, regular waves,
+(3) how close are the harmonics over the measured bar of Dingemans (1994); (4) how many
+grid-point updates per second does a step do (4000-point flume, regular waves,
 corrector iterations included)? Anchor: FUNWAVE-TVD (Fortran, serial, -O3) does 2.2e5 point
 updates/s on a 4000-point 1D flume on this machine kind; goal >= 1e7.
 
@@ -13,11 +14,12 @@ from __future__ import annotations
 
 import json
 import time
+from pathlib import Path
 
 import numpy as np
 
 from wave_client.boussinesq import BoussinesqModel, airy_celerity, nwogu_celerity
-from wave_client.boussinesq.checks import solitary_run, standing_wave_speed
+from wave_client.boussinesq.checks import compare_with_measurement, solitary_run, standing_wave_speed
 
 FUNWAVE_TVD_ANCHOR = 2.2e5  # point updates/s, serial Fortran -O3, 4000-point 1D flume
 GOAL = 1e7
@@ -49,6 +51,17 @@ def solitary() -> None:
              speed_rel_error_vs_profile=speed / r["c_profile"] - 1, c_profile=r["c_profile"])
 
 
+def dingemans() -> None:
+    root = Path(__file__).resolve().parents[1]
+    r = compare_with_measurement(root / "examples" / "waves" / "dingemans.toml",
+                                 root / "tests" / "data" / "dingemans_1994_gauges.csv", still_level=0.8)
+    for x, cm, cd in zip(r["x"], r["model"], r["measured"]):
+        emit(bench="boussinesq_dingemans_bar", gauge_x_m=x,
+             measured_harmonics_mm=[round(v, 3) for v in np.abs(cd) * 1e3],
+             model_harmonics_mm=[round(v, 3) for v in np.abs(cm) * 1e3],
+             model_over_measured=[round(v, 4) for v in np.abs(cm) / np.abs(cd)])
+
+
 def throughput(nodes: int = 4000, steps: int = 2000, repeats: int = 5) -> None:
     depth, period, dx = 1.0, 3.0, 0.05
     m = BoussinesqModel(0.0, (nodes - 1) * dx, dx, depth, sponge_left=10.0, sponge_right=10.0)
@@ -70,4 +83,5 @@ def throughput(nodes: int = 4000, steps: int = 2000, repeats: int = 5) -> None:
 if __name__ == "__main__":
     dispersion()
     solitary()
+    dingemans()
     throughput()

@@ -10,6 +10,7 @@ import pytest
 
 from wave_client import waves_cli
 from wave_client.boussinesq import nwogu_wavenumber
+from wave_client.boussinesq.checks import compare_with_measurement
 from wave_client.boussinesq.run import run_scene
 from wave_client.boussinesq.scene import SceneError, WaveScene, build_model, load_scene
 
@@ -172,3 +173,25 @@ def test_submerged_bar_long_run_reaches_a_steady_periodic_state(tmp_path):
     amps = [np.array([harmonic_amplitudes(t[w], eta[w, j], [omega, 2 * omega, 3 * omega])
                       for j in range(eta.shape[1])]) for w in windows]
     np.testing.assert_allclose(amps[1], amps[0], atol=0.02 * 0.01)
+
+
+DINGEMANS = ROOT / "examples" / "waves" / "dingemans.toml"
+DINGEMANS_DATA = ROOT / "tests" / "data" / "dingemans_1994_gauges.csv"
+
+
+def test_dingemans_bar_against_measurements():
+    """The measured bar (Dingemans 1994, Beji & Battjes at scale 2; tests/data header). Criteria
+    fixed beforehand from the model's range of validity: the primary wave's amplitude within 15 %
+    at every gauge and its phase (relative to gauge 1) within 0.3 rad, i.e. 1 % of the ~30 rad of
+    travel; the 2nd harmonic within 15 % on and just behind the bar (x = 20-30 m), where its kd
+    is at most ~1.7. Not asserted: the 2nd harmonic before the bar (the linear source emits a
+    small free 2nd harmonic that the experiment's wavemaker suppressed) and the released 3rd
+    harmonic in 0.8 m behind the bar (kd ~ 3.5, outside Nwogu's dispersion range); the bench and
+    examples/waves/compare_dingemans.py report them."""
+    r = compare_with_measurement(DINGEMANS, DINGEMANS_DATA, still_level=0.8)
+    model, measured, xs = r["model"], r["measured"], np.array(r["x"])
+    np.testing.assert_allclose(np.abs(model[:, 0]), np.abs(measured[:, 0]), rtol=0.15)
+    rel_phase = np.angle(model[:, 0] / model[0, 0]) - np.angle(measured[:, 0] / measured[0, 0])
+    assert np.all(np.abs(np.angle(np.exp(1j * rel_phase))) < 0.3)
+    bar = (xs > 20) & (xs < 31)
+    np.testing.assert_allclose(np.abs(model[bar, 1]), np.abs(measured[bar, 1]), rtol=0.15)

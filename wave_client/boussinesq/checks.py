@@ -66,3 +66,55 @@ def solitary_run(height_ratio: float = 0.1, depth: float = 1.0, distance: float 
         rec[i] = (m.t, m.x[j] - a1 / (2 * a2), a0 - a1 * a1 / (4 * a2))
     return {"t": rec[:, 0], "x": rec[:, 1], "height": rec[:, 2], "c": c, "c_profile": c_profile,
             "H": height, "d": d}
+
+
+def harmonics(t: np.ndarray, y: np.ndarray, omega: float, n: int = 3) -> np.ndarray:
+    """Complex amplitudes A_k e^{i phi_k}, k = 1..n, of y = mean + sum A_k cos(k omega t - phi_k)
+    by least squares (any record length; whole periods are not needed)."""
+    t = np.asarray(t, float)
+    cols = [f(k * omega * t) for k in range(1, n + 1) for f in (np.cos, np.sin)] + [np.ones_like(t)]
+    c, *_ = np.linalg.lstsq(np.column_stack(cols), np.asarray(y, float), rcond=None)
+    return c[0:-1:2] + 1j * c[1:-1:2]
+
+
+def read_gauge_csv(path) -> tuple[np.ndarray, np.ndarray, list[str]]:
+    """(time, values[:, gauge], column names) of a gauge CSV ('#' comments, one header row)."""
+    lines = [ln for ln in open(path, encoding="utf-8").read().splitlines() if ln and not ln.startswith("#")]
+    header = lines[0].split(",")
+    data = np.array([[float(v) for v in ln.split(",")] for ln in lines[1:]])
+    return data[:, 0], data[:, 1:], header[1:]
+
+
+def compare_with_measurement(scene_path, data_path, still_level: float, periods: int = 6,
+                             progress: bool = False) -> dict:
+    """Run a regular-wave `wavesph waves` scene and fit harmonics 1-3 at its gauges, for the model
+    (its last `periods` periods) and for a measured record (gauge CSV in the scene's gauge order,
+    levels above the floor: `still_level` is subtracted).
+
+    Returns {"x": gauge positions, "model": (gauges, 3) complex amplitudes [m], "measured": same,
+    "t_model", "eta_model", "t_measured", "eta_measured"}.
+    """
+    import tempfile
+    from pathlib import Path
+
+    from .run import run_scene
+    from .scene import load_scene
+
+    scene_path = Path(scene_path)
+    scene = load_scene(scene_path)
+    period = scene.wave.period
+    omega = 2 * np.pi / period
+    with tempfile.TemporaryDirectory() as tmp:
+        csv = Path(tmp) / "model.csv"
+        run_scene(scene, csv, base_dir=scene_path.parent, progress=progress)
+        tm, em, _ = read_gauge_csv(csv)
+    td, ed, _ = read_gauge_csv(data_path)
+    ed = ed - still_level
+    if ed.shape[1] != len(scene.gauges.x):
+        raise ValueError(f"{data_path}: {ed.shape[1]} gauge columns, the scene has {len(scene.gauges.x)}")
+    keep = tm > tm[-1] - periods * period
+    tm, em = tm[keep], em[keep]
+    model = np.array([harmonics(tm, em[:, j], omega) for j in range(em.shape[1])])
+    measured = np.array([harmonics(td, ed[:, j], omega) for j in range(ed.shape[1])])
+    return {"x": list(scene.gauges.x), "model": model, "measured": measured, "period": period,
+            "t_model": tm, "eta_model": em, "t_measured": td, "eta_measured": ed}
