@@ -28,6 +28,7 @@ from .messages import (Bye, Error, Get, GetNodes, GoBack, Hello, Message, Nodes,
 from .wire import MAX_TEXT, NO_SCENE_HASH, Capability
 
 TIME_RTOL = 1e-9  # relative tolerance when matching window times to the SPH clock
+HELLO_LIMIT = 4 + 32 + 2 * (4 + MAX_TEXT)  # largest payload before WELCOME: a HELLO
 
 
 class State(Enum):
@@ -116,7 +117,7 @@ class SphSession:
     def max_payload(self) -> int:
         """Largest payload the client may send now: before HELLO only a small one."""
         if self.state is State.AWAIT_HELLO:
-            return 4 + 32 + 2 * (4 + MAX_TEXT)
+            return HELLO_LIMIT
         return self.client_limit
 
     # -- incoming ---------------------------------------------------------------------------

@@ -295,9 +295,6 @@ class RunManager:
         run.attached.set()
         return run
 
-    def snapshot(self, run: Run) -> dict[str, Any]:
-        return run.info.model_dump(mode="json")
-
 
 async def _first_of(a: asyncio.Event, b: asyncio.Event, timeout: float) -> asyncio.Event | None:
     """Whichever event is set first, or None after ``timeout`` seconds."""

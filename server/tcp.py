@@ -6,14 +6,13 @@ import asyncio
 import logging
 
 from protocol import ErrorCode, Hello, ProtocolError
+from protocol.session import HELLO_LIMIT
 
 from .coupling import error_frame, serve_client
 from .runs import RunManager
 from .transports import TcpTransport
 
 log = logging.getLogger("wavesph.server")
-
-HELLO_LIMIT = 4 + 32 + 2 * (4 + 4096)
 
 
 async def start_tcp_server(manager: RunManager, host: str, port: int) -> asyncio.base_events.Server:

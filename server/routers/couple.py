@@ -7,10 +7,10 @@ import asyncio
 from fastapi import APIRouter, WebSocket
 
 from protocol import ErrorCode, Hello, ProtocolError
+from protocol.session import HELLO_LIMIT
 
 from ..coupling import error_frame, serve_client
 from ..deps import websocket_token_ok
-from ..tcp import HELLO_LIMIT
 from ..transports import WebSocketTransport
 
 router = APIRouter(tags=["coupling"])
