@@ -28,6 +28,7 @@ def test_satisfies_wave_model_contract():
     m, _ = flume(0.5, 2.0, -3, 6)
     assert isinstance(m, WaveModel)
     assert m.depth == pytest.approx(0.5)
+    assert m.reference_level == pytest.approx(-0.531 * 0.5)
     m.advance_to(1.0)
     assert m.t == 1.0
     u, w = m.velocity(1.0, np.linspace(-0.5, 0.1, 7))

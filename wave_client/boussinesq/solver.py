@@ -188,6 +188,12 @@ class BoussinesqModel:
         """Model time [s]."""
         return self._t
 
+    @property
+    def reference_level(self) -> float:
+        """z_alpha = beta h [m] (up from still water) at the coupling point: the level at which SPH
+        should measure the u_ref handed to `impose` (protocol WELCOME.z_ref)."""
+        return self.beta * self.depth
+
     def depth_at(self, x: ArrayLike) -> np.ndarray:
         """Still-water depth h(x) [m] of the piecewise-linear bathymetry."""
         return np.interp(np.asarray(x, float), self._bx, self._bd)
