@@ -129,6 +129,7 @@ class OpenFlume(Simulation):
             p[ob.OB_ZBED] = nd.z_bed
             p[ob.OB_ZTOP] = nd.z_top
             p[ob.OB_DZG] = 0.25 * dp
+            p[ob.OB_DP] = dp
             self.zn[b] = nd.z
             # the wall columns outside this face (above the floor) become the buffer lattice
             sel = np.nonzero((kind == WALL) & ((x - nd.x_face) * nx > 0) & (z > tank.z0))[0]

@@ -12,10 +12,14 @@ interpolated linearly in time and linearly in z between the nodes):
     active (interacts as fluid) iff z_i < z_s,b;  rho_i = rho0 (1 + rho0 g (z_s,b - z_i)/B)^(1/7)
     (hydrostatic below the imposed or measured surface; Tait EOS, same form as the initial state).
 Crossings (d: depth into the buffer, counted per end so that mass balance is exact):
-    fluid with d >= 0            -> buffer                         (counter OUT)
+    fluid with d >= 0 where the imposed flow leaves (u n_x > 0), or with d >= dp
+                                 -> buffer                         (counter OUT)
     active buffer with d < 0     -> fluid, new buffer particle at x + n_x L, same z (IN, CREATED)
     idle buffer with d < 0       -> removed (it is above the surface), replaced as above (REMOVED)
     buffer with d >= L           -> removed (slot INACTIVE, dropped at the next sort) (REMOVED)
+The condition on fluid entering against an inflow stops a particle at the face from bouncing
+between fluid and buffer: every bounce would clone it at the far end (a net particle created
+each time), and the clones pile up into clumps that blow the inflow up.
 The measured elevation comes from a gauge a short distance inside the face: the vertical-line
 method (seed 004, second method), surface where sum_j m_j W falls below rho0/2, fluid and
 active buffer particles counted; NaN when dry (then no correction, imposed surface used).
@@ -47,8 +51,8 @@ STATUS_TEXT = {ST_CAPACITY: "particle capacity exhausted by open-boundary inflow
 
 # per-end parameters obp[b, :]
 (OB_ON, OB_XF, OB_NX, OB_LEN, OB_SWL, OB_SQGD, OB_ABSORB, OB_IMPOSED, OB_XG, OB_ZBED, OB_ZTOP,
- OB_DZG) = range(12)
-N_OBP = 12
+ OB_DZG, OB_DP) = range(13)
+N_OBP = 13
 # per-end counters[b, :]
 C_IN, C_OUT, C_CREATED, C_REMOVED = range(4)
 N_COUNTERS = 4
@@ -144,7 +148,8 @@ def buffer_update(f, kind, n, dt, r, zs0, du0, zs1, du1, zn, win_u, win_w, prm):
 
 
 @njit(cache=True)
-def buffer_transitions(f, kind, ids, n, capacity, obp, zs0, zs1, counters, next_id):
+def buffer_transitions(f, kind, ids, n, capacity, obp, r, zs0, du0, zs1, du1, zn, win_u,
+                       counters, next_id):
     """Convert particles crossing a face, spawn and remove buffer particles (serial: appends).
 
     Returns the new slot count, or -1 if the capacity is exhausted."""
@@ -154,10 +159,14 @@ def buffer_transitions(f, kind, ids, n, capacity, obp, zs0, zs1, counters, next_
         k = kind[i]
         if k == FLUID:
             for b in range(2):
-                if obp[b, OB_ON] > 0.5 and (f[X, i] - obp[b, OB_XF]) * obp[b, OB_NX] >= 0.0:
-                    zs = zs0 if b == 0 else zs1
-                    kind[i] = INLET + b if f[Z, i] < zs else INLET_IDLE + b
-                    counters[b, C_OUT] += 1
+                nx = obp[b, OB_NX]
+                d = (f[X, i] - obp[b, OB_XF]) * nx
+                if obp[b, OB_ON] > 0.5 and d >= 0.0:
+                    u = profile_value(zn[b], win_u[b], r, f[Z, i]) + (du0 if b == 0 else du1)
+                    if u * nx > 0.0 or d >= obp[b, OB_DP]:
+                        zs = zs0 if b == 0 else zs1
+                        kind[i] = INLET + b if f[Z, i] < zs else INLET_IDLE + b
+                        counters[b, C_OUT] += 1
                     break
             continue
         b = _end_of(k)
@@ -277,7 +286,8 @@ def advance_open(f, f2, kind, kind2, ids, ids2, cell, cell2, order, cell_start, 
         zs0, du0 = boundary_state(0, r, obp, win_eta, win_etag, eta_meas)
         zs1, du1 = boundary_state(1, r, obp, win_eta, win_etag, eta_meas)
         buffer_update(f, kind, n, dts, r, zs0, du0, zs1, du1, zn, win_u, win_w, prm)
-        n_new = buffer_transitions(f, kind, ids, n, capacity, obp, zs0, zs1, counters, next_id)
+        n_new = buffer_transitions(f, kind, ids, n, capacity, obp, r, zs0, du0, zs1, du1, zn,
+                                   win_u, counters, next_id)
         if n_new < 0:
             status = ST_CAPACITY
             n_flag = n

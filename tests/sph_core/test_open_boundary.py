@@ -77,9 +77,9 @@ def test_oscillating_flow_crosses_both_ways_with_exact_mass_balance():
     ids = ps.ids[: ps.n][ps.kind[: ps.n] >= 0]
     assert np.unique(ids).size == ids.size  # identity kept across creation and removal
     assert ps.capacity == capacity  # no reallocation
-    # buffer particles stay inside their buffers, fluid inside the tank
+    # fluid pushed into a buffer against its inflow stays fluid for at most dp
     st = fl.fluid_state()
-    assert st["x"].min() >= 0.0 and st["x"].max() <= sc.tank.x1
+    assert st["x"].min() >= -DP and st["x"].max() <= sc.tank.x1 + DP
 
 
 @pytest.mark.parametrize("bad, match", [
