@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from conftest import live_server
+from server_harness import live_server
 
 ROOT = Path(__file__).resolve().parents[2]
 SOURCE = ROOT / "examples" / "c_client" / "wsph_client.c"

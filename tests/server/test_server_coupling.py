@@ -14,7 +14,7 @@ from protocol import (ErrorCode, GoBack, Hello, RemoteError, Result, Set,
                       Solve, scene_hash)
 from protocol.wire import HEADER, MAGIC, MessageType
 
-from conftest import live_server
+from server_harness import live_server
 from coupling_client import TcpClient, WsClient, bye, handshake, run_windows
 
 

@@ -16,7 +16,7 @@ from server.flume_engine import FlumeEngine
 from server.main import create_app  # noqa: F401  (default engine factory: the flume)
 from server.schemas import RunRequest
 
-from conftest import live_server
+from server_harness import live_server
 from coupling_client import TcpClient, bye, handshake
 
 G, DEPTH, H, T, WINDOW = 9.81, 0.3, 0.02, 1.0, 0.05

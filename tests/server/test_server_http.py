@@ -13,7 +13,7 @@ from pydantic import ValidationError
 from server.main import create_app
 from server.settings import Settings
 
-from conftest import live_server, scene
+from server_harness import live_server, scene
 from coupling_client import TcpClient, bye, handshake, run_windows
 
 
