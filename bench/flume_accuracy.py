@@ -51,7 +51,8 @@ def run(theory: str, height: float, period: float, depth: float, dp: float, peri
         wavelength = float(model.length)
     out = flume_case(model, height=height, period=period, depth=depth, wavelength=wavelength,
                      dp=dp, periods=periods, ramp=ramp, standing=theory == "standing",
-                     absorb=(absorb, absorb), name=f"flume_{case or theory}")
+                     absorb=(absorb, absorb), regular=theory != "irregular",
+                     name=f"flume_{case or theory}")
     return {"case": case, "theory": theory, **out}
 
 
@@ -70,7 +71,8 @@ def main(argv: list[str] | None = None) -> int:
     a = ap.parse_args(argv)
     if a.case:
         row = read_cases()[a.case]
-        theory, height, period, depth = row["theory"], float(row["H"]), float(row["T"]), float(row["d"])
+        theory = row["theory"]
+        height, period, depth = float(row["H"]), float(row["T"]), float(row["d"])
     elif a.theory and a.H and a.T and a.d:
         theory, height, period, depth = a.theory, a.H, a.T, a.d
         if theory.startswith("stokes") and theory not in THEORY_OF:

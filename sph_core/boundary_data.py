@@ -2,7 +2,7 @@
 
     nodes = BoundaryNodes(side="left", x_face=0.0, z=z_levels, z_bed=0.0, z_top=1.5)
     src = WaveModelBoundary(model, nodes, still_water_level=1.0, x_model=0.0)   # in-process theory
-    src = WindowBoundary(nodes)                                                  # pushed by a socket
+    src = WindowBoundary(nodes, still_water_level=1.0)                           # pushed windows
     s = src.sample(t)          # BoundarySample(t, u, w, eta, eta_gauge), validated
 
 A source is any object with ``nodes`` and ``sample(t) -> BoundarySample``. The solver samples it
@@ -49,7 +49,8 @@ class BoundaryNodes:
         z = np.ascontiguousarray(self.z, dtype=float)
         object.__setattr__(self, "z", z)
         if z.ndim != 1 or z.size < 2:
-            raise BoundaryDataError(f"z: need a 1-D array of at least 2 levels, got shape {z.shape}")
+            raise BoundaryDataError(f"z: need a 1-D array of at least 2 levels, got shape "
+                                    f"{z.shape}")
         if not np.all(np.isfinite(z)) or not np.all(np.diff(z) > 0):
             raise BoundaryDataError("z: levels must be finite and strictly increasing")
         if not self.z_top > self.z_bed:

@@ -63,8 +63,9 @@ class OpenFlume(Simulation):
         if "right" in {o.side for o in scene.open_boundaries} and abs(cells - round(cells)) > 1e-6:
             # the right buffer continues the fluid lattice laid out from x0: a partial spacing
             # would leave a gap (or an overlap) of particles at the face
-            raise ValueError(f"tank.x1: x1 - x0 = {scene.tank.x1 - scene.tank.x0} m must be a whole "
-                             f"number of particle spacings dp = {scene.dp} m with a right open end")
+            raise ValueError(f"tank.x1: x1 - x0 = {scene.tank.x1 - scene.tank.x0} m must be a "
+                             f"whole number of particle spacings dp = {scene.dp} m with a right "
+                             "open end")
         super().__init__(scene, run_dir=run_dir, spare=spare)
         self.window = float(window)
         self.open_sides = tuple(o.side for o in scene.open_boundaries)
@@ -164,7 +165,8 @@ class OpenFlume(Simulation):
                 self.win_etag[b, lv] = s.gauge_eta
 
     # ---------------------------------------------------------------- driving
-    def advance_to(self, t_end: float, progress: Callable[[Simulation], None] | None = None) -> None:
+    def advance_to(self, t_end: float,
+                   progress: Callable[[Simulation], None] | None = None) -> None:
         """Advance to ``t_end`` [s] in windows of ``self.window``, sampling every source at each
         window end (sides without a source keep the data of the last window)."""
         if not math.isfinite(t_end):
@@ -195,10 +197,10 @@ class OpenFlume(Simulation):
                     if s is not None:
                         raise BoundaryDataError(f"{side}: the flume has no open boundary there")
                     continue
-                if s is None:
+                if s is None:  # the side's source, else the data of the last window held
+                    last = self._samples[side]
                     s = (self.sources[side].sample(t1) if side in self.sources
-                         else BoundarySample(t1, self._samples[side].u, self._samples[side].w,
-                                             self._samples[side].eta, self._samples[side].eta_gauge))
+                         else BoundarySample(t1, last.u, last.w, last.eta, last.eta_gauge))
                 end[side] = validate_sample(s, self.nodes[side], self.swl, where=side)
                 if abs(end[side].t - t1) > 1e-9 * max(1.0, abs(t1)):
                     raise BoundaryDataError(f"{side}.t: sample at t = {end[side].t} for a window "

@@ -17,10 +17,10 @@ import numpy as np
 
 
 def rmse_over_height(eta: np.ndarray, eta_theory: np.ndarray, height: float) -> float:
-    """sqrt(mean((eta - eta_theory)^2)) / H over the samples where both are finite.
+    """sqrt(mean((eta - eta_theory)^2)) / H.
 
-    A dry sample (NaN) where the theory is wet counts as a miss of the full theoretical value
-    above the bed would be arbitrary, so dry samples raise instead: a gauge mid-flume must be wet."""
+    A dry sample (NaN) has no elevation to compare, and any stand-in value would be arbitrary:
+    dry or non-finite samples raise ValueError (a gauge mid-flume must stay wet)."""
     eta = np.asarray(eta, dtype=float)
     eta_theory = np.asarray(eta_theory, dtype=float)
     if eta.shape != eta_theory.shape or eta.size == 0:

@@ -113,14 +113,15 @@ def run_wave_flume(scene: Scene, model: Any, *, window: float, x_model_left: flo
 def flume_case(model: Any, *, height: float, period: float, depth: float, wavelength: float,
                dp: float, periods: float, ramp: float, standing: bool = False,
                absorb: tuple[bool, bool] = (True, True), window_per_period: int = 50,
-               name: str = "wave_flume", **constants: Any) -> dict[str, Any]:
+               regular: bool = True, name: str = "wave_flume", **constants: Any) -> dict[str, Any]:
     """Run one wave case and score it: the figures of ``bench/flume_accuracy.py``.
 
     Flume one wavelength long (standing wave: half, faces at the nodes of eta, antinode
     mid-flume); ``model`` must carry the start-up ramp of duration ``ramp``. rmse_over_H: the
     mid-flume gauge vs the model over the ``periods`` after the ramped wave reached mid-flume
     (at the linear group velocity); reflection: least squares
-    over the gauges at mid-flume and L/8 either side (None for a standing wave)."""
+    over the gauges at mid-flume and L/8 either side (None for a standing wave or an irregular
+    sea, ``regular=False``, whose ``wavelength`` and ``period`` are those of the peak)."""
     length = 0.5 * wavelength if standing else wavelength
     # the ramp starts the model everywhere at once, SPH's wave front travels from the inlet:
     # compare once the fully ramped wave has reached mid-flume at the (linear) group velocity
@@ -136,7 +137,7 @@ def flume_case(model: Any, *, height: float, period: float, depth: float, wavele
     res = run_wave_flume(scene, model, window=period / window_per_period, x_model_left=x_left)
     sel = res.t >= t_start - 1e-9
     refl = None
-    if not standing:
+    if regular and not standing:
         names = ["refl_a", "mid", "refl_b"]
         refl, _, _ = reflection_coefficient(
             res.t[sel], np.array([res.eta[n][sel] for n in names]),

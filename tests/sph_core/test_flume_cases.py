@@ -51,11 +51,14 @@ def test_case_table_wavelengths_are_linear_dispersion():
 
 
 def test_case_V_coarse_flume_generates_the_wave():
-    """H/dp = 3 over 2 periods after a 1-period ramp: a coarse check that the inlet makes the
-    right wave and the outlet lets it out (the accuracy goal is for H/dp >= 10, below)."""
-    res = run_case("V", dp=0.02, periods=2.0)
-    assert res["rmse_over_H"] < 0.15, res
-    assert res["reflection"] < 0.25, res
+    """H/dp = 3, one period measured after a 1-period ramp and the travel to mid-flume: a coarse
+    check that the inlet makes the right wave and the outlet lets it out. Bounds: twice and
+    three times the goals that hold at H/dp >= 10 (5 %, below)."""
+    res = run_case("V", dp=0.02, periods=1.0)
+    assert res["rmse_over_H"] < 0.10, res
+    assert res["reflection"] < 0.15, res
+    counts = res["boundary_counts"]
+    assert res["fluid_change"] == sum(c["in"] - c["out"] for c in counts.values())
 
 
 @pytest.mark.slow
