@@ -1,0 +1,74 @@
+"""The pieces behind the flume figures: the seed 002 correction, the boundary profile
+interpolation, the reflection analysis and the RMSE."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from sph_core import open_boundary as ob
+from sph_core.wave_analysis import reflection_coefficient, rmse_over_height
+
+G, D = 9.81, 0.5
+
+
+def ends(absorb: bool = True, imposed: tuple[bool, bool] = (True, False)) -> np.ndarray:
+    obp = np.zeros((2, ob.N_OBP))
+    for b, nx in enumerate((-1.0, 1.0)):
+        obp[b, ob.OB_ON] = 1.0
+        obp[b, ob.OB_NX] = nx
+        obp[b, ob.OB_SWL] = D
+        obp[b, ob.OB_SQGD] = math.sqrt(G / D)
+        obp[b, ob.OB_ABSORB] = float(absorb)
+        obp[b, ob.OB_IMPOSED] = float(imposed[b])
+        obp[b, ob.OB_ZTOP] = 2 * D
+    return obp
+
+
+def test_seed_002_corrections_have_the_published_signs():
+    """v_in = v_th - (eta_in,meas - eta_th) sqrt(g/d);
+    v_out = v_th - (eta_th - eta_out,meas) sqrt(g/d)."""
+    eta_th = np.array([[0.01, 0.01], [0.02, 0.02]])  # [end, window level]
+    meas = np.array([0.03, 0.05])
+    zs_in, du_in = ob.boundary_state(0, 0.5, ends(), eta_th, eta_th, meas)
+    zs_out, du_out = ob.boundary_state(1, 0.5, ends(), eta_th, eta_th, meas)
+    assert du_in == pytest.approx(-(0.03 - 0.01) * math.sqrt(G / D))
+    assert du_out == pytest.approx(-(0.02 - 0.05) * math.sqrt(G / D))
+    # inlet: imposed surface; outlet: extrapolated (measured) surface
+    assert zs_in == pytest.approx(D + 0.01) and zs_out == pytest.approx(D + 0.05)
+    # correction off, or a dry gauge (NaN): theory only
+    assert ob.boundary_state(0, 0.5, ends(absorb=False), eta_th, eta_th, meas)[1] == 0.0
+    zs, du = ob.boundary_state(1, 0.5, ends(), eta_th, eta_th, np.array([np.nan, np.nan]))
+    assert du == 0.0 and zs == pytest.approx(D + 0.02)
+
+
+def test_profile_is_linear_in_z_and_in_time_and_clamped_at_the_ends():
+    zn = np.array([0.0, 0.1, 0.2])
+    a = np.array([[0.0, 1.0, 2.0], [10.0, 11.0, 12.0]])  # [window level, node]
+    assert ob.profile_value(zn, a, 0.0, 0.05) == pytest.approx(0.5)
+    assert ob.profile_value(zn, a, 0.25, 0.15) == pytest.approx(0.75 * 1.5 + 0.25 * 11.5)
+    assert ob.profile_value(zn, a, 1.0, 0.5) == pytest.approx(12.0)
+    assert ob.profile_value(zn, a, 0.0, -0.1) == pytest.approx(0.0)
+    assert ob.window_weight(1.5, np.array([1.0, 3.0])) == pytest.approx(0.25)
+
+
+@pytest.mark.parametrize("kr", [0.0, 0.2, 0.6])
+def test_reflection_coefficient_recovers_a_known_reflection(kr):
+    period, k, a_i = 2.0, 2 * math.pi / 3.0, 0.03
+    omega = 2 * math.pi / period
+    t = np.arange(0.0, 3 * period, period / 40)
+    xs = np.array([1.0, 1.375, 1.75])
+    etas = np.array([a_i * np.cos(k * x - omega * t) + kr * a_i * np.cos(k * x + omega * t + 0.7)
+                     + 0.002 * np.cos(2 * (k * x - omega * t)) for x in xs])
+    got, inc, ref = reflection_coefficient(t, etas, xs, period, k)
+    assert got == pytest.approx(kr, abs=1e-6)
+    assert inc == pytest.approx(a_i, rel=1e-6)
+
+
+def test_rmse_over_height_and_dry_records():
+    th = np.sin(np.linspace(0, 6, 50))
+    assert rmse_over_height(th + 0.01, th, 0.5) == pytest.approx(0.02)
+    with pytest.raises(ValueError, match="dry"):
+        rmse_over_height(np.where(th > 0.9, np.nan, th), th, 0.5)
