@@ -50,6 +50,7 @@ class Run:
         self.engine: CouplingEngine | None = None
         self.gauges: GaugeWriter | None = None
         self.task: asyncio.Task | None = None
+        self.task_client: asyncio.Task | None = None   # the built-in theory client, if any
         self.client_attached = False
         self.resume_from: Path | None = None
         self._saved_at = 0.0
@@ -106,7 +107,7 @@ class RunManager:
         run.info.state = state
         run.info.reason = reason
         run.info.status = f"{state}: {reason}" if reason and state in (FAILED, UNSTABLE) else state
-        run.info.resumable = (state in (FAILED, CANCELLED) and run.request.mode == "coupled"
+        run.info.resumable = (state in (FAILED, CANCELLED) and _windowed(run.request)
                               and run.state_file.exists())
         if state in TERMINAL:
             run.info.ended = time.time()
@@ -126,7 +127,7 @@ class RunManager:
 
         info = RunInfo(id=run_id, mode=request.mode, state=QUEUED, status=QUEUED, created=time.time(),
                        t_end=request.scene.t_end, scene_hash=scene_hash(scene_bytes).hex(),
-                       gauges_file="gauges.csv" if request.mode == "coupled" else "sph/probes.csv")
+                       gauges_file="gauges.csv" if _windowed(request) else "sph/probes.csv")
         run_dir = self.store.create(run_id, request.model_dump(mode="json"), scene_bytes)
         run = Run(info, request, run_dir)
         self.runs[run_id] = run
@@ -155,7 +156,7 @@ class RunManager:
             run = self.runs[self.queue.popleft()]
             run.info.queue_position = None
             self.active.add(run.info.id)
-            body = self._standalone(run) if run.request.mode == "standalone" else self._coupled(run)
+            body = self._coupled(run) if _windowed(run.request) else self._standalone(run)
             run.task = asyncio.get_running_loop().create_task(body, name=f"run-{run.info.id}")
         self._queue_positions()
 
@@ -266,6 +267,11 @@ class RunManager:
             run.info.windows = run.gauges.rows_kept
             run.info.started = time.time()
             self._set_state(run, WAITING)
+            if run.request.source is not None:  # standalone, driven by a built-in theory client
+                from .theory_source import serve_theory
+
+                self.attach(run.info.id)
+                run.task_client = asyncio.get_running_loop().create_task(serve_theory(self, run))
             woke = await _first_of(run.attached, run.cancelled, self.settings.client_wait_timeout)
             if woke is None:
                 self._set_state(run, FAILED, f"no client connected within "
@@ -294,6 +300,11 @@ class RunManager:
         run.client_attached = True
         run.attached.set()
         return run
+
+
+def _windowed(request: RunRequest) -> bool:
+    """Runs on the coupled path (engine + windows): coupled ones and theory-driven standalone ones."""
+    return request.mode == "coupled" or request.source is not None
 
 
 async def _first_of(a: asyncio.Event, b: asyncio.Event, timeout: float) -> asyncio.Event | None:

@@ -11,6 +11,8 @@ from pydantic import BaseModel, ConfigDict, Field
 from sph_core.geometry import wall_layers
 from sph_core.scene import Scene
 
+from .theory_source import TheorySource
+
 
 class CouplingOptions(BaseModel):
     model_config = ConfigDict(extra="forbid")
@@ -28,8 +30,10 @@ class RunRequest(BaseModel):
     scene: Scene
     mode: Literal["coupled", "standalone"] = Field(
         "coupled", description="coupled: wait for a client on /runs/{id}/couple or the TCP port; "
-                               "standalone: run the scene as it is")
+                               "standalone: run the scene as it is (open ends: driven by `source`)")
     coupling: CouplingOptions = CouplingOptions()
+    source: TheorySource | None = Field(None, description="built-in wave theory driving the open "
+                                                          "ends of a standalone run")
 
 
 class RunInfo(BaseModel):

@@ -13,6 +13,7 @@ from ..deps import Auth, Manager, RunDep
 from ..runs import TERMINAL
 from ..schemas import RunInfo, RunRequest, estimate_particles
 from ..store import read_gauges
+from ..theory_source import source_errors
 
 router = APIRouter(prefix="/runs", tags=["runs"], dependencies=[Auth])
 
@@ -37,10 +38,8 @@ async def create_run(body: RunRequest, manager: Manager) -> RunInfo:
     if body.mode == "coupled" and not body.scene.open_boundaries:
         raise _unprocessable(["body", "scene", "open_boundaries"],
                              "a coupled run needs at least one open end for the client to drive")
-    if body.mode == "standalone" and body.scene.open_boundaries:
-        raise _unprocessable(["body", "mode"],
-                             "standalone runs of scenes with open boundaries (a built-in wave "
-                             "source) are not available yet: use mode 'coupled' with a client")
+    for loc, msg in source_errors(body.scene, body.mode, body.source):
+        raise _unprocessable(["body", *loc], msg)
     return manager.submit(body).info
 
 

@@ -48,8 +48,8 @@ def test_mode_and_open_boundaries_must_agree(srv):
     assert r.status_code == 422
     assert r.json()["detail"][0]["loc"] == ["body", "scene", "open_boundaries"]
     r = srv.http.post("/runs", json={"scene": scene(open_boundaries=[{"side": "left"}]),
-                                     "mode": "standalone"})
-    assert r.status_code == 422 and r.json()["detail"][0]["loc"] == ["body", "mode"]
+                                     "mode": "standalone"})  # open ends need a wave source
+    assert r.status_code == 422 and r.json()["detail"][0]["loc"] == ["body", "source"]
 
 
 def test_concurrency_cap_queues_runs(tmp_path, factory):

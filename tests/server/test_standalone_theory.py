@@ -1,0 +1,86 @@
+"""Standalone runs of open-boundary scenes driven by a built-in theory (server/theory_source.py).
+
+The built-in source must be the coupled path without the socket: the same scene driven by the
+same theory through wave_client's client over a WebSocket gives the same gauges to round-off.
+"""
+
+from __future__ import annotations
+
+import csv
+
+import numpy as np
+import pytest
+
+from wave_client.coupling import CouplingOptions, couple
+from wave_client.theories import build_theory
+
+from server_harness import live_server
+
+DEPTH, H, T, RAMP = 0.3, 0.02, 1.0, 0.5
+FLUME = {"name": "theory-flume", "dp": 0.04, "t_end": 0.3, "still_water_level": DEPTH,
+         "tank": {"x0": 0.0, "x1": 1.2, "z0": 0.0, "z1": 0.45},
+         "water_blocks": [{"x0": 0.0, "x1": 1.2, "z0": 0.0, "z1": DEPTH}],
+         "open_boundaries": [{"side": "left", "elevation": "imposed", "absorb": True},
+                             {"side": "right", "elevation": "extrapolated", "absorb": True}],
+         "probes": [{"kind": "elevation", "name": "g1", "x": 0.6}],
+         "output": {"probe_every": 0.05}}
+SOURCE = {"theory": "stokes", "H": H, "T": T, "order": 2, "ramp_periods": RAMP / T}
+
+
+def rows(path) -> list[list[str]]:
+    with open(path, newline="") as f:
+        return list(csv.reader(f))
+
+
+def test_standalone_theory_run_equals_the_coupled_run(tmp_path):
+    with live_server(tmp_path) as srv:
+        r = srv.http.post("/runs", json={"scene": FLUME, "mode": "standalone", "source": SOURCE})
+        assert r.status_code == 201, r.text
+        alone = srv.wait_state(r.json()["id"], "finished", "failed", "unstable", timeout=120)
+        assert alone["state"] == "finished", alone["status"]
+        r = srv.http.post("/runs", json={"scene": FLUME, "mode": "coupled"})
+        assert r.status_code == 201, r.text
+        run = r.json()
+        srv.wait_state(run["id"], "waiting_for_client", timeout=120)
+        wave = build_theory("stokes", height=H, period=T, depth=DEPTH, order=2, ramp_time=RAMP)
+        report = couple(f"ws://127.0.0.1:{srv.port}/runs/{run['id']}/couple", wave, CouplingOptions(),
+                        timeout=60.0, progress=False, log_path=tmp_path / "client.csv")
+        coupled = srv.wait_state(run["id"], "finished")
+    runs = tmp_path / "runs"
+    a, b = rows(runs / alone["id"] / "gauges.csv"), rows(runs / run["id"] / "gauges.csv")
+    # T/50 windows (the client's default, below window_max) up to t_end
+    assert alone["windows"] == coupled["windows"] == len(report.records) == 15
+    assert a[0] == b[0] and len(a) == len(b) == 16
+    va = np.array([[float(v) for v in r] for r in a[1:]])
+    vb = np.array([[float(v) for v in r] for r in b[1:]])
+    assert np.all(np.isfinite(va)) and np.ptp(va[:, 2]) > 1e-3  # the inlet gauge saw the wave rise
+    np.testing.assert_allclose(va, vb, rtol=1e-12, atol=1e-15)
+    # the source's theory log holds the model's elevation at the gauges, as the client's does
+    ta = rows(runs / alone["id"] / "theory.csv")
+    tb = rows(tmp_path / "client.csv")
+    model_a = [r for r in ta if not r[0].startswith("#")]
+    model_b = [r for r in tb if not r[0].startswith("#")]
+    col = model_a[0].index("eta_model_2")
+    np.testing.assert_allclose([float(r[col]) for r in model_a[1:]],
+                               [float(r[col]) for r in model_b[1:]], rtol=1e-12, atol=1e-15)
+    assert alone["particles"] == coupled["particles"] and alone["steps"] == coupled["steps"]
+
+
+@pytest.mark.parametrize("change, loc", [
+    ({"source": None}, ["body", "source"]),
+    ({"source": {**SOURCE, "H": 0.5}}, ["body", "source", "H"]),          # breaks at d = 0.3 m
+    ({"source": {**SOURCE, "order": 9}}, ["body", "source", "order"]),
+    ({"source": {**SOURCE, "theory": "linear"}}, ["body", "source", "order"]),  # linear has none
+    ({"source": {**SOURCE, "T": -1.0}}, ["body", "source", "T"]),
+    ({"source": {**SOURCE, "colour": 1}}, ["body", "source", "colour"]),
+    ({"source": {**SOURCE, "theory": "cnoidal"}}, ["body", "source", "theory"]),
+    ({"mode": "coupled"}, ["body", "source"]),                              # a client drives it
+])
+def test_bad_source_is_422_naming_the_field(tmp_path, change, loc):
+    body = {"scene": FLUME, "mode": "standalone", "source": SOURCE, **change}
+    if body["source"] is None:
+        del body["source"]
+    with live_server(tmp_path) as srv:
+        r = srv.http.post("/runs", json=body)
+    assert r.status_code == 422, r.text
+    assert r.json()["detail"][0]["loc"] == loc, r.text
