@@ -13,7 +13,8 @@ import sys
 
 # name -> (module, one-line help)
 COMMANDS: dict[str, tuple[str, str]] = {
-    "demo": ("sph_core.demo_cli", "run the coupled demo on embedded defaults"),
+    "demo": ("server.demo_cli", "coupled wave-SPH flume with a beach on embedded defaults "
+                                "(--dambreak: the standalone dam break)"),
     "run": ("sph_core.cli", "run an SPH scene (TOML) standalone"),
     "serve": ("server.cli", "start the SPH coupling server (HTTP + WebSocket + TCP)"),
     "couple": ("wave_client.couple_cli", "couple a wave model to a running server"),

@@ -1,0 +1,299 @@
+"""`wavesph demo`: a coupled wave-SPH flume with a beach, end to end on this machine.
+
+Starts the SPH server in this process on free loopback ports, creates a coupled run of a short
+2D flume (open inlet on the left, flat bed, then a 1:10 beach up to a closed right end), connects
+wave_client's coupling client with a regular second-order Stokes wave over the real socket
+(WebSocket, or TCP with ``--transport tcp``), shows the client's progress bar, and writes into
+the run directory (default ./runs/demo-<UTC time>):
+
+    <run id>/            the server's run record: meta.json, gauges.csv (SPH-measured), sph/...
+    client_gauges.csv    the client's log: measured and theoretical elevation per window
+    elevation.png        SPH-measured vs theoretical elevation at the gauges, and the flume
+    summary.json         the figures printed at the end
+
+Datum: the flume floor is z = 0, still water at z = depth_for(dp) (0.24 m); elevations are up from it.
+The standalone dam break of earlier versions: ``wavesph demo --dambreak`` (or
+``wavesph run examples/scenes/dambreak_martin_moyce.toml``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import sys
+import threading
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+# the embedded case: depth d, regular wave (H, T), beach slope
+DEPTH = 0.24          # still-water depth on the flat bed [m] (rounded to whole dp: depth_for)
+HEIGHT = 0.04         # wave height [m]
+PERIOD = 1.4          # wave period [s]; L = 2.0 m at this depth (Stokes 2, Ursell ~ 11)
+SLOPE = 0.1           # 1:10 beach
+X_TOE = 2.0           # beach toe [m]: one wavelength of flat bed after the inlet
+RAMP_PERIODS = 2.0    # start-up ramp of the wave [periods]
+GAUGES = {"flat": 1.0, "toe": X_TOE, "beach": X_TOE + 0.5 * DEPTH / SLOPE}  # x [m]
+
+
+def depth_for(dp: float) -> float:
+    """Still-water depth [m] nearest DEPTH holding whole particle rows: the particles fill whole
+    rows of dp, so any other depth would put the SPH surface up to dp/2 below still water."""
+    return dp * max(4, round(DEPTH / dp))
+
+
+def tank_end(dp: float) -> float:
+    """x [m] of the closed right end: the beach rises 0.1 m past still water (room for run-up)."""
+    return dp * round((X_TOE + (depth_for(dp) + 0.1) / SLOPE) / dp)
+
+
+def demo_scene(dp: float, t_end: float) -> dict[str, Any]:
+    """The flume as a server scene (plain dict, validated by the server)."""
+    d, x1 = depth_for(dp), tank_end(dp)
+    return {
+        "name": "wavesph-demo", "dp": dp, "t_end": t_end, "still_water_level": d,
+        "tank": {"x0": 0.0, "x1": x1, "z0": 0.0, "z1": d + 2 * HEIGHT + 4 * dp},
+        "water_blocks": [{"x0": 0.0, "x1": X_TOE + d / SLOPE, "z0": 0.0, "z1": d}],
+        "beds": [{"points": [[X_TOE, 0.0], [x1, SLOPE * (x1 - X_TOE)]]}],
+        # c0 = 10 sqrt(g d) bounds orbital speeds x10; free slip: the theory is inviscid
+        "constants": {"c0": 10.0 * math.sqrt(9.81 * d), "wall_slip": "free_slip"},
+        "output": {"probe_every": PERIOD / 20},
+        "probes": [{"kind": "elevation", "name": n, "x": x} for n, x in GAUGES.items()],
+        "open_boundaries": [{"side": "left", "elevation": "imposed", "absorb": True}],
+    }
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--t-end", type=float, default=8.0,
+                        help="simulated time [s] (default 8: 2 ramp periods, then ~3 periods "
+                             "of full waves at the flat-bed gauge)")
+    parser.add_argument("--dp", type=float, default=0.02,
+                        help="particle spacing [m] (default 0.02: ~3300 particles, H/dp = 2)")
+    parser.add_argument("--transport", choices=("ws", "tcp"), default="ws",
+                        help="coupling socket: WebSocket (default) or plain TCP")
+    parser.add_argument("--out", type=Path, default=None,
+                        help="run directory (default ./runs/demo-<UTC time>); must be new or empty")
+    parser.add_argument("--no-plot", action="store_true", help="skip the figure")
+    parser.add_argument("--dambreak", action="store_true",
+                        help="run the standalone dam break (Martin & Moyce) instead, as "
+                             "`wavesph run examples/scenes/dambreak_martin_moyce.toml` does")
+    parser.epilog = ("Coupled flume: open inlet, 1:10 beach, Stokes-2 wave H = 0.04 m, T = 1.4 s, "
+                     "depth 0.24 m, coupled over a real socket to an in-process server.")
+
+
+def main(args: argparse.Namespace) -> int:
+    # numba's OpenMP threads spin while waiting by default: on a busy machine (more runnable
+    # threads than cores) a step then costs 10-20x more. Passive waiting costs little otherwise.
+    os.environ.setdefault("OMP_WAIT_POLICY", "passive")
+    if args.dambreak:
+        return _dambreak(args)
+    if not (args.t_end > 0 and math.isfinite(args.t_end)) or not 0.002 <= args.dp <= 0.05:
+        print("wavesph demo: --t-end must be > 0 s and --dp within [0.002, 0.05] m", file=sys.stderr)
+        return 2
+    out = args.out or Path("runs") / f"demo-{time.strftime('%Y%m%dT%H%M%SZ', time.gmtime())}"
+    if out.exists() and any(out.iterdir()):
+        print(f"wavesph demo: --out {out} exists and is not empty: choose a new directory",
+              file=sys.stderr)
+        return 2
+    out.mkdir(parents=True, exist_ok=True)
+    tic = time.perf_counter()
+    with InProcessServer(out) as srv:
+        info, report = _run(srv, demo_scene(args.dp, args.t_end), args.transport, out)
+    depth = depth_for(args.dp)
+    wall = time.perf_counter() - tic
+    run_dir = out / info["id"]
+    if info["state"] != "finished" or report is None:
+        print(f"wavesph demo: the run ended {info['status']}; data so far in {run_dir}",
+              file=sys.stderr)
+        return 1
+    figures = _figures(info, report, wall, depth)
+    (out / "summary.json").write_text(json.dumps(figures, indent=2))
+    print(f"particles {figures['particles']}, windows {figures['windows']}, SPH steps "
+          f"{figures['steps']}, wall time {wall:.1f} s (SPH solve {figures['sph_solve_s']:.1f} s)\n"
+          f"speed {figures['particle_steps_per_s']:.3g} particle-steps/s while solving "
+          f"({figures['particle_steps_per_s_wall']:.3g} over the wall time, compilation included); "
+          f"coupling overhead {100 * figures['coupling_overhead_share']:.1f} % of the coupled time\n"
+          f"RMSE/H at the flat-bed gauge (x = {GAUGES['flat']} m, t >= {figures['compare_from_s']:.2f} s, "
+          f"measured vs Stokes 2): "
+          f"{_fmt(figures['rmse_over_H_flat'])}", file=sys.stderr)
+    if not args.no_plot:
+        plot(report, info, out / "elevation.png", args.dp, args.t_end, figures["compare_from_s"])
+    print(f"outputs in {out.resolve()}:\n"
+          f"  {info['id']}/gauges.csv   SPH-measured gauges (server)\n"
+          f"  {info['id']}/meta.json    run record ({info['status']})\n"
+          f"  client_gauges.csv          measured and theoretical elevation per window\n"
+          + ("" if args.no_plot else "  elevation.png              measured vs theory\n")
+          + "  summary.json               these figures", file=sys.stderr)
+    return 0
+
+
+def _fmt(v: float | None) -> str:
+    return "n/a (the run ended before full waves reached the gauge)" if v is None else f"{v:.3f}"
+
+
+class InProcessServer:
+    """The wavesph server (HTTP + WebSocket + TCP) on free loopback ports, in a thread."""
+
+    def __init__(self, runs_dir: Path) -> None:
+        import uvicorn
+
+        from server.main import create_app
+        from server.settings import Settings
+
+        self.settings = Settings(host="127.0.0.1", port=0, tcp_port=0, runs_dir=runs_dir,
+                                 max_runs=1)
+        self.app = create_app(self.settings)
+        self.server = uvicorn.Server(uvicorn.Config(
+            self.app, host="127.0.0.1", port=0, log_level="warning", lifespan="on",
+            ws_max_size=self.settings.max_frame + 16, ws_per_message_deflate=False))
+        self.thread = threading.Thread(target=self.server.run, name="wavesph-server", daemon=True)
+
+    def __enter__(self) -> "InProcessServer":
+        self.thread.start()
+        deadline = time.monotonic() + 30
+        while not self.server.started:
+            if time.monotonic() > deadline or not self.thread.is_alive():
+                raise RuntimeError("the in-process server did not start")
+            time.sleep(0.02)
+        self.port = self.server.servers[0].sockets[0].getsockname()[1]
+        self.tcp_port = self.app.state.tcp_port
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.server.should_exit = True
+        self.thread.join(timeout=30)
+
+
+def _run(srv: InProcessServer, scene: dict, transport: str, out: Path) -> tuple[dict, Any]:
+    """Create the run, couple the wave to it; (final run record, client report or None)."""
+    import httpx
+
+    from wave_client.coupling import CouplingError, CouplingOptions, couple
+    from wave_client.theories import build_theory
+
+    base = f"http://127.0.0.1:{srv.port}"
+    with httpx.Client(base_url=base, timeout=60) as http:
+        r = http.post("/runs", json={"scene": scene, "mode": "coupled",
+                                     "coupling": {"window_max": PERIOD / 50}})
+        r.raise_for_status()
+        run = r.json()
+        info = _wait(http, run["id"], {"waiting_for_client", "failed"}, timeout=120)
+        if info["state"] == "failed":
+            return info, None
+        print(f"wavesph demo: {info['particles']} particles, dp = {scene['dp']} m, "
+              f"{scene['t_end']} s of Stokes-2 waves (H = {HEIGHT} m, T = {PERIOD} s, depth "
+              f"{scene['still_water_level']:.4g} m) onto a 1:{1 / SLOPE:g} beach; server on {base}, coupling over "
+              f"{'WebSocket' if transport == 'ws' else 'TCP'}", file=sys.stderr)
+        url = (f"ws://127.0.0.1:{srv.port}/runs/{run['id']}/couple" if transport == "ws"
+               else f"tcp://127.0.0.1:{srv.tcp_port}")
+        wave = build_theory("stokes", height=HEIGHT, period=PERIOD, depth=scene["still_water_level"], order=2,
+                            ramp_time=RAMP_PERIODS * PERIOD)
+        report = None
+        try:
+            report = couple(url, wave, CouplingOptions(), run_id=run["id"],
+                            scene_hash=bytes.fromhex(run["scene_hash"]), timeout=600.0,
+                            log_path=out / "client_gauges.csv")
+        except CouplingError as exc:
+            print(f"wavesph demo: coupling failed: {exc}", file=sys.stderr)
+        info = _wait(http, run["id"], {"finished", "failed", "unstable", "cancelled"}, timeout=60)
+    return info, report
+
+
+def _wait(http: Any, run_id: str, states: set[str], timeout: float) -> dict:
+    deadline = time.monotonic() + timeout
+    while True:
+        info = http.get(f"/runs/{run_id}").json()
+        if info["state"] in states or time.monotonic() > deadline:
+            return info
+        time.sleep(0.05)
+
+
+def compare_from(depth: float) -> float:
+    """Start of the comparison at the flat-bed gauge: the ramp, then the travel to the gauge at
+    the linear group velocity (before that SPH still has the front, the theory has not)."""
+    from wave_client.theories import wavenumber
+
+    k = float(wavenumber(2 * math.pi / PERIOD, depth))
+    kd = k * depth
+    c_g = 0.5 * (2 * math.pi / PERIOD / k) * (1 + 2 * kd / math.sinh(2 * kd))
+    return RAMP_PERIODS * PERIOD + GAUGES["flat"] / c_g
+
+
+def _figures(info: dict, report: Any, wall: float, depth: float) -> dict[str, Any]:
+    from sph_core.wave_analysis import rmse_over_height
+
+    t = report.t
+    j = _gauge_index(report, "flat")
+    t0 = compare_from(depth)
+    sel = t >= t0
+    rmse = None
+    if sel.sum() >= 10:
+        meas = np.array([r.eta[j] if r.wet[j] else np.nan for r in report.records])[sel]
+        theory = np.array([r.eta_model[j] for r in report.records])[sel]
+        rmse = rmse_over_height(meas, theory, HEIGHT)
+    particles, steps = info["particles"], info["steps"]
+    pss = info["particle_steps_per_s"] or 0.0
+    return {"particles": particles, "windows": info["windows"], "steps": steps,
+            "wall_s": round(wall, 2), "sph_solve_s": round(particles * steps / pss, 2) if pss else 0.0,
+            "particle_steps_per_s": round(pss), "particle_steps_per_s_wall": round(particles * steps / wall),
+            "coupling_overhead_share": round(info["coupling_overhead_share"] or 0.0, 4),
+            "compare_from_s": round(t0, 3), "rmse_over_H_flat": None if rmse is None else round(rmse, 4),
+            "gauge_x_m": GAUGES, "H_m": HEIGHT, "T_s": PERIOD, "depth_m": depth, "slope": SLOPE}
+
+
+def _gauge_index(report: Any, name: str) -> int:
+    """Index of a scene probe among the RESULT gauges: the inlet's boundary gauge comes first."""
+    return 1 + list(GAUGES).index(name)
+
+
+def plot(report: Any, info: dict, path: Path, dp: float, t_end: float, t0: float) -> Path:
+    """Measured vs theoretical elevation at each gauge, and the flume with its gauges."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    t = report.t
+    names = ["inlet gauge"] + [f"{n} (x = {x:g} m)" for n, x in GAUGES.items()]
+    fig, axes = plt.subplots(len(names) + 1, 1, figsize=(10, 2.1 * (len(names) + 1)),
+                             sharex=False, constrained_layout=True)
+    for j, (ax, name) in enumerate(zip(axes, names)):
+        meas = np.array([r.eta[j] if r.wet[j] else np.nan for r in report.records])
+        theory = np.array([r.eta_model[j] for r in report.records])
+        flat = j <= 2  # inlet, flat-bed and toe gauges stand on the flat bed
+        ax.plot(t, 100 * theory, "k--", lw=1, label="Stokes 2 theory" + ("" if flat else
+                                                                        " (flat bed: not valid here)"))
+        ax.plot(t, 100 * meas, "C0-", lw=1.2, label=f"SPH measured (dp = {dp:g} m)")
+        ax.axvline(t0, color="0.7", lw=0.8)
+        ax.set(ylabel="eta [cm]", xlim=(0, t_end), title=name)
+        ax.grid(alpha=0.3)
+        ax.legend(loc="upper left", fontsize=8)
+    axes[-2].set_xlabel("t [s]")
+    ax = axes[-1]
+    d, x1 = depth_for(dp), tank_end(dp)
+    ax.fill_between([0.0, X_TOE, x1], -0.02, [0.0, 0.0, SLOPE * (x1 - X_TOE)], color="0.75")
+    ax.fill_between([0, X_TOE, X_TOE + d / SLOPE], [0, 0, d], d, color="C0", alpha=0.3)
+    for n, x in GAUGES.items():
+        ax.axvline(x, color="C3", lw=0.8)
+        ax.text(x, d + 0.03, n, color="C3", ha="center", fontsize=8)
+    ax.set(xlabel="x [m]", ylabel="z [m]", title="flume: open inlet at x = 0, 1:10 beach, "
+           f"still water at z = {d:.4g} m (floor z = 0)", ylim=(-0.02, d + 0.1))
+    fig.suptitle(f"wavesph demo: coupled run {info['id'][:8]}, {info['particles']} particles")
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+    return path
+
+
+def _dambreak(args: argparse.Namespace) -> int:
+    """The standalone dam break (sph_core's demo) with its own defaults."""
+    from sph_core import demo_cli
+
+    p = argparse.ArgumentParser()
+    demo_cli.add_arguments(p)
+    ns = p.parse_args([])
+    ns.out, ns.no_plot = args.out, args.no_plot
+    return demo_cli.main(ns)

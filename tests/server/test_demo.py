@@ -1,0 +1,61 @@
+"""`wavesph demo` end to end on a tiny configuration: server in-process, a real socket, the
+wave client, the run directory and the plot."""
+
+from __future__ import annotations
+
+import csv
+import json
+
+import numpy as np
+import pytest
+
+import wavesph_cli
+from server.demo_cli import GAUGES, demo_scene
+from server.schemas import RunRequest
+
+
+@pytest.mark.parametrize("transport", ["ws", "tcp"])
+def test_demo_writes_a_finished_run_with_gauges_and_plot(tmp_path, transport, capsys):
+    out = tmp_path / "demo"
+    code = wavesph_cli.main(["demo", "--t-end", "0.4", "--dp", "0.04", "--transport", transport,
+                             "--out", str(out)] + (["--no-plot"] if transport == "tcp" else []))
+    assert code == 0
+    (run_dir,) = [p for p in out.iterdir() if p.is_dir()]
+    meta = json.loads((run_dir / "meta.json").read_text())
+    assert meta["state"] == "finished" and meta["t"] == pytest.approx(0.4)
+    with open(run_dir / "gauges.csv", newline="") as f:
+        rows = list(csv.reader(f))
+    cols = rows[0]
+    assert [c for c in cols if c.endswith("_eta")] == ["left_boundary_eta"] + [f"{g}_eta" for g in GAUGES]
+    values = np.array([[float(v) for v in r] for r in rows[1:]])  # 'dry' would not parse
+    assert len(rows) - 1 == meta["windows"] >= 14 and np.all(np.isfinite(values))
+    # still water ahead of the ramped wave: the flat-bed gauges read the scene's still-water
+    # level (a depth of no whole number of dp rows would read up to dp/2 = 0.02 m low)
+    flat = [cols.index("left_boundary_eta"), cols.index("flat_eta")]
+    assert np.abs(values[:, flat]).max() < 0.25 * 0.04
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["particles"] == meta["particles"] > 500 and summary["windows"] == meta["windows"]
+    assert summary["rmse_over_H_flat"] is None  # too short to reach full waves: said, not faked
+    assert (out / "elevation.png").exists() == (transport == "ws")
+    if transport == "ws":
+        assert (out / "elevation.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert str(out.resolve()) in capsys.readouterr().err
+
+
+def test_demo_refuses_a_non_empty_out_dir(tmp_path):
+    (tmp_path / "old.txt").write_text("a run's data")
+    assert wavesph_cli.main(["demo", "--out", str(tmp_path), "--t-end", "0.1"]) == 2
+    assert [p.name for p in tmp_path.iterdir()] == ["old.txt"]
+
+
+def test_demo_scene_is_a_valid_flume_with_the_beach_inside():
+    scene = RunRequest.model_validate({"scene": demo_scene(0.02, 8.0)}).scene
+    (bed,) = scene.beds
+    (x_toe, z_toe), (x_end, z_end) = bed.points
+    assert scene.tank.x1 == pytest.approx(x_end) and z_end > scene.still_water_level  # dry top
+    assert (z_end - z_toe) / (x_end - x_toe) == pytest.approx(0.1)
+    assert [o.side for o in scene.open_boundaries] == ["left"]
+    assert GAUGES["flat"] < x_toe < GAUGES["beach"] < x_end
+    for dp in (0.02, 0.03, 0.05):  # whole particle rows below still water, at any dp
+        rows = demo_scene(dp, 1.0)["still_water_level"] / dp
+        assert rows == pytest.approx(round(rows), abs=1e-9) and rows >= 4
