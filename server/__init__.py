@@ -4,7 +4,8 @@
                   [--max-runs 2] [--max-particles 2000000] [--token T]   (or WAVESPH_* env)
 
 HTTP (OpenAPI docs at /docs):
-    POST   /runs                    {scene, mode: coupled|standalone, coupling: {window_max, z_ref}}
+    POST   /runs                    {scene, mode: coupled|standalone, coupling: {window_max, z_ref},
+                                     source: {theory, H, T, ...} (standalone with open ends)}
     GET    /runs                    every run, including those of earlier server processes
     GET    /runs/{id}               status, t, steps, particles, particle_steps_per_s,
                                     coupling_overhead_share, stability, last_gauges, scene_hash
