@@ -16,6 +16,7 @@ The theory's own elevation at the gauges is written beside them, to theory.csv.
 from __future__ import annotations
 
 import logging
+import math
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
 
@@ -73,7 +74,8 @@ class TheorySource(BaseModel):
                             ramp_time=self.ramp_periods * self.T, **self.options())
 
 
-def source_errors(scene: "Scene", mode: str, source: TheorySource | None) -> list[tuple[list[str], str]]:
+def source_errors(scene: "Scene", mode: str, source: TheorySource | None,
+                  window_max: float = math.inf) -> list[tuple[list[str], str]]:
     """(location in the POST body, message) of what is wrong with ``source`` for this scene."""
     if source is None:
         if mode == "standalone" and scene.open_boundaries:
@@ -88,6 +90,9 @@ def source_errors(scene: "Scene", mode: str, source: TheorySource | None) -> lis
                        f"{list(THEORY_OPTIONS[source.theory]) or 'only H, T, ramp_periods, window'})")
               for name in ("order", "n_fourier", "gamma", "n_components", "seed")
               if getattr(source, name) is not None and name not in THEORY_OPTIONS[source.theory]]
+    if source.window is not None and source.window > window_max:
+        errors.append((["source", "window"], f"{source.window} s exceeds coupling.window_max = "
+                                             f"{window_max} s"))
     if errors:
         return errors
     depth = float(scene.still_water_level) - scene.tank.z0

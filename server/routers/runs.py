@@ -38,7 +38,7 @@ async def create_run(body: RunRequest, manager: Manager) -> RunInfo:
     if body.mode == "coupled" and not body.scene.open_boundaries:
         raise _unprocessable(["body", "scene", "open_boundaries"],
                              "a coupled run needs at least one open end for the client to drive")
-    for loc, msg in source_errors(body.scene, body.mode, body.source):
+    for loc, msg in source_errors(body.scene, body.mode, body.source, body.coupling.window_max):
         raise _unprocessable(["body", *loc], msg)
     return manager.submit(body).info
 

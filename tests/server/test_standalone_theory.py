@@ -7,6 +7,7 @@ same theory through wave_client's client over a WebSocket gives the same gauges 
 from __future__ import annotations
 
 import csv
+import time
 
 import numpy as np
 import pytest
@@ -74,6 +75,7 @@ def test_standalone_theory_run_equals_the_coupled_run(tmp_path):
     ({"source": {**SOURCE, "T": -1.0}}, ["body", "source", "T"]),
     ({"source": {**SOURCE, "colour": 1}}, ["body", "source", "colour"]),
     ({"source": {**SOURCE, "theory": "cnoidal"}}, ["body", "source", "theory"]),
+    ({"source": {**SOURCE, "window": 0.1}}, ["body", "source", "window"]),  # > window_max 0.05
     ({"mode": "coupled"}, ["body", "source"]),                              # a client drives it
 ])
 def test_bad_source_is_422_naming_the_field(tmp_path, change, loc):
@@ -84,3 +86,27 @@ def test_bad_source_is_422_naming_the_field(tmp_path, change, loc):
         r = srv.http.post("/runs", json=body)
     assert r.status_code == 422, r.text
     assert r.json()["detail"][0]["loc"] == loc, r.text
+
+
+def test_cancelled_theory_run_keeps_its_data_and_resumes_to_the_end(tmp_path):
+    scene = {**FLUME, "t_end": 1.0}
+    with live_server(tmp_path) as srv:
+        run = srv.http.post("/runs", json={"scene": scene, "mode": "standalone",
+                                           "source": SOURCE}).json()
+        deadline = time.monotonic() + 120
+        while srv.http.get(f"/runs/{run['id']}").json()["windows"] < 5:
+            assert time.monotonic() < deadline, "the theory run did not progress"
+            time.sleep(0.01)
+        info = srv.http.delete(f"/runs/{run['id']}").json()
+        info = srv.wait_state(run["id"], "cancelled")
+        assert 5 <= info["windows"] < 50 and info["resumable"]
+        kept = rows(tmp_path / "runs" / run["id"] / "gauges.csv")
+        assert len(kept) - 1 == info["windows"]
+        assert srv.http.post(f"/runs/{run['id']}/resume").status_code == 202
+        done = srv.wait_state(run["id"], "finished", "failed", timeout=120)
+    assert done["state"] == "finished", done["status"]
+    run_dir = tmp_path / "runs" / run["id"]
+    t = np.array([float(r[0]) for r in rows(run_dir / "gauges.csv")[1:]])
+    assert t.size == done["windows"] == 50 and np.all(np.diff(t) > 0)
+    np.testing.assert_allclose(t[-1], 1.0)
+    assert (run_dir / "theory.csv").exists() and (run_dir / "theory.1.csv").exists()
