@@ -48,6 +48,8 @@ class Checkpoint:
     t: float
     dt: float
     steps: int
+    cell: np.ndarray | None = None        # cell lists of the copy (set by the Simulation), so a
+    cell_start: np.ndarray | None = None  # restore needs no re-sort and continues bit for bit
 
 
 class ParticleSet:

@@ -335,13 +335,20 @@ class Simulation:
     # ---------------------------------------------------------------- checkpoints
     def checkpoint(self) -> Checkpoint:
         """An exact copy of the state (particles, clock, dt)."""
-        return self.particles.snapshot(self.t, self.dt, self.steps)
+        c = self.particles.snapshot(self.t, self.dt, self.steps)
+        c.cell = self.cell[: c.n].copy()
+        c.cell_start = self.cell_start.copy()
+        return c
 
     def restore(self, c: Checkpoint) -> None:
         """Return exactly to a checkpoint; the cell lists are rebuilt for its particle order."""
         self.particles.restore(c)
         self.t, self.dt, self.steps = c.t, c.dt, c.steps
-        self._rebuild_cells()
+        if c.cell is not None and c.cell_start is not None and c.cell_start.size == self.cell_start.size:
+            self.cell[: c.n] = c.cell
+            self.cell_start[:] = c.cell_start
+        else:
+            self._rebuild_cells()
         self.status = "paused"
         o = self.scene.output
         self._k_probe = int(math.floor(self.t / o.probe_every + 1e-9)) + 1 if o.probe_every else 0
