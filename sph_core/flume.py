@@ -66,6 +66,15 @@ class OpenFlume(Simulation):
             raise ValueError(f"tank.x1: x1 - x0 = {scene.tank.x1 - scene.tank.x0} m must be a "
                              f"whole number of particle spacings dp = {scene.dp} m with a right "
                              "open end")
+        reach = 4.0 * scene.h  # the buffer (2h) and the support of its outermost fluid
+        for i, bed in enumerate(scene.beds):
+            xs = [pt[0] for pt in bed.points]
+            for o in scene.open_boundaries:
+                xf = scene.tank.x0 if o.side == "left" else scene.tank.x1
+                if min(xs) - reach < xf < max(xs) + reach:
+                    # buffers stand on the tank floor: a bed there would cut through them
+                    raise ValueError(f"beds.{i}: comes within {reach:.3g} m of the {o.side} open "
+                                     "end; open ends need the flat tank floor there")
         super().__init__(scene, run_dir=run_dir, spare=spare)
         self.window = float(window)
         self.open_sides = tuple(o.side for o in scene.open_boundaries)
@@ -152,6 +161,8 @@ class OpenFlume(Simulation):
         self.dt = float(wcsph.initialise(*self._arrays(), ps.n, self.prm, self.grid.ncx,
                                          self.grid.ncz))
         self._swap()
+        ob.measure_boundaries(ps.f, ps.kind, self.cell_start, self.obp, self.eta_meas, self.prm,
+                              self.grid.ncx, self.grid.ncz)
 
     def _load_window(self, t1: float, start: Mapping[str, BoundarySample],
                      end: Mapping[str, BoundarySample]) -> None:
