@@ -59,3 +59,25 @@ def test_demo_scene_is_a_valid_flume_with_the_beach_inside():
     for dp in (0.02, 0.03, 0.05):  # whole particle rows below still water, at any dp
         rows = demo_scene(dp, 1.0)["still_water_level"] / dp
         assert rows == pytest.approx(round(rows), abs=1e-9) and rows >= 4
+
+
+def test_example_scene_file_is_the_demo_scene():
+    from pathlib import Path
+
+    from sph_core.scene import load_scene, make_scene
+
+    path = Path(__file__).resolve().parents[2] / "examples" / "scenes" / "demo_beach_flume.toml"
+    a = load_scene(path).model_dump()
+    b = make_scene(demo_scene(0.02, 8.0)).model_dump()
+    assert _close(a, b)
+
+
+def _close(a, b) -> bool:
+    """Equal structures, floats to 1e-12 relative."""
+    if isinstance(a, dict):
+        return a.keys() == b.keys() and all(_close(a[k], b[k]) for k in a)
+    if isinstance(a, (list, tuple)):
+        return len(a) == len(b) and all(_close(x, y) for x, y in zip(a, b))
+    if isinstance(a, float):
+        return a == pytest.approx(b, rel=1e-12, abs=1e-15)
+    return a == b
