@@ -22,7 +22,7 @@ from typing import TYPE_CHECKING, Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
-from protocol import Bye, Error, Message, Nodes, Result, Welcome, decode_frame
+from protocol import MAX_PAYLOAD, Bye, Error, Message, Nodes, Result, Welcome, decode_frame
 from protocol.session import HELLO_LIMIT
 from wave_client.coupling import CouplingCore, CouplingOptions, GaugeLog
 from wave_client.theories import build_theory
@@ -127,7 +127,7 @@ class TheoryClient:
         return out or None
 
     async def send(self, data: bytes) -> None:
-        seq, msg = decode_frame(data, max(self.max_payload, len(data)))
+        seq, msg = decode_frame(data, MAX_PAYLOAD)  # the server's own frames
         try:
             frames = self._answer(seq, msg)
         except Exception as exc:  # noqa: BLE001 -- the model failed: tell the door, as a client would
