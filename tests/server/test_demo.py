@@ -15,7 +15,8 @@ from server.schemas import RunRequest
 
 
 @pytest.mark.parametrize("transport", ["ws", "tcp"])
-def test_demo_writes_a_finished_run_with_gauges_and_plot(tmp_path, transport, capsys):
+def test_demo_writes_a_finished_run_with_gauges_and_plot(tmp_path, transport, capsys, monkeypatch):
+    monkeypatch.setenv("OMP_WAIT_POLICY", "passive")  # the demo sets it; keep it out of other tests
     out = tmp_path / "demo"
     code = wavesph_cli.main(["demo", "--t-end", "0.4", "--dp", "0.04", "--transport", transport,
                              "--out", str(out)] + (["--no-plot"] if transport == "tcp" else []))
@@ -42,7 +43,8 @@ def test_demo_writes_a_finished_run_with_gauges_and_plot(tmp_path, transport, ca
     assert str(out.resolve()) in capsys.readouterr().err
 
 
-def test_demo_refuses_a_non_empty_out_dir(tmp_path):
+def test_demo_refuses_a_non_empty_out_dir(tmp_path, monkeypatch):
+    monkeypatch.setenv("OMP_WAIT_POLICY", "passive")
     (tmp_path / "old.txt").write_text("a run's data")
     assert wavesph_cli.main(["demo", "--out", str(tmp_path), "--t-end", "0.1"]) == 2
     assert [p.name for p in tmp_path.iterdir()] == ["old.txt"]
