@@ -72,3 +72,9 @@ def main(args: argparse.Namespace) -> int:
               f"({sim.n_particles * sim.steps / max(sim.wall_time, 1e-9) / 1e6:.2f} M particle-steps/s); "
               f"results in {out}", file=sys.stderr)
     return code
+
+
+if __name__ == "__main__":  # python -m sph_core.cli SCENE.toml
+    _parser = argparse.ArgumentParser(prog="python -m sph_core.cli", description=__doc__.splitlines()[0])
+    add_arguments(_parser)
+    raise SystemExit(main(_parser.parse_args()))

@@ -83,3 +83,9 @@ def plot(sim: Simulation, t: np.ndarray, xf: np.ndarray, a: float, path: Path) -
     fig.savefig(path, dpi=110)
     plt.close(fig)
     return path
+
+
+if __name__ == "__main__":  # python -m sph_core.demo_cli  (wavesph demo is the coupled flume)
+    _parser = argparse.ArgumentParser(prog="python -m sph_core.demo_cli", description=__doc__.splitlines()[0])
+    add_arguments(_parser)
+    raise SystemExit(main(_parser.parse_args()))
