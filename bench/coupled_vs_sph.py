@@ -1,0 +1,97 @@
+"""Is the coupled Boussinesq-SPH flume as accurate as, and 10x cheaper than, SPH alone?
+
+    python bench/coupled_vs_sph.py [--dp 0.02] [--wavelengths 12] [--sph-only-seconds 3]
+                                   [--modes two_way,absorption_only] [--out DIR]
+
+The flume of server/coupled_flume.py: regular waves (H = 0.04 m, T = 1.4 s, d = 0.24 m) from a
+Boussinesq source 12 wavelengths up-flume of an SPH zone (open inlet, 1.2 m flat bed, 1:10 beach).
+Runs, at one particle spacing dp:
+  reference        Boussinesq alone over the whole flume (beach to depth d/3, then a sponge)
+  coupled          the SPH zone driven by `wavesph couple --model boussinesq` over WebSocket,
+                   two-way and absorption-only (`[coupling] two_way`)
+  sph_only         SPH over the whole length, inlet at the source driven by Stokes-2 theory
+                   (server standalone run). A full run at dp = 0.02 takes ~20+ min on 2 cores, so by
+                   default only the first --sph-only-seconds are run and the wall time is
+                   extrapolated linearly in simulated time (build excluded from the scaling);
+                   `extrapolated` says so, and its rmse_over_H is then null (the wave has not
+                   reached the gauge). --sph-only-seconds 0 runs it to the end.
+rmse_over_H: elevation at the flat-bed gauge inside the SPH zone (0.8 m past the inlet) against
+the reference, over t >= compare_from (ramp + front travel + 1 period) to t_end (4 periods).
+Prints one JSON object per line: one per run, then the summary with `speedup` = SPH-only wall
+time / coupled (two-way) wall time.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+import tempfile
+from pathlib import Path
+
+os.environ.setdefault("OMP_WAIT_POLICY", "passive")  # before numba: shared, loaded cores
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from server.coupled_flume import (FlumeCase, correlation, reference_run, rmse_over_h,  # noqa: E402
+                                  run_coupled, run_sph_only)
+
+
+def _accuracy(c: FlumeCase, res: dict, gauge: str = "flat") -> dict:
+    if "t" not in res or res["state"] != "finished":
+        return {"rmse_over_H": None, "correlation": None}
+    t, eta = res["t"], res["eta"][gauge]
+    ref = reference_run(c, t)[gauge]
+    rmse = rmse_over_h(t, eta, ref, c)
+    return {"rmse_over_H": None if rmse is None else round(rmse, 4),
+            "correlation": None if rmse is None else round(correlation(t, eta, ref, c.compare_from), 4)}
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--dp", type=float, default=0.02, help="particle spacing [m] (both runs)")
+    ap.add_argument("--wavelengths", type=float, default=12.0,
+                    help="Boussinesq source to SPH inlet, in wavelengths")
+    ap.add_argument("--sph-only-seconds", type=float, default=3.0,
+                    help="simulated seconds of the SPH-only run, extrapolated to t_end (0: full run)")
+    ap.add_argument("--modes", default="two_way,absorption_only")
+    ap.add_argument("--out", type=Path, default=None, help="run directories (default: a temp dir)")
+    args = ap.parse_args(argv)
+    out = args.out or Path(tempfile.mkdtemp(prefix="coupled_vs_sph-"))
+    c = FlumeCase(wavelengths=args.wavelengths).at(args.dp)
+    common = {"dp": args.dp, "H": c.height, "T": c.period, "depth": c.depth, "H_over_dp":
+              round(c.height / args.dp, 3), "wavelengths": c.wavelengths,
+              "wavelength_m": round(c.wavelength, 4), "t_end": round(c.t_end, 3),
+              "compare_from": round(c.compare_from, 3), "gauge_x_from_inlet": c.gauge}
+    coupled = {}
+    for mode in args.modes.split(","):
+        res = run_coupled(c, args.dp, out / f"coupled_{mode}", two_way=mode == "two_way")
+        line = {"run": "coupled", "mode": res["mode"], **common, "state": res["state"],
+                "particles": res["particles"], "steps": res["steps"], "windows": res["windows"],
+                "wall_s": round(res["wall_s"], 2),
+                "coupling_overhead_share": res["coupling_overhead_share"], **_accuracy(c, res)}
+        coupled[mode] = line
+        print(json.dumps(line), flush=True)
+    full = args.sph_only_seconds <= 0 or args.sph_only_seconds >= c.t_end
+    res = run_sph_only(c, args.dp, out / "sph_only", t_end=None if full else args.sph_only_seconds)
+    build, run_wall = res["build_s"], res["wall_s"] - res["build_s"]
+    wall = res["wall_s"] if full else build + run_wall * c.t_end / res["t_end"]
+    sph = {"run": "sph_only", **common, "state": res["state"], "particles": res["particles"],
+           "steps": res["steps"], "simulated_s": round(res["t_end"], 3),
+           "measured_wall_s": round(res["wall_s"], 2), "build_s": round(build, 2),
+           "extrapolated": not full, "wall_s": round(wall, 2),
+           **(_accuracy(c, res) if full else {"rmse_over_H": None, "correlation": None})}
+    print(json.dumps(sph), flush=True)
+    base = coupled.get("two_way") or next(iter(coupled.values()))
+    summary = {"summary": "coupled_vs_sph", "dp": args.dp, "H_over_dp": common["H_over_dp"],
+               "speedup": round(wall / base["wall_s"], 2), "speedup_mode": base["mode"],
+               "sph_only_extrapolated": not full,
+               "particles_ratio": round(sph["particles"] / base["particles"], 2),
+               "rmse_over_H_coupled": {m: v["rmse_over_H"] for m, v in coupled.items()},
+               "rmse_over_H_sph_only": sph["rmse_over_H"], "out": str(out)}
+    print(json.dumps(summary), flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
