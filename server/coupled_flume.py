@@ -3,21 +3,24 @@
 One flume, three ways to compute it (x in the Boussinesq model's frame: source at x = 0):
 
     |sponge| source (x=0) ..... n wavelengths of flat bed d ..... x_c | flat x_flat | 1:10 beach |
-                                                                  SPH inlet (open, absorbing)
+                                                                  SPH inlet (open)
 
 - coupled: the Boussinesq model (wave_client, a `wavesph waves` scene) covers the far field up to
   x_c plus an overlap of flat bed ending in a sponge; the SPH zone (server, sph_core's OpenFlume)
   starts with an open inlet at x_c. The client is `wavesph couple --model boussinesq --config
   <scene.toml>`, unchanged, over a real socket. ``two_way`` (the wave scene's ``[coupling]``):
   SPH's elevation and z_alpha velocity at the inlet gauge become the model's characteristic
-  boundary at x_c (reflections travel on into the model); False: absorption-only (the SPH inlet
-  absorbs the reflection itself, the model never hears of it).
+  boundary at x_c (the beach's reflection travels on into the model, the inlet lets it out);
+  False: absorption-only (the model never hears of SPH; the client's seed 002 correction,
+  `--absorb`, absorbs the reflection at the SPH inlet). Why not the SPH boundary: `run_coupled`.
 - reference: the Boussinesq model alone over the whole flume, the bathymetry continued with the
   same 1:10 beach. Nwogu's model has no dry land and no breaking: its beach stops at depth d/3
   (`H_MIN_FRACTION`) and continues flat into a sponge (no wall), so it reflects less than
   SPH's breaking beach; the gauge compared stands on the flat bed before the beach.
 - sph_only: SPH over the whole length, an open inlet at the source position driven by a
-  second-order Stokes theory (the server's standalone theory run), the same beach.
+  second-order Stokes theory (the server's standalone theory run), the same beach. Its inlet
+  does not absorb: the beach's reflection would reach it only after t_end, and the boundary's
+  own correction has the reference flaw described in `run_coupled`.
 
 Datum: SPH floor z = 0, still water z = d (`still_water_level`); the wave model measures z up
 from still water. SPH x = model x - x_c.
@@ -25,8 +28,10 @@ from still water. SPH x = model x - x_c.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import math
+import sys
 import time
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -124,12 +129,14 @@ def _tank_end(c: FlumeCase, x_toe: float, dp: float) -> float:
 
 
 def _sph_scene(c: FlumeCase, dp: float, t_end: float, x_toe: float, gauges: dict[str, float],
-               name: str) -> dict[str, Any]:
+               name: str, absorb: bool) -> dict[str, Any]:
     d = c.depth
     x1 = _tank_end(c, x_toe, dp)
     return {
         "name": name, "dp": dp, "t_end": t_end, "still_water_level": d,
-        "tank": {"x0": 0.0, "x1": x1, "z0": 0.0, "z1": d + 2 * c.height + 4 * dp},
+        # room above the beach's top (0.1 m above still water) for run-up and splashes: a drop
+        # over the tank top ends the run (dp = 0.02 with the top at d + 2H + 4dp: t = 29.5 s)
+        "tank": {"x0": 0.0, "x1": x1, "z0": 0.0, "z1": d + 0.1 + 2 * c.height + 4 * dp},
         # the shoreline wedge is filled only where it holds >= 2 particle rows: a thinner wedge
         # over the staircase bed jets particles out in still water (dp = 0.02: 1-2 m/s at t ~ 1 s,
         # density out of band, run unstable); the water spreads up the rest of the slope itself
@@ -137,17 +144,21 @@ def _sph_scene(c: FlumeCase, dp: float, t_end: float, x_toe: float, gauges: dict
                           "z1": d}],
         "beds": [{"points": [[x_toe, 0.0], [x1, c.slope * (x1 - x_toe)]]}],
         # c0 = 10 sqrt(g d) bounds orbital speeds x10; free slip: both wave models are inviscid
-        "constants": {"c0": 10.0 * math.sqrt(9.81 * d), "wall_slip": "free_slip"},
+        # density band low end 0.5 (default 0.7): a splash drop thrown up the beach keeps few
+        # neighbours, its density falls by continuity (its pressure saturates at -B anyway); at
+        # 0.7 the guard stopped still-water runs at t = 1-2.3 s (dp = 0.02) on such drops
+        "constants": {"c0": 10.0 * math.sqrt(9.81 * d), "wall_slip": "free_slip",
+                      "density_band": [0.5, 1.3]},
         "output": {"probe_every": c.period / 20},
         "probes": [{"kind": "elevation", "name": n, "x": x} for n, x in gauges.items()],
-        "open_boundaries": [{"side": "left", "elevation": "imposed", "absorb": True}],
+        "open_boundaries": [{"side": "left", "elevation": "imposed", "absorb": absorb}],
     }
 
 
-def sph_zone_scene(c: FlumeCase, dp: float) -> dict[str, Any]:
+def sph_zone_scene(c: FlumeCase, dp: float, absorb: bool = False) -> dict[str, Any]:
     """The SPH zone of the coupled flume (server scene): inlet at SPH x = 0 (model x_c)."""
     c = c.at(dp)
-    return _sph_scene(c, dp, c.t_end, c.x_flat, c.gauges, "coupled-flume-sph-zone")
+    return _sph_scene(c, dp, c.t_end, c.x_flat, c.gauges, "coupled-flume-sph-zone", absorb)
 
 
 def sph_only_scene(c: FlumeCase, dp: float, t_end: float | None = None) -> dict[str, Any]:
@@ -156,7 +167,7 @@ def sph_only_scene(c: FlumeCase, dp: float, t_end: float | None = None) -> dict[
     x0 = dp * round(c.x_couple / dp)  # the SPH zone's inlet on the particle lattice
     gauges = {n: x0 + x for n, x in c.gauges.items()}
     return _sph_scene(c, dp, c.t_end if t_end is None else t_end, x0 + c.x_flat, gauges,
-                      "sph-only-flume")
+                      "sph-only-flume", absorb=False)
 
 
 def wave_scene(c: FlumeCase, two_way: bool = True, reference: bool = False) -> dict[str, Any]:
@@ -264,9 +275,25 @@ def _gauges_csv(path: Path) -> tuple[np.ndarray, dict[str, np.ndarray]]:
 
 
 def run_coupled(c: FlumeCase, dp: float, out: Path, two_way: bool = True,
-                transport: str = "ws") -> dict[str, Any]:
+                transport: str = "ws", absorb: str | None = None) -> dict[str, Any]:
     """The coupled flume over a real socket: in-process server, `wavesph couple --model
-    boussinesq --config <out>/wave_scene.toml` as the client. Figures and series (dict)."""
+    boussinesq --config <out>/wave_scene.toml [--absorb]` as the client. Figures and series.
+
+    absorb: who absorbs the beach's reflection at the SPH inlet; exactly one absorber, or the
+    gain doubles (docs/ARCHITECTURE.md). Default: "none" for two-way, "client" otherwise.
+      "none": two-way only: the model's characteristic boundary takes SPH's reflected wave
+        L = (eta - u_ref / r) / 2 and hands it back in the inlet data, so the inlet passes it.
+      "client": `wavesph couple --absorb`; mismatch = the inlet gauge's reading minus the
+        model's elevation *at the gauge's x* (the uncoupled twin's beyond x_c in two-way mode).
+      "sph": the scene's open boundary (`absorb = true`). Over the socket its reference is the
+        elevation SET gives for the face (the protocol carries eta at the nodes' x only), not
+        at its gauge 2h inside: off by k 2h (0.18 rad at dp = 0.02) of the incident wave.
+        Measured (dp = 0.02, two-way, so also doubled): the SPH wave led the reference by
+        0.25 rad and was 9 % low, RMSE/H 12 %. Kept to show it (bench --absorb sph).
+    """
+    absorb = absorb or ("none" if two_way else "client")
+    if absorb not in ("none", "client", "sph"):
+        raise ValueError(f"absorb: 'none', 'client' or 'sph', got {absorb!r}")
     import argparse
 
     import httpx
@@ -278,11 +305,14 @@ def run_coupled(c: FlumeCase, dp: float, out: Path, two_way: bool = True,
     cfg = out / "wave_scene.toml"
     cfg.write_text(to_toml(wave_scene(c, two_way=two_way),
                            "coupled flume: Boussinesq far field (server/coupled_flume.py)"))
-    z_ref = 0.531 * -c.depth  # Nwogu's z_alpha = beta d: the model's reference_level at x_c
+    from wave_client.boussinesq.dispersion import BETA
+
+    z_ref = BETA * c.depth  # Nwogu's z_alpha: the model's reference_level at x_c (flat bed)
     tic = time.perf_counter()
     with InProcessServer(out) as srv, httpx.Client(base_url=f"http://127.0.0.1:{srv.port}",
                                                    timeout=60) as http:
-        r = http.post("/runs", json={"scene": sph_zone_scene(c, dp), "mode": "coupled",
+        r = http.post("/runs", json={"scene": sph_zone_scene(c, dp, absorb == "sph"),
+                                     "mode": "coupled",
                                      "coupling": {"window_max": c.window, "z_ref": z_ref}})
         r.raise_for_status()
         run = r.json()
@@ -294,11 +324,14 @@ def run_coupled(c: FlumeCase, dp: float, out: Path, two_way: bool = True,
         args = parser.parse_args(["--url", url, "--run-id", run["id"], "--model", "boussinesq",
                                   "--config", str(cfg), "--scene-hash", run["scene_hash"],
                                   "--output", str(out / "client_gauges.csv"), "--no-progress",
-                                  "--timeout", "600"])
-        code = couple_cli.main(args) if info["state"] == "waiting_for_client" else None
+                                  "--timeout", "600"]
+                                 + (["--absorb"] if absorb == "client" else []))
+        with contextlib.redirect_stdout(sys.stderr):  # the CLI's summary line: keep stdout clean
+            code = couple_cli.main(args) if info["state"] == "waiting_for_client" else None
         info = _wait(http, run["id"], TERMINAL, timeout=120)
     wall = time.perf_counter() - tic
-    result = {"mode": "two_way" if two_way else "absorption_only", "exit_code": code,
+    result = {"mode": "two_way" if two_way else "absorption_only", "absorb": absorb,
+              "exit_code": code,
               "state": info["state"], "status": info["status"], "particles": info["particles"],
               "steps": info["steps"], "windows": info["windows"], "wall_s": wall,
               "coupling_overhead_share": info.get("coupling_overhead_share")}
@@ -371,7 +404,5 @@ def write_examples(directory: Path) -> list[Path]:
 
 
 if __name__ == "__main__":
-    import sys
-
     for p in write_examples(Path(sys.argv[1] if len(sys.argv) > 1 else "examples/coupled")):
         print(p)

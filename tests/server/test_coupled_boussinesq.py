@@ -30,13 +30,16 @@ def passive_omp(monkeypatch):
 @pytest.mark.parametrize("two_way,transport", [(True, "ws"), (False, "tcp")])
 def test_coarse_coupled_flume_follows_the_boussinesq_only_run(tmp_path, passive_omp, two_way,
                                                               transport):
-    """Finishes over the socket with every gauge wet and finite, and the flat-bed gauge follows
-    the Boussinesq-only run: correlation >= 0.9 (phase error below ~25 deg; a wrong x offset of
-    L/4 gives ~0, a sign error -1, no wave NaN) and RMSE/H <= 0.25: at H/dp = 1 the kernel
-    gauge's surface is uncertain by ~dp/4 = H/4 (the fine-dp goal is the slow test's)."""
+    """Two-way (the model's boundary lets SPH's reflection out) over WebSocket, absorption-only
+    (`wavesph couple --absorb`) over TCP. Finishes with every gauge wet and finite, and the
+    flat-bed gauge follows the Boussinesq-only run: correlation >= 0.9 (phase error below
+    ~25 deg; a wrong x offset of L/4 gives ~0, a sign error -1, no wave NaN) and RMSE/H <= 0.25:
+    at H/dp = 1 the kernel gauge's surface is uncertain by ~dp/4 = H/4 (the fine-dp goal is the
+    slow test's)."""
     c = COARSE.at(COARSE_DP)
     res = run_coupled(c, COARSE_DP, tmp_path, two_way=two_way, transport=transport)
     assert res["exit_code"] == 0 and res["state"] == "finished", res["status"]
+    assert res["absorb"] == ("none" if two_way else "client")  # one absorber, never two
     assert res["windows"] == math.ceil(c.t_end / c.window - 1e-9)
     t, eta = res["t"], res["eta"]
     assert t[-1] == pytest.approx(c.t_end)
