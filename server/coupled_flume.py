@@ -39,7 +39,7 @@ from typing import Any
 
 import numpy as np
 
-from .demo_cli import InProcessServer, _wait, depth_for
+from .demo_cli import InProcessServer, _wait
 
 H_MIN_FRACTION = 1.0 / 3.0   # the reference Boussinesq beach ends at depth d/3 (then a sponge)
 SHORE_ROWS = 2               # particle rows of the thinnest water filled at the shoreline
