@@ -6,8 +6,9 @@
 The flume of server/coupled_flume.py: regular waves (H = 0.04 m, T = 1.4 s, d = 0.24 m) from a
 Boussinesq source 30 wavelengths (59 m) up-flume of an SPH zone (open inlet, 1.2 m flat bed, 1:10
 beach). The coupled cost hardly depends on that length, the SPH-only cost grows with it: measured
-(dp = 0.02, 2 shared cores) speedup 4.0-4.5 at 12 wavelengths (20 411 vs 2 716 particles), 12.5 at
-30 (47 006 vs 2 702); the small zone runs fewer particle-steps per second (1.7e6 vs 2.8e6).
+(dp = 0.02, 2 shared cores) speedup 4.6 at 12 wavelengths (full SPH-only run: 802 s, 20 349
+particles, RMSE/H 0.46: the wave lost 2/3 of its height over 12 L; coupled 173 s, 2 716
+particles), 12.5 at 30 (47 006 vs 2 702); the small zone runs fewer particle-steps per second.
 Runs, at one particle spacing dp:
   reference        Boussinesq alone over the whole flume (beach to depth d/3, then a sponge)
   coupled          the SPH zone driven by `wavesph couple --model boussinesq` over WebSocket,
