@@ -222,24 +222,8 @@ class OpenFlume(Simulation):
                 self.writer.update_meta(**self._meta_fields(), cause=f"boundary data: {exc}")
             raise
         self._load_window(t1, self._samples, end)
-        self.status = "running"
-        try:
-            while self.t < t1:
-                self._run_until(self._next_output_time(t1))
-                self._record_outputs()
-                if progress is not None:
-                    progress(self)
-            self._samples = end
-            self.status = "completed" if self.t >= self.scene.t_end else "paused"
-        except UnstableError:
-            raise
-        except BaseException as exc:  # keep the record honest on Ctrl-C or a bug
-            self.status = "interrupted" if isinstance(exc, KeyboardInterrupt) else "failed"
-            if self.writer:
-                self.writer.update_meta(**self._meta_fields(), cause=repr(exc))
-            raise
-        if self.writer:
-            self.writer.update_meta(**self._meta_fields())
+        self._advance_recording(t1, progress)
+        self._samples = end
 
     def _run_until(self, t_stop: float) -> None:
         ps = self.particles

@@ -262,21 +262,16 @@ class Simulation:
             raise ValueError(f"t_end: must be finite, got {t_end}")
         if self.status == "unstable":
             raise RuntimeError("advance_to: the run is unstable; restore a checkpoint first")
+        self._advance_recording(t_end, progress)
+
+    def _advance_recording(self, t_end: float,
+                           progress: Callable[["Simulation"], None] | None) -> None:
+        """The run loop shared by every solver: step to each output time, record, report, and keep
+        meta.json honest on any way out (UnstableError, Ctrl-C, a bug)."""
         self.status = "running"
         try:
             while self.t < t_end:
-                t_stop = self._next_output_time(t_end)
-                tic = time.perf_counter()
-                ps = self.particles
-                t, dt, steps, status, swapped, n_flag, vmax = wcsph.advance(
-                    *self._arrays(), ps.n, self.prm, self.grid.ncx, self.grid.ncz,
-                    self.integrator, self.t, self.dt, t_stop, STEPS_PER_CALL)
-                self.wall_time += time.perf_counter() - tic
-                if swapped:
-                    self._swap()
-                self.t, self.dt, self.steps, self.v_max = float(t), float(dt), self.steps + steps, vmax
-                if status not in (wcsph.ST_REACHED_T, wcsph.ST_STEP_LIMIT):
-                    self._fail_unstable(status, n_flag)
+                self._run_until(self._next_output_time(t_end))
                 self._record_outputs()
                 if progress is not None:
                     progress(self)
@@ -290,6 +285,20 @@ class Simulation:
             raise
         if self.writer:
             self.writer.update_meta(**self._meta_fields())
+
+    def _run_until(self, t_stop: float) -> None:
+        """One call of the jitted closed-tank loop up to ``t_stop`` (or STEPS_PER_CALL steps)."""
+        tic = time.perf_counter()
+        ps = self.particles
+        t, dt, steps, status, swapped, n_flag, vmax = wcsph.advance(
+            *self._arrays(), ps.n, self.prm, self.grid.ncx, self.grid.ncz,
+            self.integrator, self.t, self.dt, t_stop, STEPS_PER_CALL)
+        self.wall_time += time.perf_counter() - tic
+        if swapped:
+            self._swap()
+        self.t, self.dt, self.steps, self.v_max = float(t), float(dt), self.steps + steps, vmax
+        if status not in (wcsph.ST_REACHED_T, wcsph.ST_STEP_LIMIT):
+            self._fail_unstable(status, n_flag)
 
     def advance_steps(self, n_steps: int) -> None:
         """Take exactly ``n_steps`` steps without recording outputs (benchmarks, tests)."""
