@@ -7,11 +7,9 @@ checks the values the C client computed against linear theory evaluated here ind
 
 from __future__ import annotations
 
-import shutil
 import socket
 import subprocess
 import threading
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -21,22 +19,8 @@ from protocol import (ErrorCode, FrameDecoder, Nodes, ProtocolError, Result, Sph
                       scene_hash)
 from protocol.session import PeerError, Reply, SetWindow, SolveWindow
 
-ROOT = Path(__file__).resolve().parents[2]
-SOURCE = ROOT / "examples" / "c_client" / "wsph_client.c"
 G_ACC, DEPTH, H, T = 9.81, 0.6, 0.04, 1.2
 X_INLET = 0.0
-
-
-@pytest.fixture(scope="module")
-def c_client(tmp_path_factory) -> Path:
-    gcc = shutil.which("gcc")
-    if gcc is None:
-        pytest.skip("gcc not found on PATH: the C example client cannot be compiled here")
-    exe = tmp_path_factory.mktemp("cbuild") / "wsph_client"
-    build = subprocess.run([gcc, "-std=c99", "-Wall", "-Wextra", "-pedantic", "-Werror", "-O2",
-                            "-o", str(exe), str(SOURCE), "-lm"], capture_output=True, text=True)
-    assert build.returncode == 0, build.stderr
-    return exe
 
 
 class PythonPeer:

@@ -2,29 +2,13 @@
 
 from __future__ import annotations
 
-import shutil
 import subprocess
-from pathlib import Path
 
 import numpy as np
 import pytest
 
 from server_harness import live_server
 
-ROOT = Path(__file__).resolve().parents[2]
-SOURCE = ROOT / "examples" / "c_client" / "wsph_client.c"
-
-
-@pytest.fixture(scope="module")
-def c_client(tmp_path_factory) -> Path:
-    gcc = shutil.which("gcc")
-    if gcc is None:
-        pytest.skip("gcc not found on PATH: the C example client cannot be compiled here")
-    exe = tmp_path_factory.mktemp("cbuild") / "wsph_client"
-    build = subprocess.run([gcc, "-std=c99", "-Wall", "-Wextra", "-pedantic", "-Werror", "-O2",
-                            "-o", str(exe), str(SOURCE), "-lm"], capture_output=True, text=True)
-    assert build.returncode == 0, build.stderr
-    return exe
 
 
 def test_c_client_against_the_server(srv, engines, c_client):
