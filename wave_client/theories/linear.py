@@ -50,16 +50,8 @@ def depth_profiles(k: ArrayLike, z: ArrayLike, depth: float) -> tuple[np.ndarray
     return ez * (1.0 + e) / den, ez * -np.expm1(-2.0 * k * (z + depth)) / den
 
 
-class AiryWave(WaveTheory):
-    """Linear progressive wave travelling towards +x.
-
-    eta = (H/2) cos(k x - omega t),  omega^2 = g k tanh(k d)
-    u   = (H/2) omega cosh(k (z + d)) / sinh(k d) cos(k x - omega t)
-    w   = (H/2) omega sinh(k (z + d)) / sinh(k d) sin(k x - omega t)
-
-    Between z = 0 and the crest the profile is evaluated at the actual z (as raschii's
-    AiryWave does); above the surface the surface value is returned (see `WaveTheory`).
-    """
+class _LinearMode(WaveTheory):
+    """One linear mode of height H and period T on depth d: validated parameters, omega, k, L."""
 
     def __init__(
         self, height: float, period: float, depth: float, *, ramp_time: float = 0.0, g: float = G
@@ -73,6 +65,18 @@ class AiryWave(WaveTheory):
         self.omega = 2.0 * np.pi / self.period
         self.k = float(wavenumber(self.omega, self.depth, self.g))
         self.length = 2.0 * np.pi / self.k
+
+
+class AiryWave(_LinearMode):
+    """Linear progressive wave travelling towards +x.
+
+    eta = (H/2) cos(k x - omega t),  omega^2 = g k tanh(k d)
+    u   = (H/2) omega cosh(k (z + d)) / sinh(k d) cos(k x - omega t)
+    w   = (H/2) omega sinh(k (z + d)) / sinh(k d) sin(k x - omega t)
+
+    Between z = 0 and the crest the profile is evaluated at the actual z (as raschii's
+    AiryWave does); above the surface the surface value is returned (see `WaveTheory`).
+    """
 
     def _eta(self, x: np.ndarray, t: float) -> np.ndarray:
         return 0.5 * self.height * np.cos(self.k * x - self.omega * t)
@@ -84,7 +88,7 @@ class AiryWave(WaveTheory):
         return a * self.omega * ch * np.cos(phase), a * self.omega * sh * np.sin(phase)
 
 
-class StandingWave(WaveTheory):
+class StandingWave(_LinearMode):
     """Linear standing wave, e.g. the sloshing mode of a closed tank (walls at antinodes).
 
     eta = A cos(k x) cos(omega t),  A = H/2,  omega^2 = g k tanh(k d)
@@ -96,19 +100,6 @@ class StandingWave(WaveTheory):
     k x = pi/2 + n pi; u vanishes at the antinodes k x = n pi (where the walls of a tank of
     length L = n pi / k stand).
     """
-
-    def __init__(
-        self, height: float, period: float, depth: float, *, ramp_time: float = 0.0, g: float = G
-    ) -> None:
-        super().__init__(ramp_time)
-        self.height = require_positive("height", height)
-        self.period = require_positive("period", period)
-        self.depth = require_positive("depth", depth)
-        self.g = require_positive("g", g)
-        check_not_breaking(self.height, self.period, self.depth)
-        self.omega = 2.0 * np.pi / self.period
-        self.k = float(wavenumber(self.omega, self.depth, self.g))
-        self.length = 2.0 * np.pi / self.k
 
     def _eta(self, x: np.ndarray, t: float) -> np.ndarray:
         return 0.5 * self.height * np.cos(self.k * x) * np.cos(self.omega * t)
