@@ -83,7 +83,9 @@ class Constants(_Model):
     nu: float = Field(1.0e-6, ge=0, description="laminar kinematic viscosity [m^2/s]")
     delta: float = Field(0.1, ge=0, description="delta-SPH density diffusion coefficient")
     wall_slip: Literal["no_slip", "free_slip"] = "no_slip"
-    density_band: tuple[float, float] = Field((0.7, 1.3), description="sane rho/rho0 band")
+    density_band: tuple[float, float] = Field(
+        (0.7, 1.3), description="rho/rho0: above the high end the run stops (compression blow-up); "
+                                "the low end floors a splash drop's density")
     integrator: Literal["kdk", "symplectic_pc"] = Field(
         "kdk", description="kdk: leapfrog, 1 force pass/step; symplectic_pc: DualSPHysics-style, 2 passes")
 
@@ -124,6 +126,11 @@ class FrontProbe(_Model):
 Probe = Annotated[Union[PointProbe, ElevationProbe, FrontProbe], Field(discriminator="kind")]
 
 
+# buffer pressure of an outlet (elevation "extrapolated") that does not name one; see
+# OpenBoundary.pressure (measured in sph_core/open_boundary.py's docstring)
+OUTLET_PRESSURE = "hydrostatic"
+
+
 class OpenBoundary(_Model):
     """An open end of the tank (issue 3, seed 002): the tank wall on ``side`` is replaced by a
     buffer of particles, one kernel support wide, outside the tank face (x0 or x1).
@@ -138,6 +145,10 @@ class OpenBoundary(_Model):
     elevation: Literal["imposed", "extrapolated"] = "imposed"
     absorb: bool = True
     gauge_offset: float | None = Field(None, gt=0, description="boundary gauge distance inside the face [m]")
+    pressure: Literal["hydrostatic", "extrapolated"] | None = Field(
+        None, description="buffer pressure: hydrostatic below the buffer's surface, or "
+                          "extrapolated from the fluid through mirrored ghost nodes; None: "
+                          "OUTLET_PRESSURE for an extrapolated elevation, else hydrostatic")
 
 
 class Output(_Model):
@@ -153,6 +164,9 @@ class Scene(_Model):
     name: str = "scene"
     dp: float = Field(gt=0, description="initial particle spacing [m]")
     t_end: float = Field(gt=0, description="end time [s]")
+    # A coupled zone that stays at rest until the far-field waves arrive need not be solved
+    # before then: its clock starts at t_start (the wave model runs alone up to it).
+    t_start: float = Field(0.0, ge=0, description="start time [s]: the water is at rest then")
     still_water_level: float | None = Field(None, description="z of the still-water level [m]")
     tank: Tank
     water_blocks: list[WaterBlock] = Field(min_length=1)
@@ -166,6 +180,8 @@ class Scene(_Model):
     @model_validator(mode="after")
     def _consistent(self) -> "Scene":
         t = self.tank
+        if not self.t_end > self.t_start:
+            raise ValueError(f"t_end: must be after t_start = {self.t_start} s")
         sides = [o.side for o in self.open_boundaries]
         if len(set(sides)) != len(sides):
             raise ValueError(f"open_boundaries: one boundary per side, got sides {sides}")
@@ -184,7 +200,7 @@ class Scene(_Model):
             x = getattr(p, "x", None)
             if x is not None and not (t.x0 <= x <= t.x1):
                 raise ValueError(f"probes.{i}.x: must lie inside the tank [{t.x0}, {t.x1}]")
-        if self.output.snapshot_every and self.output.snapshot_every > self.t_end:
+        if self.output.snapshot_every and self.output.snapshot_every > self.t_end - self.t_start:
             raise ValueError("output.snapshot_every: must not exceed t_end")
         return self
 

@@ -103,7 +103,7 @@ class Simulation:
         self._counts = np.zeros(cap, dtype=np.int64)
         self.dt = float(wcsph.initialise(*self._arrays(), ps.n, prm, self.grid.ncx, self.grid.ncz))
         self._swap()
-        self.t = 0.0
+        self.t = scene.t_start
         self.steps = 0
         self.wall_time = 0.0
         self.v_max = 0.0
@@ -322,8 +322,8 @@ class Simulation:
         cause = wcsph.STATUS_TEXT[status]
         if status == wcsph.ST_DENSITY:
             lo, hi = self.scene.constants.density_band
-            bad = np.nonzero((rho < lo * self.scene.constants.rho0) | (rho > hi * self.scene.constants.rho0))[0]
-            cause += f" [{lo}, {hi}] rho0"
+            bad = np.nonzero(rho > hi * self.scene.constants.rho0)[0]
+            cause += f" {hi} rho0"
         elif status == wcsph.ST_LEFT_DOMAIN:
             t = self.scene.tank
             hd = 0.5 * self.scene.dp

@@ -41,6 +41,23 @@ def test_run_directory_outputs(tmp_path):
     assert "particles_00002.vtu" in (tmp_path / "run.pvd").read_text()
 
 
+def test_run_starting_later_keeps_its_clock(tmp_path):
+    """t_start shifts the clock only: same particles and steps as from 0, probes from t_start."""
+    scene = small_dambreak()
+    later = scene.model_copy(update={"t_start": 2.0, "t_end": 2.0 + scene.t_end})
+    a, b = Simulation(scene), Simulation(later, run_dir=tmp_path)
+    a.advance_to(scene.t_end)
+    b.advance_to(later.t_end)
+    b.close()
+    assert b.t == pytest.approx(later.t_end) and b.steps == a.steps
+    np.testing.assert_allclose(b.particles.f[:, :b.particles.n], a.particles.f[:, :a.particles.n],
+                               atol=1e-9)
+    times = [float(r[0]) for r in list(csv.reader((tmp_path / "probes.csv").open()))[1:]]
+    assert times == pytest.approx([2.0, 2.01, 2.02, 2.03, 2.04, 2.05])
+    with pytest.raises(ValueError, match="t_end: must be after t_start"):
+        make_scene({**scene.model_dump(), "t_start": 1.0, "t_end": 0.5})
+
+
 @pytest.mark.parametrize("integrator", ["kdk", "symplectic_pc"])
 def test_checkpoint_restore_is_exact(integrator):
     scene = small_dambreak(integrator=integrator)
