@@ -7,9 +7,13 @@ Runs one case of the seed 002 validation table (tests/data/wave_cases_seed002.cs
 or any regular wave through a flume one wavelength long (standing wave: half a wavelength, faces
 at the nodes of eta) with open ends driven by the theory. Prints one JSON line:
 case, theory, H, T, d, dp, H_over_dp, periods, rmse_over_H (mid-flume gauge vs theory over the
-periods after the ramp), reflection (least squares over the gauges L/8 either side of mid-flume,
-first harmonic; incident/reflected separation, so not for the standing wave), wall_s,
-particles, steps, particle_steps_per_s, boundary counts and the mean water level drift.
+periods after the ramp), reflection (first harmonic, least squares over nine gauges within L/4
+of mid-flume with a fitted spatial decay of both waves: the coarse flume damps its waves, and a
+fit without decay reads that as reflection), reflection_3g (the plain fit over mid-flume and L/8
+either side), neither for the standing wave; wall_s, particles, steps, particle_steps_per_s,
+boundary counts, the mean water level at mid-flume (mean_level_m), the change of the flume's
+water volume per length since the start (level_drift_m) and the gauges' mean level over the
+last period (level_last_period_m).
 """
 
 from __future__ import annotations

@@ -25,8 +25,13 @@ from .wave_analysis import reflection_coefficient, rmse_over_height
 from .flume import OpenFlume, flume_nodes
 from .scene import Scene, make_scene
 
-# gauges of the reflection analysis: L/8 either side of mid-flume (spacing L/4)
-GAUGE_OFFSETS = {"mid": 0.0, "refl_a": -0.125, "refl_b": 0.125}
+# gauges [wavelengths from mid-flume] of the reflection analysis: L/16 apart within L/4 of
+# mid-flume (nine, for the decay-aware fit), among them refl_a, mid, refl_b at -L/8, 0, +L/8 (the
+# classic three-gauge least squares, reported too)
+GAUGE_OFFSETS = {"mid": 0.0, "refl_a": -0.125, "refl_b": 0.125,
+                 **{f"refl_{j:+d}": j / 16.0 for j in (-4, -3, -1, 1, 3, 4)}}
+REFLECTION_GAUGES = ["refl_-4", "refl_-3", "refl_a", "refl_-1", "mid", "refl_+1",
+                     "refl_b", "refl_+3", "refl_+4"]
 
 
 def wave_flume_scene(*, depth: float, wavelength: float, height: float, dp: float, t_end: float,
@@ -35,7 +40,7 @@ def wave_flume_scene(*, depth: float, wavelength: float, height: float, dp: floa
                      c0: float | None = None, g: float = 9.81, name: str = "wave_flume",
                      **constants: Any) -> Scene:
     """A flat-bed flume [0, length] x [0, top] (floor z = 0, still water at z = depth) with open
-    ends and elevation gauges mid-flume and L/8 either side of it.
+    ends and elevation gauges mid-flume and L/16 apart within L/4 of it.
 
     length defaults to one wavelength; the tank top leaves 2H + 4dp above still water. c0
     defaults to 10 sqrt(g d): the shallow-water celerity bounds the orbital speeds, and the
@@ -119,9 +124,15 @@ def flume_case(model: Any, *, height: float, period: float, depth: float, wavele
     Flume one wavelength long (standing wave: half, faces at the nodes of eta, antinode
     mid-flume); ``model`` must carry the start-up ramp of duration ``ramp``. rmse_over_H: the
     mid-flume gauge vs the model over the ``periods`` after the ramped wave reached mid-flume
-    (at the linear group velocity); reflection: least squares
-    over the gauges at mid-flume and L/8 either side (None for a standing wave or an irregular
-    sea, ``regular=False``, whose ``wavelength`` and ``period`` are those of the peak)."""
+    (at the linear group velocity); reflection: least squares over the nine gauges within L/4
+    of mid-flume with a fitted spatial decay (``wave_analysis``: the coarse flume damps its
+    waves, and the plain fit reads that as reflection); reflection_3g: the plain least squares
+    over mid-flume and L/8 either side. Both None for a standing wave or an irregular sea
+    (``regular=False``, whose ``wavelength`` and ``period`` are those of the peak).
+    mean_level_m: mean of the mid-flume gauge minus the model's over the scored periods;
+    level_drift_m: change of the flume's water volume per length since the start (fluid
+    particles x dp^2 / length; None unless a regular progressive wave); level_last_period_m: the reflection gauges' (else mid) time mean
+    over the last period minus the model's."""
     length = 0.5 * wavelength if standing else wavelength
     # the ramp starts the model everywhere at once, SPH's wave front travels from the inlet:
     # compare once the fully ramped wave has reached mid-flume at the (linear) group velocity
@@ -136,18 +147,31 @@ def flume_case(model: Any, *, height: float, period: float, depth: float, wavele
     x_left = -0.5 * scene.tank.x1 if standing else 0.0
     res = run_wave_flume(scene, model, window=period / window_per_period, x_model_left=x_left)
     sel = res.t >= t_start - 1e-9
-    refl = None
+    refl = refl_3g = None
     if regular and not standing:
-        names = ["refl_a", "mid", "refl_b"]
-        refl, _, _ = reflection_coefficient(
-            res.t[sel], np.array([res.eta[n][sel] for n in names]),
-            np.array([res.gauge_x[n] for n in names]), period, 2.0 * math.pi / wavelength)
+        def kr(names: list[str], decay: bool) -> float:
+            return reflection_coefficient(
+                res.t[sel], np.array([res.eta[n][sel] for n in names]),
+                np.array([res.gauge_x[n] for n in names]), period, k, decay=decay)[0]
+        refl = kr(REFLECTION_GAUGES, True)
+        refl_3g = kr(["refl_a", "mid", "refl_b"], False)
     nf = res.n_fluid
+    # water level drift: a flume one wavelength long holds the volume of still water at any
+    # phase of a regular progressive wave; each fluid particle carries dp^2 of the initial lattice
+    level_drift = ((nf[-1, 1] - nf[0, 1]) * dp * dp / scene.tank.x1
+                   if regular and not standing else None)
+    # and the gauges' time-mean over the last whole period, minus the model's
+    last = res.t >= res.t[-1] - period + 1e-9
+    gauges = REFLECTION_GAUGES if regular and not standing else ["mid"]
+    level_last = float(np.mean([np.mean(res.eta[n][last]) - np.mean(res.theory[n][last])
+                                for n in gauges]))
     return {"H": height, "T": period, "d": depth, "dp": dp, "H_over_dp": round(height / dp, 3),
             "periods": periods,
             "rmse_over_H": rmse_over_height(res.eta["mid"][sel], res.theory["mid"][sel], height),
-            "reflection": refl, "absorb": list(absorb), "wall_s": round(res.wall_s, 2),
+            "reflection": refl, "reflection_3g": refl_3g, "absorb": list(absorb),
+            "wall_s": round(res.wall_s, 2),
             "particles": res.particles, "steps": res.steps,
             "particle_steps_per_s": round(res.particles * res.steps / max(res.wall_s, 1e-9)),
             "fluid_change": int(nf[-1, 1] - nf[0, 1]), "boundary_counts": res.counts,
-            "mean_level_m": float(np.mean(res.eta["mid"][sel]) - np.mean(res.theory["mid"][sel]))}
+            "mean_level_m": float(np.mean(res.eta["mid"][sel]) - np.mean(res.theory["mid"][sel])),
+            "level_drift_m": level_drift, "level_last_period_m": level_last}

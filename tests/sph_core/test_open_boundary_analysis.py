@@ -54,6 +54,25 @@ def test_profile_is_linear_in_z_and_in_time_and_clamped_at_the_ends():
     assert ob.window_weight(1.5, np.array([1.0, 3.0])) == pytest.approx(0.25)
 
 
+def test_decay_aware_reflection_fit_separates_damping_from_reflection():
+    """Incident and reflected waves both damped at 0.07 /m (case V at H/dp = 3): the decay-aware
+    fit over nine gauges recovers K_R at the array centre, the plain fit does not."""
+    period, k, a_i, delta = 2.0, 2 * math.pi / 3.32, 0.025, 0.07
+    omega = 2 * math.pi / period
+    t = np.arange(0.0, 3 * period, period / 40)
+    xs = 1.66 + np.arange(-4, 5) * 3.32 / 16
+    xc = xs - 1.66
+    for kr in (0.0, 0.03):
+        etas = np.array([a_i * np.exp(-delta * x) * np.cos(k * x - omega * t)
+                         + kr * a_i * np.exp(delta * x) * np.cos(k * x + omega * t + 0.7)
+                         for x in xc])
+        got, inc, _ = reflection_coefficient(t, etas, xs, period, k, decay=True)
+        assert got == pytest.approx(kr, abs=1e-6)
+        assert inc == pytest.approx(a_i, rel=1e-6)
+        plain = reflection_coefficient(t, etas[[2, 4, 6]], xs[[2, 4, 6]], period, k)[0]
+        assert abs(plain - kr) > 0.01, plain
+
+
 @pytest.mark.parametrize("kr", [0.0, 0.2, 0.6])
 def test_reflection_coefficient_recovers_a_known_reflection(kr):
     period, k, a_i = 2.0, 2 * math.pi / 3.0, 0.03
