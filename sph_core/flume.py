@@ -30,7 +30,7 @@ from .boundary_data import (BoundaryData, BoundaryDataError, BoundaryNodes, Boun
                             still_sample, validate_sample)
 from .eos import GAMMA, hydrostatic_density
 from .particles import INLET, M, P, RHO, WALL, X, Z, Checkpoint
-from .scene import Scene
+from .scene import OUTLET_PRESSURE, OpenBoundary, Scene
 from .simulation import STEPS_PER_CALL, Simulation, UnstableError
 
 SIDES = ("left", "right")
@@ -135,6 +135,7 @@ class OpenFlume(Simulation):
             p[ob.OB_SQGD] = math.sqrt(c.g / depth)
             p[ob.OB_ABSORB] = 1.0 if o.absorb else 0.0
             p[ob.OB_IMPOSED] = 1.0 if o.elevation == "imposed" else 0.0
+            p[ob.OB_GHOST] = 1.0 if buffer_pressure(o) == "extrapolated" else 0.0
             p[ob.OB_XG] = nd.x_gauge
             p[ob.OB_ZBED] = nd.z_bed
             p[ob.OB_ZTOP] = nd.z_top
@@ -283,6 +284,13 @@ class OpenFlume(Simulation):
         self.eta_meas[:] = c.eta_meas
         self.counters[:] = c.counters
         self._samples = dict(c.samples)
+
+
+def buffer_pressure(o: OpenBoundary) -> str:
+    """How the buffer of open end ``o`` gets its pressure: ``hydrostatic`` or ``extrapolated``."""
+    if o.pressure is not None:
+        return o.pressure
+    return OUTLET_PRESSURE if o.elevation == "extrapolated" else "hydrostatic"
 
 
 def flume_nodes(scene: Scene) -> dict[str, BoundaryNodes]:

@@ -10,7 +10,14 @@ interpolated linearly in time and linearly in z between the nodes):
     du_b = n_x (eta_meas,b - eta_gauge,b(t)) sqrt(g/d)  if absorbing        (seed 002 correction)
     surface z_s,b = swl + eta_b(t)  (elevation imposed)  or  swl + eta_meas,b  (extrapolated)
     active (interacts as fluid) iff z_i < z_s,b;  rho_i = rho0 (1 + rho0 g (z_s,b - z_i)/B)^(1/7)
-    (hydrostatic below the imposed or measured surface; Tait EOS, same form as the initial state).
+    (hydrostatic below the imposed or measured surface; Tait EOS, same form as the initial state),
+    or, at an end with ghost extrapolation (OB_GHOST; seed 002's outlet), after the sort:
+    p_i = p_g + (x_i - x_g) dp/dx_g from the fluid at the ghost node x_g = 2 x_f - x_i mirrored
+    into the fluid (first-order consistent interpolation, Tafuni et al. 2018), rho_i = EOS^-1(p_i).
+    The outlet extrapolates by default (scene.OUTLET_PRESSURE, with the measured reflection: half
+    the hydrostatic buffer's): the hydrostatic buffer takes the pressure of the surface measured
+    2h inside the face, out of phase with the face and without the wave's non-hydrostatic
+    pressure; the ghost nodes carry the fluid's own pressure field into the buffer.
 Crossings (d: depth into the buffer, counted per end so that mass balance is exact):
     fluid with d >= 0 where the imposed flow leaves (u n_x > 0), or with d >= dp
                                  -> buffer                         (counter OUT)
@@ -32,13 +39,13 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from .eos import pressure
-from .kernels import w_of_q
+from .eos import density, pressure
+from .kernels import f_of_q, w_of_q
 from .particles import (AX, AZ, DRHO, FLUID, INACTIVE, INLET, M, N_SORTED_KDK, OUTLET, P, RHO, VX,
                         VZ, X, Z)
-from .wcsph import (PR_ALPHA_W, PR_B, PR_GAMMA, PR_GZ, PR_H, PR_INV_CS, PR_RHO0, PR_XMIN, PR_ZMIN,
-                    ST_DENSITY, ST_LEFT_DOMAIN, ST_NONFINITE, ST_REACHED_T, ST_STEP_LIMIT, _sort,
-                    fluid_pass, kdk_kick, kdk_kick_drift, stable_dt, wall_pass)
+from .wcsph import (PR_ALPHA_F, PR_ALPHA_W, PR_B, PR_GAMMA, PR_GZ, PR_H, PR_INV_CS, PR_RHO0,
+                    PR_XMIN, PR_ZMIN, ST_DENSITY, ST_LEFT_DOMAIN, ST_NONFINITE, ST_REACHED_T,
+                    ST_STEP_LIMIT, _sort, fluid_pass, kdk_kick, kdk_kick_drift, stable_dt, wall_pass)
 
 # idle buffer particles: above the boundary's surface, kept in place but not interacting.
 # End b has active kind INLET + b and idle kind INLET_IDLE + b.
@@ -51,8 +58,12 @@ STATUS_TEXT = {ST_CAPACITY: "particle capacity exhausted by open-boundary inflow
 
 # per-end parameters obp[b, :]
 (OB_ON, OB_XF, OB_NX, OB_LEN, OB_SWL, OB_SQGD, OB_ABSORB, OB_IMPOSED, OB_XG, OB_ZBED, OB_ZTOP,
- OB_DZG, OB_DP) = range(13)
-N_OBP = 13
+ OB_DZG, OB_DP, OB_GHOST) = range(14)
+N_OBP = 14
+# smallest determinant of the (h-scaled) first-order correction matrix at a ghost node; below it
+# the node has too few fluid neighbours on too few sides (free surface, corner) for a gradient,
+# and the Shepard (zeroth-order) value is used. DualSPHysics' default limit (Tafuni et al. 2018).
+GHOST_DET_MIN = 1e-3
 # per-end counters[b, :]
 C_IN, C_OUT, C_CREATED, C_REMOVED = range(4)
 N_COUNTERS = 4
@@ -145,6 +156,104 @@ def buffer_update(f, kind, n, dt, r, zs0, du0, zs1, du1, zn, win_u, win_w, prm):
         f[DRHO, i] = 0.0
         f[AX, i] = 0.0
         f[AZ, i] = 0.0
+
+
+@njit(cache=True)
+def ghost_pressure(f, kind, cell_start, xg, zg, prm, ncx, ncz):
+    """First-order consistent SPH interpolation of the fluid pressure at a ghost node (xg, zg)
+    (Liu & Liu 2006; Tafuni et al. 2018, eq. 13): with r_j = (x_j - xg, z_j - zg), V_j = m_j/rho_j,
+    the Taylor series p_j = p_g + r_j . grad p_g tested with W_gj and grad W_gj = F_gj r_j gives
+        sum_j V_j [W, F x_j, F z_j]^T [1, x_j, z_j] (p_g, p_x, p_z)^T = sum_j V_j [W, F x_j, F z_j]^T p_j
+    over fluid particles j; a linear field is reproduced exactly. Solved in h-scaled form (the
+    matrix is the identity for a full, regular support). Returns (p_g, p_x, p_z, order): order 1
+    if the determinant exceeds GHOST_DET_MIN, 0 for the Shepard value sum V W p / sum V W with no
+    gradient, -1 if the node has no fluid neighbour."""
+    x = f[X]
+    z = f[Z]
+    h = prm[PR_H]
+    aw = prm[PR_ALPHA_W]
+    af = prm[PR_ALPHA_F]
+    xmin = prm[PR_XMIN]
+    zmin = prm[PR_ZMIN]
+    inv_cs = prm[PR_INV_CS]
+    s2 = 4.0 * h * h
+    cx = min(max(int((xg - xmin) * inv_cs), 0), ncx - 1)
+    cz = min(max(int((zg - zmin) * inv_cs), 0), ncz - 1)
+    cxl = max(cx - 1, 0)
+    cxh = min(cx + 1, ncx - 1)
+    a00 = a01 = a02 = a10 = a11 = a12 = a20 = a21 = a22 = 0.0
+    b0 = b1 = b2 = 0.0
+    for zz in range(max(cz - 1, 0), min(cz + 2, ncz)):
+        row = zz * ncx
+        for j in range(cell_start[row + cxl], cell_start[row + cxh + 1]):
+            if kind[j] != FLUID:
+                continue
+            dx = x[j] - xg
+            dz = z[j] - zg
+            r2 = dx * dx + dz * dz
+            if r2 >= s2:
+                continue
+            q = math.sqrt(r2) / h
+            v = f[M, j] / f[RHO, j]
+            w = v * w_of_q(q, aw)
+            fv = v * f_of_q(q, af) * h  # h-scaled gradient weight: F r_j h, with r_j / h below
+            sx = dx / h
+            sz = dz / h
+            pj = f[P, j]
+            a00 += w
+            a01 += w * sx
+            a02 += w * sz
+            a10 += fv * dx
+            a11 += fv * dx * sx
+            a12 += fv * dx * sz
+            a20 += fv * dz
+            a21 += fv * dz * sx
+            a22 += fv * dz * sz
+            b0 += w * pj
+            b1 += fv * dx * pj
+            b2 += fv * dz * pj
+    if a00 <= 0.0:
+        return 0.0, 0.0, 0.0, -1
+    det = (a00 * (a11 * a22 - a12 * a21) - a01 * (a10 * a22 - a12 * a20)
+           + a02 * (a10 * a21 - a11 * a20))
+    if abs(det) < GHOST_DET_MIN:
+        return b0 / a00, 0.0, 0.0, 0
+    pg = (b0 * (a11 * a22 - a12 * a21) - a01 * (b1 * a22 - a12 * b2)
+          + a02 * (b1 * a21 - a11 * b2)) / det
+    px = (a00 * (b1 * a22 - a12 * b2) - b0 * (a10 * a22 - a12 * a20)
+          + a02 * (a10 * b2 - b1 * a20)) / det
+    pz = (a00 * (a11 * b2 - b1 * a21) - a01 * (a10 * b2 - b1 * a20)
+          + b0 * (a10 * a21 - a11 * a20)) / det
+    return pg, px / h, pz / h, 1
+
+
+@njit(parallel=True, cache=True)
+def buffer_extrapolate(f, kind, cell_start, n, obp, prm, ncx, ncz):
+    """Pressure and density of the active buffer particles of ends with ghost extrapolation
+    (seed 002 outlet; Tafuni et al. 2018): buffer particle i at depth d past the face x_f gets the
+    fluid's pressure at its ghost node x_g = 2 x_f - x_i (same z, d inside the fluid), carried to
+    x_i by the interpolated gradient,
+        p_i = max(p_g + (x_i - x_g) dp/dx, 0),   rho_i = rho0 (1 + p_i/B)^(1/gamma)
+    (not below zero: buffer particles have no free surface of their own to hold a suction, as the
+    hydrostatic option). A ghost node without fluid keeps the hydrostatic value of buffer_update."""
+    rho0 = prm[PR_RHO0]
+    bb = prm[PR_B]
+    gam = prm[PR_GAMMA]
+    for i in prange(n):
+        k = kind[i]
+        if k != INLET and k != OUTLET:
+            continue
+        b = 0 if k == INLET else 1
+        if obp[b, OB_GHOST] < 0.5:
+            continue
+        xi = f[X, i]
+        xg = 2.0 * obp[b, OB_XF] - xi
+        pg, px, pz, order = ghost_pressure(f, kind, cell_start, xg, f[Z, i], prm, ncx, ncz)
+        if order < 0:
+            continue
+        p = max(pg + (xi - xg) * px, 0.0)
+        f[P, i] = p
+        f[RHO, i] = density(p, rho0, bb, gam)
 
 
 @njit(cache=True)
@@ -257,7 +366,8 @@ def advance_open(f, f2, kind, kind2, ids, ids2, cell, cell2, order, cell_start, 
     """Leapfrog (kick-drift-kick, as ``wcsph.advance``) with open-boundary buffers.
 
     Per step: kick-drift of the fluid; buffers imposed and moved (data at t + dt); crossings;
-    sort (inactive slots dropped: n shrinks); walls, forces, second kick; boundary gauges.
+    sort (inactive slots dropped: n shrinks); ghost-node pressure of extrapolating ends; walls,
+    forces, second kick; boundary gauges.
     Returns (t, dt_next, steps, status, swapped, n_flagged, v_max, n)."""
     swapped = 0
     steps = 0
@@ -301,6 +411,7 @@ def advance_open(f, f2, kind, kind2, ids, ids2, cell, cell2, order, cell_start, 
         cell, cell2 = cell2, cell
         swapped = 1 - swapped
         n = cell_start[ncell]  # inactive slots were sorted to the end
+        buffer_extrapolate(f, kind, cell_start, n, obp, prm, ncx, ncz)
         wall_pass(f, kind, cell, cell_start, n, ncx, ncz, prm)
         fluid_pass(f, kind, cell, cell_start, n, ncx, ncz, prm)
         n_bad, n_band, v2max, a2max, rmax = kdk_kick(f, kind, n, dts, prm)

@@ -10,9 +10,11 @@ import math
 import numpy as np
 import pytest
 
+from sph_core import open_boundary as ob
 from sph_core.boundary_data import (BoundaryDataError, BoundaryNodes, BoundarySample, StillWater,
                                     WindowBoundary)
 from sph_core.flume import OpenFlume, flume_nodes
+from sph_core.particles import FLUID, OUTLET, P, Z
 from sph_core.scene import make_scene
 
 D = 0.3          # still-water depth [m]; the tank floor is z = 0
@@ -57,6 +59,26 @@ def test_still_water_with_open_ends_stays_still():
     assert np.max(np.abs(st["p"][low] - p_ref) / p_ref) < 0.03
     for side, eta in fl.boundary_gauges().items():
         assert eta is not None and abs(eta) < 0.5 * DP, side
+
+
+def test_outlet_pressure_extrapolated_from_a_hydrostatic_column_is_hydrostatic():
+    """The initial fluid is an exact hydrostatic column, p = rho0 g (swl - z) (Tait EOS of the
+    hydrostatic density); the ghost nodes carry it into the outlet buffer to round-off, from the
+    floor (fluid on one side in z) up to the surface row, where the support is cut off."""
+    sc = flume_scene()
+    fl = OpenFlume(sc, sources={s: StillWater(n) for s, n in flume_nodes(sc).items()})
+    assert fl.obp[1, ob.OB_GHOST] == 1.0 and fl.obp[0, ob.OB_GHOST] == 0.0  # the defaults
+    ps = fl.particles
+    kind, z = ps.kind[: ps.n], ps.f[Z, : ps.n]
+    fluid = kind == FLUID
+    np.testing.assert_allclose(ps.f[P, : ps.n][fluid], 1000.0 * G * (D - z[fluid]), rtol=1e-9)
+    out = kind == OUTLET
+    ps.f[P, : ps.n][out] = 0.0
+    ob.buffer_extrapolate(ps.f, ps.kind, fl.cell_start, ps.n, fl.obp, fl.prm, fl.grid.ncx,
+                          fl.grid.ncz)
+    assert out.sum() == 3 * round(D / DP)  # three columns up to the surface
+    np.testing.assert_allclose(ps.f[P, : ps.n][out], 1000.0 * G * (D - z[out]), rtol=1e-9,
+                               atol=1e-6)
 
 
 def test_oscillating_flow_crosses_both_ways_with_exact_mass_balance():

@@ -1,5 +1,5 @@
 """The pieces behind the flume figures: the seed 002 correction, the boundary profile
-interpolation, the reflection analysis and the RMSE."""
+interpolation, the outlet's ghost-node interpolation, the reflection analysis and the RMSE."""
 
 from __future__ import annotations
 
@@ -9,6 +9,9 @@ import numpy as np
 import pytest
 
 from sph_core import open_boundary as ob
+from sph_core.particles import FLUID, P, X, Z
+from sph_core.scene import make_scene
+from sph_core.simulation import Simulation
 from sph_core.wave_analysis import reflection_coefficient, rmse_over_height
 
 G, D = 9.81, 0.5
@@ -52,6 +55,33 @@ def test_profile_is_linear_in_z_and_in_time_and_clamped_at_the_ends():
     assert ob.profile_value(zn, a, 1.0, 0.5) == pytest.approx(12.0)
     assert ob.profile_value(zn, a, 0.0, -0.1) == pytest.approx(0.0)
     assert ob.window_weight(1.5, np.array([1.0, 3.0])) == pytest.approx(0.25)
+
+
+def test_ghost_node_interpolation_reproduces_a_linear_field_exactly():
+    """First-order consistency: p = a + b x + c z on disordered fluid is returned with its
+    gradient to round-off, inside the fluid, with half a support (at the face of an outlet) and
+    at a corner; a node with no fluid says so."""
+    dp = 0.02
+    sim = Simulation(make_scene({
+        "dp": dp, "t_end": 1.0, "still_water_level": 0.3,
+        "tank": {"x0": 0.0, "x1": 0.6, "z0": 0.0, "z1": 0.4},
+        "water_blocks": [{"x0": 0.0, "x1": 0.6, "z0": 0.0, "z1": 0.3}]}))
+    ps = sim.particles
+    f, kind = ps.f, ps.kind[: ps.n]
+    fl = kind == FLUID
+    rng = np.random.default_rng(3)
+    # disorder the lattice in place (cells stay valid: shifts are far below a cell)
+    f[X, : ps.n][fl] += rng.uniform(-0.3, 0.3, fl.sum()) * dp
+    f[Z, : ps.n][fl] += rng.uniform(-0.3, 0.3, fl.sum()) * dp
+    a, b, c = 50.0, 300.0, -9810.0
+    f[P, : ps.n][fl] = a + b * f[X, : ps.n][fl] + c * f[Z, : ps.n][fl]
+    args = (sim.prm, sim.grid.ncx, sim.grid.ncz)
+    for xg, zg in [(0.3, 0.15), (0.6, 0.15), (0.59, 0.01), (0.3, 0.29)]:
+        pg, px, pz, order = ob.ghost_pressure(f, ps.kind, sim.cell_start, xg, zg, *args)
+        assert order == 1, (xg, zg)
+        assert pg == pytest.approx(a + b * xg + c * zg, rel=1e-9, abs=1e-6), (xg, zg)
+        assert (px, pz) == pytest.approx((b, c), rel=1e-7), (xg, zg)
+    assert ob.ghost_pressure(f, ps.kind, sim.cell_start, 0.3, 0.39, *args)[3] == -1
 
 
 def test_decay_aware_reflection_fit_separates_damping_from_reflection():
