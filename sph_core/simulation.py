@@ -25,7 +25,7 @@ from .geometry import build_layout
 from .kernels import wendland_alpha
 from .neighbours import CellGrid
 from .output import RunWriter
-from .particles import (DRHO, FLUID, M, N_FIELDS, P, RHO, VX, VZ, WALL, X, Z, Checkpoint,
+from .particles import (DRHO, FLUID, INACTIVE, M, N_FIELDS, P, RHO, VX, VZ, WALL, X, Z, Checkpoint,
                         ParticleSet)
 from .probes import (fluid_neighbour_counts, interpolate_points, line_mass_density,
                      surface_from_line)
@@ -108,6 +108,8 @@ class Simulation:
         self.wall_time = 0.0
         self.v_max = 0.0
         self.fluid_mass0 = self.fluid_mass()
+        self.fluid_count0 = self.n_fluid
+        self.excluded: list[dict[str, float]] = []  # particles removed for density (_exclude)
         # probes
         self._points = [p for p in scene.probes if isinstance(p, PointProbe)]
         self._elev = [p for p in scene.probes if isinstance(p, ElevationProbe)]
@@ -212,6 +214,7 @@ class Simulation:
         return {"status": self.status, "t": self.t, "steps": self.steps,
                 "wall_time_s": round(self.wall_time, 3), "dt": self.dt,
                 "n_particles": self.n_particles, "n_fluid": self.n_fluid,
+                "excluded": len(self.excluded), "excluded_particles": self.excluded[-20:],
                 "c0": self.c0, "h": self.h, "integrator": self.scene.constants.integrator,
                 "passes_per_step": self.passes_per_step, "threads": numba.get_num_threads(),
                 "particle_steps_per_s": (self.n_particles * self.steps / self.wall_time
@@ -314,6 +317,21 @@ class Simulation:
         if status not in (wcsph.ST_REACHED_T, wcsph.ST_STEP_LIMIT):
             self._fail_unstable(status, n_flag)
 
+    def _exclude(self, bad: np.ndarray, ids: np.ndarray, x: np.ndarray, z: np.ndarray,
+                 rho: np.ndarray) -> bool:
+        """Remove the fluid particles ``bad`` (indices into the fluid selection) from the run
+        and log them, if the scene's exclude_limit allows; False if it does not."""
+        limit = self.scene.constants.exclude_limit * self.fluid_count0
+        if bad.size == 0 or len(self.excluded) + bad.size > limit:
+            return False
+        slots = np.nonzero(self.particles.mask(FLUID))[0][bad]
+        self.particles.kind[slots] = INACTIVE  # skipped by every pass, sorted to the end
+        self.excluded += [{"id": int(ids[k]), "t": self.t, "step": self.steps, "x": float(x[k]),
+                           "z": float(z[k]), "rho": float(rho[k])} for k in bad]
+        if self.writer:
+            self.writer.update_meta(**self._meta_fields())
+        return True
+
     def _fail_unstable(self, status: int, n_flag: int) -> None:
         ps = self.particles
         sel = ps.mask(FLUID)
@@ -322,8 +340,11 @@ class Simulation:
         cause = wcsph.STATUS_TEXT[status]
         if status == wcsph.ST_DENSITY:
             lo, hi = self.scene.constants.density_band
-            bad = np.nonzero(rho > hi * self.scene.constants.rho0)[0]
-            cause += f" {hi} rho0"
+            rho0 = self.scene.constants.rho0
+            bad = np.nonzero((rho < lo * rho0) | (rho > hi * rho0))[0]
+            if self._exclude(bad, ids, x, z, rho):
+                return
+            cause += f" [{lo}, {hi}] rho0 (after {len(self.excluded)} excluded)"
         elif status == wcsph.ST_LEFT_DOMAIN:
             t = self.scene.tank
             hd = 0.5 * self.scene.dp
@@ -353,6 +374,7 @@ class Simulation:
         """Return exactly to a checkpoint; the cell lists are rebuilt for its particle order."""
         self.particles.restore(c)
         self.t, self.dt, self.steps = c.t, c.dt, c.steps
+        self.excluded = [e for e in self.excluded if e["step"] <= c.steps]
         if c.cell is not None and c.cell_start is not None and c.cell_start.size == self.cell_start.size:
             self.cell[: c.n] = c.cell
             self.cell_start[:] = c.cell_start

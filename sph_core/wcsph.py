@@ -52,11 +52,8 @@ ST_DENSITY = 3
 ST_LEFT_DOMAIN = 4
 STATUS_TEXT = {
     ST_NONFINITE: "non-finite velocity or density (NaN/inf)",
-    # Only compression stops a run. A drop thrown off the surface (splash, run-up) loses
-    # density by continuity as its few neighbours move apart: not a blow-up, so its density is
-    # floored at the band's low end (tension bounded at p(low)). DualSPHysics removes particles
-    # leaving [700, 1300] kg/m^3 instead; the floor keeps every particle and the mass.
-    ST_DENSITY: "density above the sane band",
+    # the loop stops; Simulation excludes the particles if within Constants.exclude_limit
+    ST_DENSITY: "density outside the sane band",
     ST_LEFT_DOMAIN: "fluid particle left the tank (through a wall or over its top)",
 }
 
@@ -291,7 +288,7 @@ def kdk_kick(f, kind, n, dt, prm):
         if kind[i] == FLUID:
             u = vx[i] + hdt * ax[i]
             w = vz[i] + hdt * az[i]
-            r = max(rho[i] + hdt * drho[i], lo)  # floor: see STATUS_TEXT[ST_DENSITY]
+            r = rho[i] + hdt * drho[i]
             vx[i] = u
             vz[i] = w
             rho[i] = r
@@ -299,7 +296,7 @@ def kdk_kick(f, kind, n, dt, prm):
             a2 = ax[i] * ax[i] + az[i] * az[i]
             if not (np.isfinite(v2) and np.isfinite(r) and np.isfinite(a2)):
                 n_bad += 1
-            elif r > hi:
+            elif r < lo or r > hi:
                 n_band += 1
             v2max = max(v2max, v2)
             a2max = max(a2max, a2)
@@ -366,7 +363,7 @@ def pc_correct(f, kind, n, dt, prm):
     for i in prange(n):
         if kind[i] == FLUID:
             eps = -f[DRHO, i] / rho[i] * dt
-            r = max(f[RHON, i] * (2.0 - eps) / (2.0 + eps), lo)  # floor: STATUS_TEXT[ST_DENSITY]
+            r = f[RHON, i] * (2.0 - eps) / (2.0 + eps)
             u0 = f[VXN, i]
             w0 = f[VZN, i]
             u = u0 + dt * ax[i]
@@ -383,7 +380,7 @@ def pc_correct(f, kind, n, dt, prm):
             a2 = ax[i] * ax[i] + az[i] * az[i]
             if not (np.isfinite(v2) and np.isfinite(r) and np.isfinite(a2)):
                 n_bad += 1
-            elif r > hi:
+            elif r < lo or r > hi:
                 n_band += 1
             if not (xi >= fx0 and xi <= fx1 and zi >= fz0 and zi <= fz1):
                 n_out += 1

@@ -100,6 +100,24 @@ def test_unstable_run_stops_with_cause_and_keeps_outputs(tmp_path):
         sim.advance_to(scene.t_end)
 
 
+def test_particles_out_of_band_are_excluded_within_the_limit(tmp_path):
+    """A band so tight that the column's surface particles leave it: with a generous
+    exclude_limit they are removed and logged and the run goes on; with none it stops."""
+    band = {"c0": 0.5, "density_band": (0.9, 1.1)}
+    scene = small_dambreak(**band, exclude_limit=1.0)
+    sim = Simulation(scene, run_dir=tmp_path)
+    n0 = sim.n_fluid
+    sim.advance_to(scene.t_end)
+    sim.close()
+    assert sim.excluded and sim.n_fluid + len(sim.excluded) == n0
+    assert all(not 900.0 <= e["rho"] <= 1100.0 for e in sim.excluded)
+    assert len({e["id"] for e in sim.excluded}) == len(sim.excluded)
+    meta = json.loads((tmp_path / "meta.json").read_text())
+    assert meta["status"] == "completed" and meta["excluded"] == len(sim.excluded)
+    with pytest.raises(UnstableError, match="density"):
+        Simulation(small_dambreak(**band, exclude_limit=0.0)).advance_to(scene.t_end)
+
+
 def test_dry_gauge_reports_dry(tmp_path):
     scene = make_scene({
         "dp": 0.01, "t_end": 0.01, "still_water_level": 0.1,
