@@ -39,6 +39,8 @@ from typing import Any
 
 import numpy as np
 
+from wave_client.boussinesq.dispersion import G
+
 from .demo_cli import InProcessServer, _wait
 
 H_MIN_FRACTION = 1.0 / 3.0   # the reference Boussinesq beach ends at depth d/3 (then a sponge)
@@ -60,6 +62,8 @@ class FlumeCase:
     ramp_periods: float = 2.0     # start-up ramp of the source [periods]
     compare_periods: float = 4.0  # periods compared after the ramped wave reached the gauge
     dx_per_wavelength: int = 40   # Boussinesq grid
+    late_start: bool = True       # the SPH zone starts at t_sph_start, not at 0 (see there)
+    settle_periods: float = 2.0   # SPH zone at rest before the first waves reach it [periods]
 
     def at(self, dp: float) -> "FlumeCase":
         """The case with its depth rounded to whole particle rows of spacing dp."""
@@ -89,6 +93,23 @@ class FlumeCase:
     def x_couple(self) -> float:
         """Model x of the SPH inlet [m]."""
         return self.wavelengths * self.wavelength
+
+    @property
+    def t_quiet(self) -> float:
+        """Until this time [s] the SPH inlet sees (almost) still water: no linear wave outruns
+        the long-wave speed sqrt(g d), and the source's signal starts half a wavelength
+        up-flume of x_c's distance from x = 0. Measured (default case, dp = 0.02): the model's
+        |eta| at x_c stays below 1e-4 H until 14.3 s, t_quiet = 14.8 s, 1e-3 H at 15.2 s."""
+        return max(0.0, (self.x_couple - 0.5 * self.wavelength) / math.sqrt(G * self.depth))
+
+    @property
+    def t_sph_start(self) -> float:
+        """Clock of the SPH zone's first step [s] (scene ``t_start``): the water has
+        ``settle_periods`` to settle from its initial lattice before the waves arrive; the
+        Boussinesq model runs alone up to it (WELCOME's t_start). 0 without ``late_start``."""
+        if not self.late_start:
+            return 0.0
+        return max(0.0, self.t_quiet - self.settle_periods * self.period)
 
     @property
     def x_toe(self) -> float:
@@ -147,11 +168,7 @@ def _sph_scene(c: FlumeCase, dp: float, t_end: float, x_toe: float, gauges: dict
                           "z1": d}],
         "beds": [{"points": [[x_toe, 0.0], [x1, c.slope * (x1 - x_toe)]]}],
         # c0 = 10 sqrt(g d) bounds orbital speeds x10; free slip: both wave models are inviscid
-        # density band low end 0.5 (default 0.7): a splash drop thrown up the beach keeps few
-        # neighbours, its density falls by continuity (its pressure saturates at -B anyway); at
-        # 0.7 the guard stopped still-water runs at t = 1-2.3 s (dp = 0.02) on such drops
-        "constants": {"c0": 10.0 * math.sqrt(9.81 * d), "wall_slip": "free_slip",
-                      "density_band": [0.5, 1.3]},
+        "constants": {"c0": 10.0 * math.sqrt(G * d), "wall_slip": "free_slip"},
         "output": {"probe_every": c.period / 20},
         "probes": [{"kind": "elevation", "name": n, "x": x} for n, x in gauges.items()],
         "open_boundaries": [{"side": "left", "elevation": "imposed", "absorb": absorb}],
@@ -159,9 +176,11 @@ def _sph_scene(c: FlumeCase, dp: float, t_end: float, x_toe: float, gauges: dict
 
 
 def sph_zone_scene(c: FlumeCase, dp: float, absorb: bool = False) -> dict[str, Any]:
-    """The SPH zone of the coupled flume (server scene): inlet at SPH x = 0 (model x_c)."""
+    """The SPH zone of the coupled flume (server scene): inlet at SPH x = 0 (model x_c),
+    clock from ``c.t_sph_start``."""
     c = c.at(dp)
-    return _sph_scene(c, dp, c.t_end, c.x_flat, c.gauges, "coupled-flume-sph-zone", absorb)
+    scene = _sph_scene(c, dp, c.t_end, c.x_flat, c.gauges, "coupled-flume-sph-zone", absorb)
+    return {**scene, "t_start": round(c.t_sph_start, 6)}
 
 
 def sph_only_scene(c: FlumeCase, dp: float, t_end: float | None = None) -> dict[str, Any]:

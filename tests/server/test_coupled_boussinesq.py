@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import math
 import tomllib
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -27,21 +28,23 @@ def passive_omp(monkeypatch):
     monkeypatch.setenv("OMP_WAIT_POLICY", "passive")  # shared cores; kept out of other tests
 
 
-@pytest.mark.parametrize("two_way,transport", [(True, "ws"), (False, "tcp")])
+@pytest.mark.parametrize("two_way,transport,wavelengths", [(True, "ws", 2.0), (False, "tcp", 4.0)])
 def test_coarse_coupled_flume_follows_the_boussinesq_only_run(tmp_path, passive_omp, two_way,
-                                                              transport):
+                                                              transport, wavelengths):
     """Two-way (the model's boundary lets SPH's reflection out) over WebSocket, absorption-only
     (`wavesph couple --absorb`) over TCP. Finishes with every gauge wet and finite, and the
     flat-bed gauge follows the Boussinesq-only run: correlation >= 0.9 (phase error below
     ~25 deg; a wrong x offset of L/4 gives ~0, a sign error -1, no wave NaN) and RMSE/H <= 0.25:
     at H/dp = 1 the kernel gauge's surface is uncertain by ~dp/4 = H/4 (the fine-dp goal is the
-    slow test's)."""
-    c = COARSE.at(COARSE_DP)
+    slow test's). Over 4 wavelengths the SPH zone starts late (t_sph_start > 0)."""
+    c = replace(COARSE, wavelengths=wavelengths).at(COARSE_DP)
+    assert (c.t_sph_start > 0) == (wavelengths > 2)
     res = run_coupled(c, COARSE_DP, tmp_path, two_way=two_way, transport=transport)
     assert res["exit_code"] == 0 and res["state"] == "finished", res["status"]
     assert res["absorb"] == ("none" if two_way else "client")  # one absorber, never two
-    assert res["windows"] == math.ceil(c.t_end / c.window - 1e-9)
+    assert res["windows"] == math.ceil((c.t_end - c.t_sph_start) / c.window - 1e-9)
     t, eta = res["t"], res["eta"]
+    assert t[0] == pytest.approx(c.t_sph_start + c.window)  # a row per window end
     assert t[-1] == pytest.approx(c.t_end)
     assert set(eta) == {"left_boundary", "flat", "toe", "beach"}
     for name, series in eta.items():
@@ -53,6 +56,26 @@ def test_coarse_coupled_flume_follows_the_boussinesq_only_run(tmp_path, passive_
     # the client wrote its log: the same windows
     log = (tmp_path / "client_gauges.csv").read_text().splitlines()
     assert sum(1 for line in log if line and line[0].isdigit()) == res["windows"]
+
+
+def test_sph_zone_starts_while_its_water_is_still():
+    """Before t_sph_start the Boussinesq model's elevation at the SPH inlet stays below
+    1e-3 H: the SPH zone, at rest until then, misses nothing of the waves."""
+    c = FlumeCase().at(0.02)
+    assert c.t_quiet - c.t_sph_start == pytest.approx(c.settle_periods * c.period)
+    assert c.t_sph_start > 0.3 * c.t_end  # worth it: the SPH zone skips a third of the run
+    model = build_model(WaveScene.model_validate(wave_scene(c, two_way=False)))
+    peak = 0.0
+    for t in np.arange(0.0, c.t_quiet, c.window):
+        model.advance_to(float(t))
+        peak = max(peak, float(np.abs(model.elevation(np.array([c.x_couple])))[0]))
+    assert peak < 1e-3 * c.height
+    late = []  # and the waves do come after it
+    for t in np.arange(c.compare_from - c.period, c.compare_from, c.window):
+        model.advance_to(float(t))
+        late.append(float(model.elevation(np.array([c.x_couple]))[0]))
+    assert np.ptp(late) > 0.8 * c.height
+    assert sph_zone_scene(c, 0.02)["t_start"] == pytest.approx(c.t_sph_start)
 
 
 def test_scenes_are_one_flume():
