@@ -45,7 +45,8 @@ from .particles import (AX, AZ, DRHO, FLUID, INACTIVE, INLET, M, N_SORTED_KDK, O
                         VZ, X, Z)
 from .wcsph import (PR_ALPHA_F, PR_ALPHA_W, PR_B, PR_GAMMA, PR_GZ, PR_H, PR_INV_CS, PR_RHO0,
                     PR_XMIN, PR_ZMIN, ST_DENSITY, ST_LEFT_DOMAIN, ST_NONFINITE, ST_REACHED_T,
-                    ST_STEP_LIMIT, _sort, fluid_pass, kdk_kick, kdk_kick_drift, stable_dt, wall_pass)
+                    ST_STEP_LIMIT, _sort, fluid_pass, kdk_kick, kdk_kick_drift, stable_dt,
+                    wall_pass)
 
 # idle buffer particles: above the boundary's surface, kept in place but not interacting.
 # End b has active kind INLET + b and idle kind INLET_IDLE + b.
@@ -163,7 +164,8 @@ def ghost_pressure(f, kind, cell_start, xg, zg, prm, ncx, ncz):
     """First-order consistent SPH interpolation of the fluid pressure at a ghost node (xg, zg)
     (Liu & Liu 2006; Tafuni et al. 2018, eq. 13): with r_j = (x_j - xg, z_j - zg), V_j = m_j/rho_j,
     the Taylor series p_j = p_g + r_j . grad p_g tested with W_gj and grad W_gj = F_gj r_j gives
-        sum_j V_j [W, F x_j, F z_j]^T [1, x_j, z_j] (p_g, p_x, p_z)^T = sum_j V_j [W, F x_j, F z_j]^T p_j
+        sum_j V_j [W, F x_j, F z_j]^T [1, x_j, z_j] (p_g, p_x, p_z)^T
+            = sum_j V_j [W, F x_j, F z_j]^T p_j
     over fluid particles j; a linear field is reproduced exactly. Solved in h-scaled form (the
     matrix is the identity for a full, regular support). Returns (p_g, p_x, p_z, order): order 1
     if the determinant exceeds GHOST_DET_MIN, 0 for the Shepard value sum V W p / sum V W with no

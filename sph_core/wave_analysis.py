@@ -48,7 +48,8 @@ def harmonic_amplitude(t: np.ndarray, eta: np.ndarray, omega: float) -> complex:
 
 def _separate(amp: np.ndarray, xs: np.ndarray, k: float, delta: float
               ) -> tuple[complex, complex, float]:
-    """Least-squares (a_I, a_R, residual norm) of A_j = a_I e^{-(ik+delta)x_j} + a_R e^{(ik+delta)x_j}."""
+    """Least squares (a_I, a_R, residual norm) of
+    A_j = a_I exp(-(i k + delta) x_j) + a_R exp((i k + delta) x_j)."""
     a = np.stack([np.exp(-(1j * k + delta) * xs), np.exp((1j * k + delta) * xs)], axis=1)
     (a_i, a_r), *_ = np.linalg.lstsq(a, amp, rcond=None)
     return complex(a_i), complex(a_r), float(np.linalg.norm(a @ np.array([a_i, a_r]) - amp))

@@ -131,8 +131,8 @@ def flume_case(model: Any, *, height: float, period: float, depth: float, wavele
     (``regular=False``, whose ``wavelength`` and ``period`` are those of the peak).
     mean_level_m: mean of the mid-flume gauge minus the model's over the scored periods;
     level_drift_m: change of the flume's water volume per length since the start (fluid
-    particles x dp^2 / length; None unless a regular progressive wave); level_last_period_m: the reflection gauges' (else mid) time mean
-    over the last period minus the model's."""
+    particles x dp^2 / length; None unless a regular progressive wave); level_last_period_m:
+    the reflection gauges' (else mid) time mean over the last period minus the model's."""
     length = 0.5 * wavelength if standing else wavelength
     # the ramp starts the model everywhere at once, SPH's wave front travels from the inlet:
     # compare once the fully ramped wave has reached mid-flume at the (linear) group velocity

@@ -70,28 +70,36 @@ def test_case_meets_the_accuracy_goal_at_ten_particles_per_height(test):
 
 
 @pytest.mark.slow
-def test_correction_switched_off_reflects_much_more():
-    """Seed 002's correction on both ends vs off on both ends (bench at H/dp = 3:
-    K_R = 0.07 with, 0.68 without): without it the outlet imposes the theory's velocity
-    whatever arrives, and the mismatch goes back into the flume."""
-    with_corr = run_case("V", dp=0.02, periods=2.0)
-    without = run_case("V", dp=0.02, periods=2.0, absorb=(False, False))
-    assert without["reflection"] > 3.0 * with_corr["reflection"], (with_corr, without)
-    assert without["rmse_over_H"] > with_corr["rmse_over_H"], (with_corr, without)
+def test_absorbing_outlet_reflects_less_than_five_percent_and_far_less_without_correction():
+    """Seed 002's correction on both ends vs off on both ends, case V at H/dp = 3, 3 periods
+    (bench/flume_accuracy.py, measured: K_R = 0.020 with (three-gauge fit 0.040), 0.60 without;
+    RMSE/H 0.060 and 0.28; ~50 s each): without it the outlet imposes the theory's velocity
+    whatever arrives (the SPH wave reaches it 20 % smaller), and the mismatch goes back."""
+    with_corr = run_case("V", dp=0.02, periods=3.0)
+    without = run_case("V", dp=0.02, periods=3.0, absorb=(False, False))
+    assert with_corr["reflection"] < 0.05, with_corr
+    assert without["reflection"] > 5.0 * with_corr["reflection"], (with_corr, without)
+    assert without["rmse_over_H"] > 2.0 * with_corr["rmse_over_H"], (with_corr, without)
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(reason="goal not met yet: K_R = 0.073 at H/dp = 3 and 0.078 at H/dp = 6 "
-                          "(bench/flume_accuracy.py, case V, 2 periods)", strict=False)
-def test_absorbing_outlet_reflects_less_than_five_percent():
+def test_absorbing_outlet_reflects_less_than_five_percent_at_six_particles_per_height():
+    """Case V at H/dp = 6, 4 periods (measured: K_R = 0.019, three-gauge fit 0.040; RMSE/H
+    0.042; ~9 min)."""
     res = run_case("V", dp=0.01, periods=4.0)
     assert res["reflection"] < 0.05, res
 
 
 @pytest.mark.slow
 def test_mean_water_level_drifts_less_than_half_a_particle_over_twenty_periods():
-    res = run_case("V", dp=0.015, periods=20.0)
-    assert abs(res["mean_level_m"]) < 0.5 * 0.015, res
+    """Case V at H/dp = 4, 20 periods after the ramp: the flume's water volume per length
+    against still water, and the gauges' mean level over the last period against the model's
+    (measured: +1.3 mm and -1.7 mm, limit 7.5 mm; ~10 min); the first rests on the exact mass
+    balance."""
+    dp = 0.015
+    res = run_case("V", dp=dp, periods=20.0)
+    assert abs(res["level_drift_m"]) < 0.5 * dp, res
+    assert abs(res["level_last_period_m"]) < 0.5 * dp, res
     counts = res["boundary_counts"]
     assert res["fluid_change"] == sum(c["in"] - c["out"] for c in counts.values())
     assert math.isfinite(res["rmse_over_H"])
