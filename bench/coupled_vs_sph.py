@@ -21,6 +21,9 @@ Boussinesq source --wavelengths wavelengths (12: 23.6 m) up-flume of an SPH zone
 rmse_over_H: elevation at the flat-bed gauge inside the SPH zone (0.8 m past the inlet) against
 the reference, over t >= compare_from (ramp + front travel + 1 period) to t_end (4 periods).
 What bounds it: the SPH wave's own loss over those 0.8 m (bench/wave_decay.py, no coupling).
+Speed figures want a quiet machine and OpenMP's default (active) wait policy: on a shared,
+loaded machine set OMP_WAIT_POLICY=passive, which costs the small SPH zone ~27 % of its
+throughput (its parallel regions are short; a sleeping worker takes ~0.1 ms to wake).
 Prints one JSON object per line: one per run, then the summary with `speedup` = SPH-only wall
 time / coupled wall time (two-way if it finished, else absorption-only).
 """
@@ -29,12 +32,10 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
 import sys
 import tempfile
 from pathlib import Path
 
-os.environ.setdefault("OMP_WAIT_POLICY", "passive")  # before numba: shared, loaded cores
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from server.coupled_flume import (FlumeCase, correlation, reference_run, rmse_over_h,  # noqa: E402
