@@ -62,7 +62,6 @@ class FlumeCase:
     ramp_periods: float = 2.0     # start-up ramp of the source [periods]
     compare_periods: float = 4.0  # periods compared after the ramped wave reached the gauge
     dx_per_wavelength: int = 40   # Boussinesq grid
-    late_start: bool = True       # the SPH zone starts at t_sph_start, not at 0 (see there)
     settle_periods: float = 2.0   # SPH zone at rest before the first waves reach it [periods]
 
     def at(self, dp: float) -> "FlumeCase":
@@ -83,11 +82,11 @@ class FlumeCase:
     @property
     def group_velocity(self) -> float:
         """Linear (Airy) group velocity on the flat bed [m/s]: the speed of the ramped front."""
+        from sph_core.wave_analysis import group_velocity
         from wave_client.theories import wavenumber
 
-        k = float(wavenumber(self.omega, self.depth))
-        kd = k * self.depth
-        return 0.5 * self.omega / k * (1.0 + 2.0 * kd / math.sinh(2.0 * kd))
+        airy_wavelength = 2.0 * math.pi / float(wavenumber(self.omega, self.depth))
+        return group_velocity(airy_wavelength, self.period, self.depth)
 
     @property
     def x_couple(self) -> float:
@@ -106,9 +105,7 @@ class FlumeCase:
     def t_sph_start(self) -> float:
         """Clock of the SPH zone's first step [s] (scene ``t_start``): the water has
         ``settle_periods`` to settle from its initial lattice before the waves arrive; the
-        Boussinesq model runs alone up to it (WELCOME's t_start). 0 without ``late_start``."""
-        if not self.late_start:
-            return 0.0
+        Boussinesq model runs alone up to it (WELCOME's t_start)."""
         return max(0.0, self.t_quiet - self.settle_periods * self.period)
 
     @property

@@ -248,7 +248,7 @@ class OpenFlume(Simulation):
                                         unstable_step=self.steps, unstable_t=self.t)
             raise UnstableError(self.steps, self.t, cause)
         if status not in (wcsph.ST_REACHED_T, wcsph.ST_STEP_LIMIT):
-            self._fail_unstable(status, n_flag)
+            self._stopped(status, n_flag)
 
     # ---------------------------------------------------------------- readings
     def boundary_gauges(self) -> dict[str, float | None]:

@@ -208,7 +208,7 @@ class Scene(_Model):
             if x is not None and not (t.x0 <= x <= t.x1):
                 raise ValueError(f"probes.{i}.x: must lie inside the tank [{t.x0}, {t.x1}]")
         if self.output.snapshot_every and self.output.snapshot_every > self.t_end - self.t_start:
-            raise ValueError("output.snapshot_every: must not exceed t_end")
+            raise ValueError("output.snapshot_every: must not exceed the run's length t_end - t_start")
         return self
 
     # derived quantities -------------------------------------------------------------------

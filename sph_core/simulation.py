@@ -291,31 +291,24 @@ class Simulation:
 
     def _run_until(self, t_stop: float) -> None:
         """One call of the jitted closed-tank loop up to ``t_stop`` (or STEPS_PER_CALL steps)."""
-        tic = time.perf_counter()
-        ps = self.particles
-        t, dt, steps, status, swapped, n_flag, vmax = wcsph.advance(
-            *self._arrays(), ps.n, self.prm, self.grid.ncx, self.grid.ncz,
-            self.integrator, self.t, self.dt, t_stop, STEPS_PER_CALL)
-        self.wall_time += time.perf_counter() - tic
-        if swapped:
-            self._swap()
-        self.t, self.dt, self.steps, self.v_max = float(t), float(dt), self.steps + steps, vmax
-        if status not in (wcsph.ST_REACHED_T, wcsph.ST_STEP_LIMIT):
-            self._fail_unstable(status, n_flag)
+        self._advance_closed(t_stop, STEPS_PER_CALL)
 
     def advance_steps(self, n_steps: int) -> None:
         """Take exactly ``n_steps`` steps without recording outputs (benchmarks, tests)."""
+        self._advance_closed(math.inf, int(n_steps))
+
+    def _advance_closed(self, t_stop: float, max_steps: int) -> None:
         ps = self.particles
         tic = time.perf_counter()
         t, dt, steps, status, swapped, n_flag, vmax = wcsph.advance(
             *self._arrays(), ps.n, self.prm, self.grid.ncx, self.grid.ncz, self.integrator,
-            self.t, self.dt, math.inf, int(n_steps))
+            self.t, self.dt, t_stop, max_steps)
         self.wall_time += time.perf_counter() - tic
         if swapped:
             self._swap()
         self.t, self.dt, self.steps, self.v_max = float(t), float(dt), self.steps + steps, vmax
         if status not in (wcsph.ST_REACHED_T, wcsph.ST_STEP_LIMIT):
-            self._fail_unstable(status, n_flag)
+            self._stopped(status, n_flag)
 
     def _exclude(self, bad: np.ndarray, ids: np.ndarray, x: np.ndarray, z: np.ndarray,
                  rho: np.ndarray) -> bool:
@@ -332,7 +325,9 @@ class Simulation:
             self.writer.update_meta(**self._meta_fields())
         return True
 
-    def _fail_unstable(self, status: int, n_flag: int) -> None:
+    def _stopped(self, status: int, n_flag: int) -> None:
+        """The jitted loop stopped early: exclude out-of-band particles if the scene allows (the
+        caller's loop then goes on), else fail the run as unstable with its cause."""
         ps = self.particles
         sel = ps.mask(FLUID)
         x, z, rho = ps.field(X)[sel], ps.field(Z)[sel], ps.field(RHO)[sel]

@@ -24,6 +24,12 @@ import numpy as np
 from scipy.optimize import minimize_scalar
 
 
+def group_velocity(wavelength: float, period: float, depth: float) -> float:
+    """Linear group velocity [m/s] of a wave of ``wavelength`` and ``period`` in ``depth``."""
+    kd = 2.0 * math.pi / wavelength * depth
+    return 0.5 * (wavelength / period) * (1.0 + 2.0 * kd / math.sinh(2.0 * kd))
+
+
 def rmse_over_height(eta: np.ndarray, eta_theory: np.ndarray, height: float) -> float:
     """sqrt(mean((eta - eta_theory)^2)) / H.
 

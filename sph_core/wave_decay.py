@@ -20,7 +20,7 @@ from typing import Any
 import numpy as np
 
 from .scene import ElevationProbe
-from .wave_analysis import harmonic_amplitude
+from .wave_analysis import group_velocity, harmonic_amplitude
 from .wave_flume import run_wave_flume, wave_flume_scene
 
 
@@ -46,11 +46,9 @@ def amplitude_profile(model: Any, *, ramp: float, height: float, period: float, 
     """Run the flume driven by ``model`` (its start-up ramp lasting ``ramp`` s) and measure
     the amplitude ratio along it (``constants`` override the scene's, e.g. alpha)."""
     length = float(model.length)
-    k = 2.0 * math.pi / length
-    kd = k * depth
-    c_g = 0.5 * (length / period) * (1.0 + 2.0 * kd / math.sinh(2.0 * kd))
     xs = np.round(np.linspace(2.0 * math.sqrt(2.0) * dp, 0.75 * length, n_gauges), 4)
-    t0 = ramp + xs[-1] / c_g + period  # the ramped front and one period past the last gauge
+    # the ramped front and one period past the last gauge
+    t0 = ramp + xs[-1] / group_velocity(length, period, depth) + period
     scene = wave_flume_scene(depth=depth, wavelength=length, height=height, dp=dp,
                              t_end=t0 + periods * period, length=length, absorb=(True, True),
                              right_elevation="extrapolated", probe_every=period / 40,

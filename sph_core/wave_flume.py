@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 
 from .boundary_data import WaveModelBoundary
-from .wave_analysis import reflection_coefficient, rmse_over_height
+from .wave_analysis import group_velocity, reflection_coefficient, rmse_over_height
 from .flume import OpenFlume, flume_nodes
 from .scene import Scene, make_scene
 
@@ -138,8 +138,7 @@ def flume_case(model: Any, *, height: float, period: float, depth: float, wavele
     # compare once the fully ramped wave has reached mid-flume at the (linear) group velocity
     k = 2.0 * math.pi / wavelength
     kd = k * depth
-    c_g = 0.5 * (wavelength / period) * (1.0 + 2.0 * kd / math.sinh(2.0 * kd))
-    t_start = ramp + (0.0 if standing else 0.5 * length / c_g)
+    t_start = ramp + (0.0 if standing else 0.5 * length / group_velocity(wavelength, period, depth))
     scene = wave_flume_scene(depth=depth, wavelength=wavelength, height=height, dp=dp,
                              t_end=t_start + periods * period, length=length, absorb=absorb,
                              right_elevation="imposed" if standing else "extrapolated",
