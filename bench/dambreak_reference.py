@@ -23,8 +23,8 @@ import time
 import numba
 import numpy as np
 
-from sph_core.cli import progress_bar
-from sph_core.dambreak import dambreak_scene, front_errors
+from sph_core.progress import progress_bar
+from cases.dambreak import dambreak_scene, front_errors
 from sph_core.simulation import Simulation
 
 

@@ -25,7 +25,7 @@ import math
 import sys
 from pathlib import Path
 
-from sph_core.wave_flume import flume_case
+from cases.wave_flume import flume_case
 from wave_client.theories import build_theory, wavenumber
 
 CASES_CSV = Path(__file__).resolve().parents[1] / "tests" / "data" / "wave_cases_seed002.csv"
@@ -40,7 +40,7 @@ def read_cases(path: Path = CASES_CSV) -> dict[str, dict]:
         return {r["test"]: r for r in rows}
 
 
-def build_model(theory: str, height: float, period: float, depth: float, ramp: float):
+def case_theory(theory: str, height: float, period: float, depth: float, ramp: float):
     name, opts = THEORY_OF.get(theory, (theory, {}))
     return build_theory(name, height=height, period=period, depth=depth, ramp_time=ramp, **opts)
 
@@ -48,7 +48,7 @@ def build_model(theory: str, height: float, period: float, depth: float, ramp: f
 def run(theory: str, height: float, period: float, depth: float, dp: float, periods: float,
         ramp_periods: float = 1.0, absorb: bool = True, case: str | None = None) -> dict:
     ramp = ramp_periods * period
-    model = build_model(theory, height, period, depth, ramp)
+    model = case_theory(theory, height, period, depth, ramp)
     if theory == "irregular":  # flume length and gauges from the peak wave
         wavelength = 2 * math.pi / float(wavenumber(2 * math.pi / period, depth))
     else:

@@ -3,8 +3,8 @@
     python bench/wave_decay.py [--H 0.04 --T 1.4 --d 0.24] [--dp 0.02] [--alpha 0.01] [--periods 4]
 
 A flume one wavelength long with open ends driven by second-order Stokes theory (the wave of the
-coupled flume, server/coupled_flume.py, by default), gauges from 2h past the inlet to 3/4 of the
-flume (sph_core/wave_decay.py). No coupling and no wave model but the theory: the SPH wave's own
+coupled flume, cases/coupled_flume.py, by default), gauges from 2h past the inlet to 3/4 of the
+flume (cases/wave_decay.py). No coupling and no wave model but the theory: the SPH wave's own
 loss, the floor under any coupled flume's error at that dp.
 Prints one JSON line: H, T, d, dp, H_over_dp, alpha, x, amplitude_ratio (SPH / theory, first
 harmonic), decay_per_m (least squares of the log), amplitude_at_0_8m (that fit 0.8 m past the
@@ -22,7 +22,7 @@ from pathlib import Path
 os.environ.setdefault("OMP_WAIT_POLICY", "passive")  # before numba: shared, loaded cores
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from sph_core.wave_decay import amplitude_profile  # noqa: E402
+from cases.wave_decay import amplitude_profile  # noqa: E402
 from wave_client.theories import build_theory  # noqa: E402
 
 

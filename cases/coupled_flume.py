@@ -7,8 +7,9 @@ One flume, three ways to compute it (x in the Boussinesq model's frame: source a
 
 - coupled: the Boussinesq model (wave_client, a `wavesph waves` scene) covers the far field up to
   x_c plus an overlap of flat bed ending in a sponge; the SPH zone (server, sph_core's OpenFlume)
-  starts with an open inlet at x_c. The client is `wavesph couple --model boussinesq --config
-  <scene.toml>`, unchanged, over a real socket. ``two_way`` (the wave scene's ``[coupling]``):
+  starts with an open inlet at x_c. The client is wave_client's `couple` with the model of the
+  scene file, as `wavesph couple --model boussinesq --config <scene.toml>` runs it, over a real
+  socket. ``two_way`` (the wave scene's ``[coupling]``):
   SPH's elevation and z_alpha velocity at the inlet gauge become the model's characteristic
   boundary at x_c (the beach's reflection travels on into the model, the inlet lets it out);
   False: absorption-only (the model never hears of SPH; the client's seed 002 correction,
@@ -28,7 +29,6 @@ from still water. SPH x = model x - x_c.
 
 from __future__ import annotations
 
-import contextlib
 import json
 import math
 import sys
@@ -39,13 +39,13 @@ from typing import Any
 
 import numpy as np
 
-from wave_client.boussinesq.dispersion import G
+from server.runs import TERMINAL
+from wave_client import G
 
-from .demo_cli import InProcessServer, _wait
+from .local_server import InProcessServer, wait_for_state
 
 H_MIN_FRACTION = 1.0 / 3.0   # the reference Boussinesq beach ends at depth d/3 (then a sponge)
 SHORE_ROWS = 2               # particle rows of the thinnest water filled at the shoreline
-TERMINAL = {"finished", "failed", "unstable", "cancelled"}
 
 
 @dataclass(frozen=True)
@@ -82,8 +82,9 @@ class FlumeCase:
     @property
     def group_velocity(self) -> float:
         """Linear (Airy) group velocity on the flat bed [m/s]: the speed of the ramped front."""
-        from sph_core.wave_analysis import group_velocity
         from wave_client.theories import wavenumber
+
+        from .wave_analysis import group_velocity
 
         airy_wavelength = 2.0 * math.pi / float(wavenumber(self.omega, self.depth))
         return group_velocity(airy_wavelength, self.period, self.depth)
@@ -258,7 +259,7 @@ def to_toml(data: dict[str, Any], header: str = "") -> str:
 # ---------------------------------------------------------------------------- runs
 def reference_run(c: FlumeCase, times: np.ndarray) -> dict[str, np.ndarray]:
     """Boussinesq-only elevation [m] at the SPH-zone gauges (by name) at ``times`` [s]."""
-    from wave_client.boussinesq.scene import WaveScene, build_model
+    from wave_client.boussinesq.wave_scene import WaveScene, build_model
 
     scene = WaveScene.model_validate(wave_scene(c, reference=True))
     model = build_model(scene)
@@ -272,7 +273,7 @@ def reference_run(c: FlumeCase, times: np.ndarray) -> dict[str, np.ndarray]:
 
 def rmse_over_h(t: np.ndarray, eta: np.ndarray, ref: np.ndarray, c: FlumeCase) -> float | None:
     """RMSE/H of eta against ref over [compare_from, t_end]; None if the run ended before."""
-    from sph_core.wave_analysis import rmse_over_height
+    from .wave_analysis import rmse_over_height
 
     sel = t >= c.compare_from - 1e-9
     if sel.sum() < 10:
@@ -288,7 +289,7 @@ def correlation(t: np.ndarray, eta: np.ndarray, ref: np.ndarray, t0: float) -> f
 
 def _gauges_csv(path: Path) -> tuple[np.ndarray, dict[str, np.ndarray]]:
     """(t, {gauge name: eta}) of a server gauges.csv; dry samples become NaN."""
-    from .store import read_gauges
+    from server.store import read_gauges
 
     cols, rows = read_gauges(path)
     t = np.array([r["t"] for r in rows])
@@ -299,8 +300,8 @@ def _gauges_csv(path: Path) -> tuple[np.ndarray, dict[str, np.ndarray]]:
 
 def run_coupled(c: FlumeCase, dp: float, out: Path, two_way: bool = True,
                 transport: str = "ws", absorb: str | None = None) -> dict[str, Any]:
-    """The coupled flume over a real socket: in-process server, `wavesph couple --model
-    boussinesq --config <out>/wave_scene.toml [--absorb]` as the client. Figures and series.
+    """The coupled flume over a real socket: in-process server, the client as `wavesph couple
+    --model boussinesq --config <out>/wave_scene.toml [--absorb]` runs it. Figures and series.
 
     absorb: who absorbs the beach's reflection at the SPH inlet; exactly one absorber, or the
     gain doubles (docs/ARCHITECTURE.md). Default: "none" for two-way, "client" otherwise.
@@ -317,18 +318,18 @@ def run_coupled(c: FlumeCase, dp: float, out: Path, two_way: bool = True,
     absorb = absorb or ("none" if two_way else "client")
     if absorb not in ("none", "client", "sph"):
         raise ValueError(f"absorb: 'none', 'client' or 'sph', got {absorb!r}")
-    import argparse
-
     import httpx
 
-    from wave_client import couple_cli
+    from wave_client.boussinesq.dispersion import BETA
+    from wave_client.boussinesq.wave_scene import build_model, load_wave_scene
+    from wave_client.coupling import CouplingError, CouplingOptions, couple
 
     c = c.at(dp)
     out.mkdir(parents=True, exist_ok=True)
     cfg = out / "wave_scene.toml"
     cfg.write_text(to_toml(wave_scene(c, two_way=two_way),
-                           "coupled flume: Boussinesq far field (server/coupled_flume.py)"))
-    from wave_client.boussinesq.dispersion import BETA
+                           "coupled flume: Boussinesq far field (cases/coupled_flume.py)"))
+    scene = load_wave_scene(cfg)  # the file, as the CLI reads it
 
     z_ref = BETA * c.depth  # Nwogu's z_alpha: the model's reference_level at x_c (flat bed)
     tic = time.perf_counter()
@@ -339,19 +340,21 @@ def run_coupled(c: FlumeCase, dp: float, out: Path, two_way: bool = True,
                                      "coupling": {"window_max": c.window, "z_ref": z_ref}})
         r.raise_for_status()
         run = r.json()
-        info = _wait(http, run["id"], {"waiting_for_client"} | TERMINAL, timeout=300)
+        info = wait_for_state(http, run["id"], {"waiting_for_client"} | TERMINAL, timeout=300)
         url = (f"ws://127.0.0.1:{srv.port}/runs/{run['id']}/couple" if transport == "ws"
                else f"tcp://127.0.0.1:{srv.tcp_port}")
-        parser = argparse.ArgumentParser()
-        couple_cli.add_arguments(parser)
-        args = parser.parse_args(["--url", url, "--run-id", run["id"], "--model", "boussinesq",
-                                  "--config", str(cfg), "--scene-hash", run["scene_hash"],
-                                  "--output", str(out / "client_gauges.csv"), "--no-progress",
-                                  "--timeout", "600"]
-                                 + (["--absorb"] if absorb == "client" else []))
-        with contextlib.redirect_stdout(sys.stderr):  # the CLI's summary line: keep stdout clean
-            code = couple_cli.main(args) if info["state"] == "waiting_for_client" else None
-        info = _wait(http, run["id"], TERMINAL, timeout=120)
+        code = None  # the client's exit status as `wavesph couple` would give it
+        if info["state"] == "waiting_for_client":
+            try:
+                couple(url, lambda welcome: build_model(scene, base_dir=cfg.parent),
+                       CouplingOptions(window=c.window, absorb=absorb == "client"),
+                       run_id=run["id"], scene_hash=bytes.fromhex(run["scene_hash"]),
+                       timeout=600.0, log_path=out / "client_gauges.csv", progress=False)
+                code = 0
+            except CouplingError as exc:
+                print(f"coupled flume: coupling failed: {exc}", file=sys.stderr)
+                code = 1
+        info = wait_for_state(http, run["id"], TERMINAL, timeout=120)
     wall = time.perf_counter() - tic
     result = {"mode": "two_way" if two_way else "absorption_only", "absorb": absorb,
               "exit_code": code,
@@ -420,8 +423,8 @@ def write_examples(directory: Path) -> list[Path]:
     paths = []
     for name, (what, make) in EXAMPLE_FILES.items():
         path = directory / name
-        path.write_text(to_toml(make(c), f"{what}\nGenerated by `python -m server.coupled_flume "
-                                         f"{directory}` (server/coupled_flume.py); SI units."))
+        path.write_text(to_toml(make(c), f"{what}\nGenerated by `python -m cases.coupled_flume "
+                                         f"{directory}` (cases/coupled_flume.py); SI units."))
         paths.append(path)
     return paths
 

@@ -14,13 +14,13 @@ from pathlib import Path
 
 import numpy as np
 
-from .scene import Scene, make_scene
+from sph_core.scene import Scene, make_scene
 
 
 def martin_moyce_table(path: str | Path | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """(T, Z) of the Martin & Moyce table (n^2 = 2); default: the copy shipped with sph_core."""
+    """(T, Z) of the Martin & Moyce table (n^2 = 2); default: the copy shipped with cases."""
     if path is None:
-        text = resources.files("sph_core").joinpath("data/dambreak_martin_moyce_1952.csv").read_text()
+        text = resources.files("cases").joinpath("data/dambreak_martin_moyce_1952.csv").read_text()
     else:
         text = Path(path).read_text()
     rows = [ln for ln in text.splitlines() if ln and not ln.startswith("#")][1:]

@@ -1,13 +1,10 @@
-"""`wavesph demo`: a standalone dam break (Martin & Moyce geometry) with a progress bar and a plot.
-
-Until the coupling exists this is the README's main command. It runs the dam break, writes the
-usual run directory (probes.csv, meta.json, VTK snapshots) and a figure comparing the surge front
+"""`wavesph demo --dambreak`: a standalone dam break (Martin & Moyce geometry) with a progress bar
+and a plot. It runs the dam break, writes the usual run directory (probes.csv, meta.json, VTK snapshots) and a figure comparing the surge front
 with Martin & Moyce (1952) and a snapshot of the particles.
 """
 
 from __future__ import annotations
 
-import argparse
 import math
 import sys
 import time
@@ -15,34 +12,28 @@ from pathlib import Path
 
 import numpy as np
 
-from .cli import run_scene
+from sph_core.particles import FLUID, VX, VZ, X, Z
+from sph_core.progress import advance_with_progress
+from sph_core.simulation import Simulation
+
 from .dambreak import dambreak_scene, front_errors, martin_moyce_table
-from .particles import FLUID, VX, VZ, X, Z
-from .simulation import Simulation
 
 
-def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--a", type=float, default=0.1, help="column width a [m] (height 2a); default 0.1")
-    parser.add_argument("--resolution", type=int, default=40, help="particles across the column width (a/dp)")
-    parser.add_argument("--T-end", dest="T_end", type=float, default=3.3,
-                        help="end time in Martin & Moyce units T = t sqrt(2g/a)")
-    parser.add_argument("--out", type=Path, default=None, help="run directory (default runs/demo-<UTC time>)")
-    parser.add_argument("--no-plot", action="store_true", help="skip the figure")
-
-
-def main(args: argparse.Namespace) -> int:
-    a = args.a
-    if a <= 0 or args.resolution < 4 or args.T_end <= 0:
-        print("wavesph demo: --a must be > 0, --resolution >= 4, --T-end > 0", file=sys.stderr)
-        return 2
-    t_end = args.T_end / math.sqrt(2 * 9.81 / a)
-    scene = dambreak_scene(a=a, dp=a / args.resolution, t_end=t_end, tank_length=5 * a,
+def run_dambreak_demo(out: Path | None = None, a: float = 0.1, resolution: int = 40,
+                      T_end: float = 3.3, make_plot: bool = True) -> int:
+    """Run the dam break of column width ``a`` [m] (height 2a) at ``resolution`` particles
+    across it to ``T_end`` in Martin & Moyce units T = t sqrt(2g/a); outputs in ``out`` (default
+    runs/demo-<UTC time>), with the figure dambreak.png. Returns a process exit code."""
+    if a <= 0 or resolution < 4 or T_end <= 0:
+        raise ValueError("dam-break demo: a must be > 0, resolution >= 4, T_end > 0")
+    t_end = T_end / math.sqrt(2 * 9.81 / a)
+    scene = dambreak_scene(a=a, dp=a / resolution, t_end=t_end, tank_length=5 * a,
                            snapshot_every=t_end / 10)
-    out = args.out or Path("runs") / f"demo-{time.strftime('%Y%m%dT%H%M%SZ', time.gmtime())}"
+    out = out or Path("runs") / f"demo-{time.strftime('%Y%m%dT%H%M%SZ', time.gmtime())}"
     sim = Simulation(scene, run_dir=out)
     print(f"dam break: column {a:g} m x {2 * a:g} m, {sim.n_fluid} fluid particles, "
           f"c0 = {sim.c0:.1f} m/s; output in {out}", file=sys.stderr)
-    code = run_scene(sim, t_end, "dam break")
+    code = advance_with_progress(sim, t_end, "dam break")
     t = np.array([r["t"] for r in sim.history])
     xf = np.array([np.nan if r["front_x"] is None else r["front_x"] for r in sim.history])
     ok = np.isfinite(xf)
@@ -50,13 +41,13 @@ def main(args: argparse.Namespace) -> int:
         err = front_errors(t[ok], xf[ok], a)
         print(f"front vs Martin & Moyce (T <= 3): max error {100 * err['max_rel_error']:.1f} %, "
               f"rms {100 * err['rms_rel_error']:.1f} %", file=sys.stderr)
-    if not args.no_plot and ok.any():
-        path = plot(sim, t[ok], xf[ok], a, out / "dambreak.png")
+    if make_plot and ok.any():
+        path = plot_dambreak(sim, t[ok], xf[ok], a, out / "dambreak.png")
         print(f"figure: {path}", file=sys.stderr)
     return code
 
 
-def plot(sim: Simulation, t: np.ndarray, xf: np.ndarray, a: float, path: Path) -> Path:
+def plot_dambreak(sim: Simulation, t: np.ndarray, xf: np.ndarray, a: float, path: Path) -> Path:
     """Front Z(T) against Martin & Moyce, and the particles at the last time coloured by speed."""
     import matplotlib
 
@@ -84,8 +75,3 @@ def plot(sim: Simulation, t: np.ndarray, xf: np.ndarray, a: float, path: Path) -
     plt.close(fig)
     return path
 
-
-if __name__ == "__main__":  # python -m sph_core.demo_cli  (wavesph demo is the coupled flume)
-    _parser = argparse.ArgumentParser(prog="python -m sph_core.demo_cli", description=__doc__.splitlines()[0])
-    add_arguments(_parser)
-    raise SystemExit(main(_parser.parse_args()))

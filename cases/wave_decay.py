@@ -5,7 +5,7 @@
     prof.ratio_at(0.8)           # SPH / theory first-harmonic amplitude 0.8 m past the inlet
 
 A flume one wavelength long with open ends driven by a wave theory (any object with the
-WaveModel duck type and a ``length``, wave_client's theories; sph_core does not import them), elevation
+WaveModel duck type and a ``length``, wave_client's theories, passed in), elevation
 gauges from 2h past the inlet to 3/4 of the flume. No coupling and no wave model but the theory:
 what it measures is SPH's own loss (viscosity, kernel smoothing of the surface, particle noise),
 the floor under any coupled flume's error at that dp. `bench/wave_decay.py` prints it.
@@ -19,7 +19,8 @@ from typing import Any
 
 import numpy as np
 
-from .scene import ElevationProbe
+from sph_core.scene import ElevationProbe
+
 from .wave_analysis import group_velocity, harmonic_amplitude
 from .wave_flume import run_wave_flume, wave_flume_scene
 

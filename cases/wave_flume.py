@@ -4,8 +4,8 @@
     run = run_wave_flume(scene, model, window=T / 50)     # model: WaveModel duck type
     run.eta["mid"], run.theory["mid"]                      # gauge records [m] vs the model
 
-The model is any object with the WaveModel duck type of ``wave_client`` (sph_core never imports
-it): the left face stands at the model's abscissa ``x_model_left``, the right face at
+The model is any object with the WaveModel duck type of ``wave_client`` (passed in: this module
+imports no wave model): the left face stands at the model's abscissa ``x_model_left``, the right face at
 ``x_model_left + tank length``; both ends sample the same model. The theory at the gauges is
 read back from the model after the run, so the model must be analytic (it is rewound).
 """
@@ -20,10 +20,11 @@ from typing import Any
 
 import numpy as np
 
-from .boundary_data import WaveModelBoundary
+from sph_core.boundary_data import WaveModelBoundary
+from sph_core.flume import OpenFlume, flume_nodes
+from sph_core.scene import Scene, make_scene
+
 from .wave_analysis import group_velocity, reflection_coefficient, rmse_over_height
-from .flume import OpenFlume, flume_nodes
-from .scene import Scene, make_scene
 
 # gauges [wavelengths from mid-flume] of the reflection analysis: L/16 apart within L/4 of
 # mid-flume (nine, for the decay-aware fit), among them refl_a, mid, refl_b at -L/8, 0, +L/8 (the

@@ -1,8 +1,10 @@
 """`wavesph` command line: a thin dispatcher.
 
-Each subcommand lives in the package that owns it and exposes ``add_arguments(parser)`` and
-``main(args) -> int``. Only the chosen subcommand's module is imported, so a wave-model user
-running ``wavesph couple`` never loads the SPH solver (or numba).
+Each subcommand is one module of this package (run, serve, couple, waves, demo) exposing
+``add_arguments(parser)`` and ``main(args) -> int``; those two names are the subcommand interface,
+the same in every module by design. Only the chosen subcommand's module is imported, and each
+imports its own layer only (``couple`` and ``waves``: wave_client and protocol), so a wave-model
+user running ``wavesph couple`` never loads the SPH solver (or numba).
 """
 
 from __future__ import annotations
@@ -13,13 +15,15 @@ import sys
 
 # name -> (module, one-line help)
 COMMANDS: dict[str, tuple[str, str]] = {
-    "demo": ("server.demo_cli", "coupled wave-SPH flume with a beach on embedded defaults "
-                                "(--dambreak: the standalone dam break)"),
-    "run": ("sph_core.cli", "run an SPH scene (TOML) standalone"),
-    "serve": ("server.cli", "start the SPH coupling server (HTTP + WebSocket + TCP)"),
-    "couple": ("wave_client.couple_cli", "couple a wave model to a running server"),
-    "waves": ("wave_client.waves_cli", "run the Boussinesq wave model alone"),
+    "demo": ("wavesph_cli.demo", "coupled wave-SPH flume with a beach on embedded defaults "
+                                 "(--dambreak: the standalone dam break)"),
+    "run": ("wavesph_cli.run", "run an SPH scene (TOML) standalone"),
+    "serve": ("wavesph_cli.serve", "start the SPH coupling server (HTTP + WebSocket + TCP)"),
+    "couple": ("wavesph_cli.couple", "couple a wave model to a running server"),
+    "waves": ("wavesph_cli.waves", "run the Boussinesq wave model alone"),
 }
+
+OUR_PACKAGES = {"protocol", "sph_core", "wave_client", "server", "cases"}
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -36,7 +40,7 @@ def main(argv: list[str] | None = None) -> int:
     try:
         module = importlib.import_module(module_name)
     except ModuleNotFoundError as exc:
-        if exc.name and module_name.startswith(exc.name):
+        if exc.name and exc.name.split(".")[0] in OUR_PACKAGES:  # a build without that layer
             print(f"wavesph {name}: not available in this build ({exc})", file=sys.stderr)
             return 2
         raise
@@ -44,6 +48,3 @@ def main(argv: list[str] | None = None) -> int:
     module.add_arguments(cmd_parser)
     return int(module.main(cmd_parser.parse_args(argv[1:])) or 0)
 
-
-if __name__ == "__main__":
-    raise SystemExit(main())

@@ -98,13 +98,13 @@ def model_factory(args: argparse.Namespace) -> tuple[Callable[[Welcome], Any], f
 
 def _boussinesq_factory(args: argparse.Namespace) -> tuple[Callable[[Welcome], Any], float | None]:
     try:  # imported lazily: the theories never need numba
-        from wave_client.boussinesq.scene import build_model, load_scene
+        from wave_client.boussinesq.wave_scene import build_model, load_wave_scene
     except ImportError as exc:
         raise ValueError(f"--model boussinesq is not available in this build ({exc})") from exc
     if args.config is None:
         raise ValueError("--model boussinesq needs --config SCENE.toml (a `wavesph waves` scene)")
     config = Path(args.config)
-    scene = load_scene(config)  # SceneError is a ValueError naming the field
+    scene = load_wave_scene(config)  # WaveSceneError is a ValueError naming the field
     return (lambda welcome: build_model(scene, base_dir=config.parent)), getattr(scene.wave, "period", None)
 
 

@@ -9,7 +9,7 @@ from pathlib import Path
 
 from pydantic import ValidationError
 
-from .settings import Settings
+from server.settings import Settings
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -27,7 +27,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def main(args: argparse.Namespace) -> int:
     import uvicorn
 
-    from .main import create_app
+    from server.main import create_app
 
     try:
         settings = Settings.from_env(host=args.host, port=args.port, tcp_port=args.tcp_port,

@@ -15,15 +15,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def main(args: argparse.Namespace) -> int:
-    from wave_client.boussinesq.run import run_scene
-    from wave_client.boussinesq.scene import SceneError, load_scene
+    from wave_client.boussinesq.standalone import run_wave_scene
+    from wave_client.boussinesq.wave_scene import WaveSceneError, load_wave_scene
     from wave_client.boussinesq.solver import BoussinesqUnstableError
 
     try:
-        scene = load_scene(args.scene)
+        scene = load_wave_scene(args.scene)
         csv_path = args.output or Path(scene.output.csv)
-        summary = run_scene(scene, csv_path, base_dir=args.scene.parent, progress=not args.no_progress)
-    except (SceneError, ValueError) as exc:
+        summary = run_wave_scene(scene, csv_path, base_dir=args.scene.parent, progress=not args.no_progress)
+    except (WaveSceneError, ValueError) as exc:
         print(f"wavesph waves: {exc}", file=sys.stderr)
         return 2
     except BoussinesqUnstableError as exc:

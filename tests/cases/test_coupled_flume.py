@@ -1,5 +1,5 @@
-"""The coupled Boussinesq-SPH flume (server/coupled_flume.py): `wavesph couple --model boussinesq`
-drives an SPH zone with a 1:10 beach over a real socket; the SPH gauge on the flat bed follows a
+"""The coupled Boussinesq-SPH flume (cases/coupled_flume.py): the coupling client with the
+Boussinesq model of a `wavesph waves` scene (as `wavesph couple --model boussinesq` runs it) drives an SPH zone with a 1:10 beach over a real socket; the SPH gauge on the flat bed follows a
 Boussinesq-only run of the same flume. Two-way and absorption-only coupling."""
 
 from __future__ import annotations
@@ -12,10 +12,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from server.coupled_flume import (FlumeCase, correlation, reference_run, rmse_over_h, run_coupled,
+from cases.coupled_flume import (FlumeCase, correlation, reference_run, rmse_over_h, run_coupled,
                                   sph_only_scene, sph_zone_scene, to_toml, wave_scene)
 from server.schemas import RunRequest
-from wave_client.boussinesq.scene import WaveScene, build_model
+from wave_client.boussinesq.wave_scene import WaveScene, build_model
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples" / "coupled"
 # short and coarse: 2 wavelengths of Boussinesq, H/dp = 1, 2 periods compared (~20 s each)
@@ -148,12 +148,12 @@ def _coupled_flat_gauge(c: FlumeCase, dp: float, out: Path, two_way: bool):
 def test_coupling_adds_no_loss_to_the_sph_wave(tmp_path, passive_omp):
     """The coupled wave's shortfall is SPH's, not the coupling's: its first-harmonic amplitude at
     the flat-bed gauge (over the reference's) is no lower than that of a theory-driven SPH flume
-    of the same wave, dp and constants at the same distance from its inlet (sph_core.wave_decay,
+    of the same wave, dp and constants at the same distance from its inlet (cases.wave_decay,
     no coupling there). Written first as equality within 3 %, which failed: measured at dp =
     0.02, coupled 0.928, theory-driven 0.864 (that flume, one wavelength long with an outlet at
     2 m, loses more); so the one-sided claim, with 0.02 for run-to-run scatter."""
-    from sph_core.wave_analysis import harmonic_amplitude
-    from sph_core.wave_decay import amplitude_profile
+    from cases.wave_analysis import harmonic_amplitude
+    from cases.wave_decay import amplitude_profile
     from wave_client.theories import build_theory
 
     dp = 0.02

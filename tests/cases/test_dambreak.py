@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from sph_core.dambreak import dambreak_scene, front_errors, martin_moyce_table
+from cases.dambreak import dambreak_scene, front_errors, martin_moyce_table
 from sph_core.simulation import Simulation
 
 DATA = Path(__file__).resolve().parents[1] / "data"

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import wavesph_cli
-from server.demo_cli import GAUGES, demo_scene
+from cases.demo_flume import GAUGES, demo_scene
 from server.schemas import RunRequest
 
 

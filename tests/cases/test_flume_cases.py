@@ -14,7 +14,7 @@ from pathlib import Path
 
 import pytest
 
-from sph_core.wave_flume import flume_case
+from cases.wave_flume import flume_case
 
 theories = pytest.importorskip("wave_client.theories")
 

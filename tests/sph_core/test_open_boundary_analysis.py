@@ -8,11 +8,11 @@ import math
 import numpy as np
 import pytest
 
+from cases.wave_analysis import reflection_coefficient, rmse_over_height
 from sph_core import open_boundary as ob
 from sph_core.particles import FLUID, P, X, Z
 from sph_core.scene import make_scene
 from sph_core.simulation import Simulation
-from sph_core.wave_analysis import reflection_coefficient, rmse_over_height
 
 G, D = 9.81, 0.5
 

@@ -1,6 +1,5 @@
 """Run life: outputs on disk, checkpoint/restore, stability guard, CLI."""
 
-import argparse
 import csv
 import json
 import math
@@ -10,7 +9,7 @@ import numpy as np
 import pytest
 
 import wavesph_cli
-from sph_core.dambreak import dambreak_scene
+from cases.dambreak import dambreak_scene
 from sph_core.scene import make_scene
 from sph_core.simulation import Simulation, UnstableError
 
@@ -155,12 +154,10 @@ def test_cli_run_bad_scene(tmp_path, capsys):
 
 def test_demo_writes_run_and_figure(tmp_path):
     out = tmp_path / "demo"
-    # `wavesph demo` is the coupled flume now; the dam break stays as sph_core.demo_cli
-    from sph_core import demo_cli
+    # `wavesph demo` is the coupled flume now; the dam break is `wavesph demo --dambreak`
+    from cases.dambreak_demo import run_dambreak_demo
 
-    parser = argparse.ArgumentParser()
-    demo_cli.add_arguments(parser)
-    code = demo_cli.main(parser.parse_args(["--resolution", "10", "--T-end", "1.0", "--out", str(out)]))
+    code = run_dambreak_demo(out, resolution=10, T_end=1.0)
     assert code == 0
     assert (out / "dambreak.png").stat().st_size > 10_000
     meta = json.loads((out / "meta.json").read_text())

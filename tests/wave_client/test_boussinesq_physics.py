@@ -12,7 +12,7 @@ import pytest
 
 from wave_client.boussinesq import BoussinesqModel, airy_celerity, nwogu_celerity, nwogu_wavenumber
 from wave_client.boussinesq.checks import solitary_run, standing_wave_speed
-from wave_client.boussinesq import kernels as K
+from wave_client.boussinesq import stepping
 from wave_client.boussinesq.dispersion import airy_wavenumber, alpha
 from wave_client.boussinesq.solitary import nwogu_solitary
 
@@ -175,12 +175,12 @@ def test_shapiro_filter_removes_grid_noise_only():
     """The 4th-order Shapiro filter removes the 2dx mode and changes a 40-points-per-wavelength
     wave by (k dx)^4 / 16 at most (here 2.4e-4)."""
     n = 200
-    x = np.arange(n + 2 * K.NG) - K.NG
+    x = np.arange(n + 2 * stepping.NG) - stepping.NG
     smooth = np.cos(2 * np.pi * x / 40)
     noisy = smooth + 0.01 * (-1.0) ** x
     work = np.zeros_like(noisy)
-    K.shapiro_filter(noisy, work, n + K.NG)
-    inner = slice(K.NG, n + K.NG)
+    stepping.shapiro_filter(noisy, work, n + stepping.NG)
+    inner = slice(stepping.NG, n + stepping.NG)
     assert np.max(np.abs(noisy[inner] - smooth[inner])) < 2.5e-4
     assert np.max(np.abs(noisy[inner] - smooth[inner])) > 1e-5  # it does act on the wave a little
 

@@ -8,11 +8,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from wave_client import waves_cli
 from wave_client.boussinesq import nwogu_wavenumber
 from wave_client.boussinesq.checks import compare_with_measurement
-from wave_client.boussinesq.run import run_scene
-from wave_client.boussinesq.scene import SceneError, WaveScene, build_model, load_scene
+from wave_client.boussinesq.standalone import run_wave_scene
+from wave_client.boussinesq.wave_scene import WaveScene, WaveSceneError, build_model, load_wave_scene
+from wavesph_cli import waves as waves_cli
 
 ROOT = Path(__file__).resolve().parents[2]
 BAR = ROOT / "examples" / "waves" / "beji_battjes.toml"
@@ -60,14 +60,14 @@ def test_scene_errors_name_the_field(tmp_path):
     bad = FLAT.format(wave='kind = "regular"\nheight = -0.01\nperiod = 2.0\nx_source = 0.0\ncolour = 1')
     p = tmp_path / "bad.toml"
     p.write_text(bad)
-    with pytest.raises(SceneError) as err:
-        load_scene(p)
+    with pytest.raises(WaveSceneError) as err:
+        load_wave_scene(p)
     msg = str(err.value)
     assert "wave.regular.height" in msg and "wave.regular.colour" in msg
     p.write_text(FLAT.format(wave='kind = "regular"\nheight = 0.01\nperiod = 2.0\nx_source = 0.0')
                  .replace("x = [5.0, 10.0]", "x = [5.0, 99.0]"))
-    with pytest.raises(SceneError, match="gauges.x"):
-        load_scene(p)
+    with pytest.raises(WaveSceneError, match="gauges.x"):
+        load_wave_scene(p)
 
 
 def test_cli_writes_gauge_csv_and_reports_bad_scene(tmp_path, capsys):
@@ -98,7 +98,7 @@ def test_series_wave_reproduces_its_components(tmp_path):
     scene = tmp_path / "s.toml"
     scene.write_text(FLAT.format(wave='kind = "series"\nfile = "series.csv"\nx_source = 0.0\nramp = 4.0'))
     out = tmp_path / "g.csv"
-    run_scene(load_scene(scene), out, base_dir=tmp_path, progress=False)
+    run_wave_scene(load_wave_scene(scene), out, base_dir=tmp_path, progress=False)
     tt, ee, _ = read_csv(out)
     sel = tt > 20.0
     omegas = [2 * np.pi / p for p in periods]
@@ -115,10 +115,10 @@ def test_submerged_bar_is_stable_and_releases_harmonics(tmp_path):
     moves from the primary wave into its harmonics over the bar: in front of the bar (5.7 m) the
     2nd and 3rd harmonics are small bound waves, behind it (>= 15.7 m) the 2nd harmonic is as
     large as half the primary or more and the 3rd harmonic has grown many times."""
-    scene = load_scene(BAR)
+    scene = load_wave_scene(BAR)
     scene = scene.model_copy(update={"grid": scene.grid.model_copy(update={"t_end": 36.36})})
     out = tmp_path / "bar.csv"
-    summary = run_scene(scene, out, base_dir=BAR.parent, progress=False)
+    summary = run_wave_scene(scene, out, base_dir=BAR.parent, progress=False)
     assert summary["unconverged_steps"] == 0
     t, eta, _ = read_csv(out)
     assert np.all(np.isfinite(eta)) and np.abs(eta).max() < 2.5 * 0.02
@@ -135,7 +135,7 @@ def test_submerged_bar_is_stable_and_releases_harmonics(tmp_path):
 
 
 def test_build_model_from_example_scene():
-    scene = load_scene(BAR)
+    scene = load_wave_scene(BAR)
     assert isinstance(scene, WaveScene)
     m = build_model(scene, BAR.parent)
     assert m.depth_at(13.0) == pytest.approx(0.1) and m.depth_at(9.0) == pytest.approx(0.25)
@@ -162,10 +162,10 @@ def test_unstable_run_is_reported_and_writes_no_nan(tmp_path, capsys):
 def test_submerged_bar_long_run_reaches_a_steady_periodic_state(tmp_path):
     """300 s (~150 periods) over the bar without a filter: bounded, and the harmonic amplitudes
     behind the bar repeat from one 20-period window to the next (no drift, no slow instability)."""
-    scene = load_scene(BAR)
+    scene = load_wave_scene(BAR)
     scene = scene.model_copy(update={"grid": scene.grid.model_copy(update={"t_end": 300.0})})
     out = tmp_path / "bar.csv"
-    run_scene(scene, out, base_dir=BAR.parent, progress=False)
+    run_wave_scene(scene, out, base_dir=BAR.parent, progress=False)
     t, eta, _ = read_csv(out)
     assert np.all(np.isfinite(eta)) and np.abs(eta).max() < 2.5 * 0.02
     omega = 2 * np.pi / 2.02

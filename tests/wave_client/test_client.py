@@ -20,10 +20,10 @@ import pytest
 from protocol import (ErrorCode, FrameDecoder, Nodes, ProtocolError, Result, SphSession, Welcome,
                       decode_frame)
 from protocol.session import PeerError, Reply, SetWindow, SolveWindow, set_payload_size
-from wave_client import couple_cli
 from wave_client.coupling import (CouplingCore, CouplingError, CouplingOptions, CouplingTimeout,
                                   GaugeLog, ServerEnded, ServerError, parse_url, run_coupling)
 from wave_client.theories import AiryWave
+from wavesph_cli import couple as couple_cli
 
 G, DEPTH = 9.81, 1.0
 C = math.sqrt(G / DEPTH)
@@ -560,7 +560,7 @@ x = 0.0
 
 
 def test_cli_couples_the_boussinesq_model(tmp_path, capsys):
-    pytest.importorskip("wave_client.boussinesq.scene")
+    pytest.importorskip("wave_client.boussinesq.wave_scene")
     config = tmp_path / "bsq.toml"
     config.write_text(BOUSSINESQ_SCENE)
     # an SPH zone with an inlet only (a beach at its end): the grid ends 2 m into it

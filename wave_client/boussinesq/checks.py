@@ -97,16 +97,16 @@ def compare_with_measurement(scene_path, data_path, still_level: float, periods:
     import tempfile
     from pathlib import Path
 
-    from .run import run_scene
-    from .scene import load_scene
+    from .standalone import run_wave_scene
+    from .wave_scene import load_wave_scene
 
     scene_path = Path(scene_path)
-    scene = load_scene(scene_path)
+    scene = load_wave_scene(scene_path)
     period = scene.wave.period
     omega = 2 * np.pi / period
     with tempfile.TemporaryDirectory() as tmp:
         csv = Path(tmp) / "model.csv"
-        run_scene(scene, csv, base_dir=scene_path.parent, progress=progress)
+        run_wave_scene(scene, csv, base_dir=scene_path.parent, progress=progress)
         tm, em, _ = read_gauge_csv(csv)
     td, ed, _ = read_gauge_csv(data_path)
     ed = ed - still_level

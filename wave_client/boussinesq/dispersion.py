@@ -16,7 +16,8 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike
 
-G = 9.81  # gravity [m/s^2], the one value used across wave_client.boussinesq
+from wave_client import G  # the package-wide value, imported from here by the solver
+
 BETA = -0.531  # z_alpha / d, Nwogu's optimal reference level
 
 

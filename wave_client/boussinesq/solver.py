@@ -5,7 +5,7 @@ variable depth, by the scheme of seed 001 Algorithm 1 / Wei & Kirby (1995): 4th-
 differences, Adams-Bashforth (3rd-order) predictor and iterated Adams-Moulton (4th-order)
 corrector, a constant tridiagonal system for u_alpha factored once, internal wave generation by a
 source function (Wei, Kirby & Sinha 1999), sponge layers and a Shapiro smoothing filter.
-Equations and discretisation: `kernels.py`; source: `source.py`; velocity profile: `profile.py`.
+Equations and discretisation: `stepping.py`; source: `source.py`; velocity profile: `profile.py`.
 
 Note on seed 001 Algorithm 1: its corrector line for U uses E where F belongs (a typo); we
 implement the standard 4th-order Adams-Moulton corrector of Wei & Kirby (1995) for both eta and
@@ -25,7 +25,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 from tqdm import tqdm
 
-from . import kernels as K
+from . import stepping
 from .dispersion import BETA, G, nwogu_wavenumber
 from .profile import reconstruct_velocity
 from .source import SourceFunction, components_from_series, make_source
@@ -142,9 +142,10 @@ class BoussinesqModel:
         self.x_couple = self.x1 if x_couple is None else float(x_couple)
         self.depth = float(self.depth_at(self.x_couple))
 
-        n = nm + 2 * K.NG
+        n = nm + 2 * stepping.NG
         self._n = n
-        pad = lambda a: np.concatenate([a[K.NG:0:-1], a, a[-2:-K.NG - 2:-1]])  # noqa: E731 (even mirror)
+        ng = stepping.NG
+        pad = lambda a: np.concatenate([a[ng:0:-1], a, a[-2:-ng - 2:-1]])  # noqa: E731 (even mirror)
         self._h = pad(h)
         za = beta * self._h
         self._coef_a = (0.5 * za * za - self._h**2 / 6.0) * self._h
@@ -220,17 +221,17 @@ class BoussinesqModel:
         self._upper[i] = (self._a2[i] + self._b2[i] * h[i + 1]) / dx2
         p = self._pin_idx
         self._lower[p], self._diag[p], self._upper[p] = 0.0, 1.0, 0.0
-        K.thomas_factor(self._lower, self._diag, self._upper, self._cprime, self._minv)
+        stepping.thomas_factor(self._lower, self._diag, self._upper, self._cprime, self._minv)
 
     def _refresh_rhs(self) -> None:
         """Recompute U = M u and the newest history level from the current state (restart the
         multistep history: used after the state is set from outside)."""
-        K.fill_ghosts(self._eta, self._u)
-        K.close_boundary(self._eta, self._u, self._uu, self._pin_idx)
-        K.apply_operator(self._lower, self._diag, self._upper, self._u, self._uu, K.NG)
-        src = K.source_signal(self.t, self._src_amp, self._src_omega, self._src_phase, self._src_ramp)
+        stepping.fill_ghosts(self._eta, self._u)
+        stepping.close_boundary(self._eta, self._u, self._uu, self._pin_idx)
+        stepping.apply_operator(self._lower, self._diag, self._upper, self._u, self._uu, stepping.NG)
+        src = stepping.source_signal(self.t, self._src_amp, self._src_omega, self._src_phase, self._src_ramp)
         wq, wd = self._scratch[7], self._scratch[8]
-        K.rhs(self._eta, self._u, self._h, self._coef_a, self._coef_b, self._sponge, self._src_shape,
+        stepping.rhs(self._eta, self._u, self._h, self._coef_a, self._coef_b, self._sponge, self._src_shape,
               src, self.g, self.dx, wq, wd, self._e_hist[0], self._f_hist[0])
         self._n_hist = 1
 
@@ -239,15 +240,15 @@ class BoussinesqModel:
         eta, u = np.asarray(eta, float), np.asarray(u, float)
         if eta.shape != self.x.shape or u.shape != self.x.shape:
             raise ValueError(f"set_state: eta and u must have shape {self.x.shape}")
-        self._eta[K.NG:-K.NG] = eta
-        self._u[K.NG:-K.NG] = u
+        self._eta[stepping.NG:-stepping.NG] = eta
+        self._u[stepping.NG:-stepping.NG] = u
         self._refresh_rhs()
 
     def set_source(self, source: SourceFunction) -> None:
         """Use a prepared source function (see `source.make_source`)."""
         if source.shape.shape != self.x.shape:
             raise ValueError("source: shape must be sampled on the model grid")
-        self._src_shape[K.NG:-K.NG] = source.shape
+        self._src_shape[stepping.NG:-stepping.NG] = source.shape
         self._src_amp = np.ascontiguousarray(source.amplitude, float)
         self._src_omega = np.ascontiguousarray(source.omega, float)
         self._src_phase = np.ascontiguousarray(source.phase, float)
@@ -304,7 +305,7 @@ class BoussinesqModel:
         if self._free is not None:
             self._free.advance_steps(n_steps)
         s = self._scratch
-        res = K.advance_steps(
+        res = stepping.advance_steps(
             n_steps, self.t, self.dt, self._n_hist, self.tol, self.max_iter, self.filter_every, self._step,
             self._eta, self._u, self._uu, self._e_hist, self._f_hist,
             self._h, self._coef_a, self._coef_b, self._lower, self._diag, self._upper,
@@ -360,12 +361,12 @@ class BoussinesqModel:
     @property
     def eta_nodes(self) -> np.ndarray:
         """eta [m] at the grid nodes (a view)."""
-        return self._eta[K.NG:-K.NG]
+        return self._eta[stepping.NG:-stepping.NG]
 
     @property
     def u_nodes(self) -> np.ndarray:
         """u_alpha [m/s] at the grid nodes (a view)."""
-        return self._u[K.NG:-K.NG]
+        return self._u[stepping.NG:-stepping.NG]
 
     def _interp(self, f_padded: np.ndarray, x: np.ndarray) -> np.ndarray:
         """Cubic Lagrange interpolation of a padded nodal field at positions x."""
@@ -380,7 +381,7 @@ class BoussinesqModel:
         r = (x - self.x0) / self.dx
         j = np.clip(np.floor(r).astype(int), 0, self.n_nodes - 2)
         w = _lagrange_weights(r - j)
-        jp = j + K.NG
+        jp = j + stepping.NG
         return w[0] * f_padded[jp - 1] + w[1] * f_padded[jp] + w[2] * f_padded[jp + 1] + w[3] * f_padded[jp + 2]
 
     def _beyond(self, x: np.ndarray) -> np.ndarray | None:
@@ -448,8 +449,8 @@ class BoussinesqModel:
         [m/s] measured by SPH at x become the right-hand boundary of the model for the
         following steps.
 
-        The grid node nearest x, b, ends the active grid (ghosts beyond: `kernels.close_boundary`;
-        further right the grid is inactive). It is a characteristic boundary (`kernels.apply_pins`):
+        The grid node nearest x, b, ends the active grid (ghosts beyond: `stepping.close_boundary`;
+        further right the grid is inactive). It is a characteristic boundary (`stepping.apply_pins`):
         the model keeps its own outgoing, right-going wave there and takes from SPH only the
         incoming, left-going part L = (eta - u_ref / r) / 2, r = u/eta of a progressive wave
         (linear Nwogu, at `coupling_omega`: the generated wave's (peak) frequency; long-wave

@@ -47,11 +47,11 @@ import numpy as np
 
 from protocol import (NO_SCENE_HASH, Bye, ClientSession, Error, ErrorCode, GetNodes, Hello, Message,
                       Nodes, ProtocolError, Result, Set, Side, Solve, Welcome)
+from protocol.session import TIME_RTOL  # the server matches window times with the same tolerance
 from wave_client.model import WaveModel
 
 CLIENT_NAME = "wavesph-couple/0.1"
-M = TypeVar("M", bound=Message)
-TIME_RTOL = 1e-9  # relative tolerance when matching the server's clock
+_M = TypeVar("_M", bound=Message)
 
 
 class CouplingError(RuntimeError):
@@ -353,7 +353,7 @@ class CouplingCore:
                     pass
             return out
 
-    def _reply(self, seq: int, msg: Message, expect: type[M]) -> M:
+    def _reply(self, seq: int, msg: Message, expect: type[_M]) -> _M:
         if isinstance(msg, Bye):
             raise ServerEnded(f"the server ended the run: {msg.reason or '(no reason given)'}")
         return self.session.reply(seq, msg, expect=expect)

@@ -13,7 +13,7 @@ import numpy as np
 import raschii
 from numpy.typing import ArrayLike
 
-G = 9.81  # gravitational acceleration [m/s^2], the value raschii uses by default
+from wave_client import G  # noqa: F401 (re-exported: the theories take g = G by default)
 
 
 def require_positive(name: str, value: float) -> float:

@@ -12,11 +12,11 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
-from .scene import WaveScene, build_model
+from .wave_scene import WaveScene, build_model
 from .solver import BoussinesqUnstableError
 
 
-def run_scene(scene: WaveScene, csv_path: Path, base_dir: Path | None = None,
+def run_wave_scene(scene: WaveScene, csv_path: Path, base_dir: Path | None = None,
               progress: bool = True) -> dict[str, float]:
     """Run the scene to grid.t_end; returns a summary (steps, wall time, corrector statistics).
 

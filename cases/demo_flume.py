@@ -1,10 +1,10 @@
-"""`wavesph demo`: a coupled wave-SPH flume with a beach, end to end on this machine.
+"""The case of `wavesph demo`: a coupled wave-SPH flume with a beach, end to end on this machine.
 
-Starts the SPH server in this process on free loopback ports, creates a coupled run of a short
+`run_demo` starts the SPH server in this process on free loopback ports, creates a coupled run of a short
 2D flume (open inlet on the left, flat bed, then a 1:10 beach up to a closed right end), connects
 wave_client's coupling client with a regular second-order Stokes wave over the real socket
 (WebSocket, or TCP with ``--transport tcp``), shows the client's progress bar, and writes into
-the run directory (default ./runs/demo-<UTC time>):
+the run directory (`wavesph_cli/demo.py` adds the figures and the plot):
 
     <run id>/            the server's run record: meta.json, gauges.csv (SPH-measured), sph/...
     client_gauges.csv    the client's log: measured and theoretical elevation per window
@@ -18,17 +18,15 @@ The standalone dam break of earlier versions: ``wavesph demo --dambreak`` (or
 
 from __future__ import annotations
 
-import argparse
-import json
 import math
-import os
 import sys
-import threading
-import time
 from pathlib import Path
 from typing import Any
 
 import numpy as np
+
+from .local_server import InProcessServer, wait_for_state
+from .wave_analysis import group_velocity, rmse_over_height
 
 # the embedded case: depth d, regular wave (H, T), beach slope
 DEPTH = 0.24          # still-water depth on the flat bed [m] (rounded to whole dp: depth_for)
@@ -67,111 +65,19 @@ def demo_scene(dp: float, t_end: float) -> dict[str, Any]:
     }
 
 
-def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--t-end", type=float, default=8.0,
-                        help="simulated time [s] (default 8: 2 ramp periods, then ~3 periods "
-                             "of full waves at the flat-bed gauge)")
-    parser.add_argument("--dp", type=float, default=0.02,
-                        help="particle spacing [m] (default 0.02: ~3300 particles, H/dp = 2, "
-                             "about a minute; 0.01 resolves the wave better at ~8x the time)")
-    parser.add_argument("--transport", choices=("ws", "tcp"), default="ws",
-                        help="coupling socket: WebSocket (default) or plain TCP")
-    parser.add_argument("--out", type=Path, default=None,
-                        help="run directory (default ./runs/demo-<UTC time>); must be new or empty")
-    parser.add_argument("--no-plot", action="store_true", help="skip the figure")
-    parser.add_argument("--dambreak", action="store_true",
-                        help="run the standalone dam break (Martin & Moyce) instead, as "
-                             "`wavesph run examples/scenes/dambreak_martin_moyce.toml` does")
-    parser.epilog = ("Coupled flume: open inlet, 1:10 beach, Stokes-2 wave H = 0.04 m, T = 1.4 s, "
-                     "depth 0.24 m, coupled over a real socket to an in-process server.")
-
-
-def main(args: argparse.Namespace) -> int:
-    # numba's OpenMP threads spin while waiting by default: on a busy machine (more runnable
-    # threads than cores) a step then costs 10-20x more. Passive waiting costs little otherwise.
-    os.environ.setdefault("OMP_WAIT_POLICY", "passive")
-    if args.dambreak:
-        return _dambreak(args)
-    if not (args.t_end > 0 and math.isfinite(args.t_end)) or not 0.002 <= args.dp <= 0.05:
-        print("wavesph demo: --t-end must be > 0 s and --dp within [0.002, 0.05] m", file=sys.stderr)
-        return 2
-    out = args.out or Path("runs") / f"demo-{time.strftime('%Y%m%dT%H%M%SZ', time.gmtime())}"
-    if out.exists() and any(out.iterdir()):
-        print(f"wavesph demo: --out {out} exists and is not empty: choose a new directory",
-              file=sys.stderr)
-        return 2
-    out.mkdir(parents=True, exist_ok=True)
-    tic = time.perf_counter()
+def run_demo(dp: float, t_end: float, transport: str, out: Path) -> tuple[dict, Any]:
+    """The demo flume at spacing ``dp`` [m] to ``t_end`` [s], coupled over ``transport`` ("ws" or
+    "tcp") to a server in this process storing its runs in ``out``: (final run record, client
+    report or None)."""
     with InProcessServer(out) as srv:
-        info, report = _run(srv, demo_scene(args.dp, args.t_end), args.transport, out)
-    depth = depth_for(args.dp)
-    wall = time.perf_counter() - tic
-    run_dir = out / info["id"]
-    if info["state"] != "finished" or report is None:
-        print(f"wavesph demo: the run ended {info['status']}; data so far in {run_dir}",
-              file=sys.stderr)
-        return 1
-    figures = _figures(info, report, wall, depth)
-    (out / "summary.json").write_text(json.dumps(figures, indent=2))
-    print(f"particles {figures['particles']}, windows {figures['windows']}, SPH steps "
-          f"{figures['steps']}, wall time {wall:.1f} s (SPH solve {figures['sph_solve_s']:.1f} s)\n"
-          f"speed {figures['particle_steps_per_s']:.3g} particle-steps/s while solving "
-          f"({figures['particle_steps_per_s_wall']:.3g} over the wall time, compilation included); "
-          f"coupling overhead {100 * figures['coupling_overhead_share']:.1f} % of the coupled time\n"
-          f"RMSE/H at the flat-bed gauge (x = {GAUGES['flat']} m, t >= {figures['compare_from_s']:.2f} s, "
-          f"measured vs Stokes 2): "
-          f"{_fmt(figures['rmse_over_H_flat'])}", file=sys.stderr)
-    if not args.no_plot:
-        plot(report, info, out / "elevation.png", args.dp, args.t_end, figures["compare_from_s"])
-    print(f"outputs in {out.resolve()}:\n"
-          f"  {info['id']}/gauges.csv   SPH-measured gauges (server)\n"
-          f"  {info['id']}/meta.json    run record ({info['status']})\n"
-          f"  client_gauges.csv          measured and theoretical elevation per window\n"
-          + ("" if args.no_plot else "  elevation.png              measured vs theory\n")
-          + "  summary.json               these figures", file=sys.stderr)
-    return 0
+        return _couple(srv, demo_scene(dp, t_end), transport, out)
 
 
-def _fmt(v: float | None) -> str:
-    return "n/a (the run ended before full waves reached the gauge)" if v is None else f"{v:.3f}"
-
-
-class InProcessServer:
-    """The wavesph server (HTTP + WebSocket + TCP) on free loopback ports, in a thread."""
-
-    def __init__(self, runs_dir: Path) -> None:
-        import uvicorn
-
-        from server.main import create_app
-        from server.settings import Settings
-
-        self.settings = Settings(host="127.0.0.1", port=0, tcp_port=0, runs_dir=runs_dir,
-                                 max_runs=1)
-        self.app = create_app(self.settings)
-        self.server = uvicorn.Server(uvicorn.Config(
-            self.app, host="127.0.0.1", port=0, log_level="warning", lifespan="on",
-            ws_max_size=self.settings.max_frame + 16, ws_per_message_deflate=False))
-        self.thread = threading.Thread(target=self.server.run, name="wavesph-server", daemon=True)
-
-    def __enter__(self) -> "InProcessServer":
-        self.thread.start()
-        deadline = time.monotonic() + 30
-        while not self.server.started:
-            if time.monotonic() > deadline or not self.thread.is_alive():
-                raise RuntimeError("the in-process server did not start")
-            time.sleep(0.02)
-        self.port = self.server.servers[0].sockets[0].getsockname()[1]
-        self.tcp_port = self.app.state.tcp_port
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        self.server.should_exit = True
-        self.thread.join(timeout=30)
-
-
-def _run(srv: InProcessServer, scene: dict, transport: str, out: Path) -> tuple[dict, Any]:
+def _couple(srv: InProcessServer, scene: dict, transport: str, out: Path) -> tuple[dict, Any]:
     """Create the run, couple the wave to it; (final run record, client report or None)."""
     import httpx
+
+    from server.runs import TERMINAL
 
     from wave_client.coupling import CouplingError, CouplingOptions, couple
     from wave_client.theories import build_theory
@@ -182,7 +88,7 @@ def _run(srv: InProcessServer, scene: dict, transport: str, out: Path) -> tuple[
                                      "coupling": {"window_max": PERIOD / 50}})
         r.raise_for_status()
         run = r.json()
-        info = _wait(http, run["id"], {"waiting_for_client", "failed"}, timeout=120)
+        info = wait_for_state(http, run["id"], {"waiting_for_client", "failed"}, timeout=120)
         if info["state"] == "failed":
             return info, None
         print(f"wavesph demo: {info['particles']} particles, dp = {scene['dp']} m, "
@@ -200,17 +106,8 @@ def _run(srv: InProcessServer, scene: dict, transport: str, out: Path) -> tuple[
                             log_path=out / "client_gauges.csv")
         except CouplingError as exc:
             print(f"wavesph demo: coupling failed: {exc}", file=sys.stderr)
-        info = _wait(http, run["id"], {"finished", "failed", "unstable", "cancelled"}, timeout=60)
+        info = wait_for_state(http, run["id"], TERMINAL, timeout=60)
     return info, report
-
-
-def _wait(http: Any, run_id: str, states: set[str], timeout: float) -> dict:
-    deadline = time.monotonic() + timeout
-    while True:
-        info = http.get(f"/runs/{run_id}").json()
-        if info["state"] in states or time.monotonic() > deadline:
-            return info
-        time.sleep(0.05)
 
 
 def compare_from(depth: float) -> float:
@@ -218,15 +115,13 @@ def compare_from(depth: float) -> float:
     the linear group velocity (before that SPH still has the front, the theory has not)."""
     from wave_client.theories import wavenumber
 
-    k = float(wavenumber(2 * math.pi / PERIOD, depth))
-    kd = k * depth
-    c_g = 0.5 * (2 * math.pi / PERIOD / k) * (1 + 2 * kd / math.sinh(2 * kd))
-    return RAMP_PERIODS * PERIOD + GAUGES["flat"] / c_g
+    wavelength = 2 * math.pi / float(wavenumber(2 * math.pi / PERIOD, depth))
+    return RAMP_PERIODS * PERIOD + GAUGES["flat"] / group_velocity(wavelength, PERIOD, depth)
 
 
-def _figures(info: dict, report: Any, wall: float, depth: float) -> dict[str, Any]:
-    from sph_core.wave_analysis import rmse_over_height
-
+def demo_figures(info: dict, report: Any, wall: float, depth: float) -> dict[str, Any]:
+    """The figures of a finished demo run (summary.json): speed, coupling overhead, RMSE/H at
+    the flat-bed gauge against the Stokes-2 theory."""
     t = report.t
     j = _gauge_index(report, "flat")
     t0 = compare_from(depth)
@@ -251,7 +146,7 @@ def _gauge_index(report: Any, name: str) -> int:
     return 1 + list(GAUGES).index(name)
 
 
-def plot(report: Any, info: dict, path: Path, dp: float, t_end: float, t0: float) -> Path:
+def plot_demo(report: Any, info: dict, path: Path, dp: float, t_end: float, t0: float) -> Path:
     """Measured vs theoretical elevation at each gauge, and the flume with its gauges."""
     import matplotlib
 
@@ -287,14 +182,3 @@ def plot(report: Any, info: dict, path: Path, dp: float, t_end: float, t0: float
     fig.savefig(path, dpi=100)
     plt.close(fig)
     return path
-
-
-def _dambreak(args: argparse.Namespace) -> int:
-    """The standalone dam break (sph_core's demo) with its own defaults."""
-    from sph_core import demo_cli
-
-    p = argparse.ArgumentParser()
-    demo_cli.add_arguments(p)
-    ns = p.parse_args([])
-    ns.out, ns.no_plot = args.out, args.no_plot
-    return demo_cli.main(ns)

@@ -1,4 +1,5 @@
-"""Jitted kernels of the 1D Nwogu Boussinesq solver: right-hand sides, tridiagonal solve, filter.
+"""The jitted time stepping of the 1D Nwogu Boussinesq solver: right-hand sides, tridiagonal solve,
+filter, RK4 predictor and corrector loop.
 
 Grid arrays are padded with two ghost nodes on each side: node i of the model is index i + 2.
 Reflective walls sit on the first and last model nodes: eta and h are mirrored even, u odd

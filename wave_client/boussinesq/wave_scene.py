@@ -109,7 +109,7 @@ class Coupling(_Strict):
                                                     "absorption-only)")
 
 
-class Output(_Strict):
+class WaveOutput(_Strict):
     csv: str = Field(default="gauges.csv", description="gauge CSV path (relative to the working directory)")
     every: float | None = Field(default=None, gt=0, description="sampling interval [s] (default dt)")
 
@@ -122,7 +122,7 @@ class WaveScene(_Strict):
     filter: Filter = Filter()
     solver: Solver = Solver()
     gauges: Gauges
-    output: Output = Output()
+    output: WaveOutput = WaveOutput()
     coupling: Coupling = Coupling()
 
     @model_validator(mode="after")
@@ -141,22 +141,22 @@ class WaveScene(_Strict):
         return self
 
 
-class SceneError(ValueError):
+class WaveSceneError(ValueError):
     """A scene file that cannot be read or is invalid; the message names the fields."""
 
 
-def load_scene(path: str | Path) -> WaveScene:
+def load_wave_scene(path: str | Path) -> WaveScene:
     """Read and validate a `wavesph waves` TOML scene."""
     path = Path(path)
     try:
         data = tomllib.loads(path.read_text())
     except (OSError, tomllib.TOMLDecodeError) as exc:
-        raise SceneError(f"{path}: {exc}") from exc
+        raise WaveSceneError(f"{path}: {exc}") from exc
     try:
         return WaveScene.model_validate(data)
     except ValidationError as exc:
         lines = [f"{'.'.join(str(p) for p in e['loc'])}: {e['msg']}" for e in exc.errors()]
-        raise SceneError(f"{path}: invalid scene\n  " + "\n  ".join(lines)) from exc
+        raise WaveSceneError(f"{path}: invalid scene\n  " + "\n  ".join(lines)) from exc
 
 
 def read_series(path: Path) -> tuple[np.ndarray, np.ndarray]:
@@ -164,9 +164,9 @@ def read_series(path: Path) -> tuple[np.ndarray, np.ndarray]:
     try:
         data = np.genfromtxt(path, delimiter=",", comments="#", skip_header=0, dtype=float)
     except OSError as exc:
-        raise SceneError(f"wave.file: {exc}") from exc
+        raise WaveSceneError(f"wave.file: {exc}") from exc
     if data.ndim != 2 or data.shape[1] < 2:
-        raise SceneError(f"wave.file {path}: need two columns time, eta")
+        raise WaveSceneError(f"wave.file {path}: need two columns time, eta")
     data = data[~np.isnan(data).any(axis=1)]  # a header row reads as NaN
     return data[:, 0], data[:, 1]
 

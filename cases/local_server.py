@@ -1,0 +1,53 @@
+"""The wavesph server on free loopback ports in a thread of this process, for the demo and the
+coupled-flume cases, which drive it over its real HTTP and coupling sockets."""
+
+from __future__ import annotations
+
+import threading
+import time
+from pathlib import Path
+from typing import Any
+
+
+class InProcessServer:
+    """The wavesph server (HTTP + WebSocket + TCP) on free loopback ports, in a thread."""
+
+    def __init__(self, runs_dir: Path) -> None:
+        import uvicorn
+
+        from server.main import create_app
+        from server.settings import Settings
+
+        self.settings = Settings(host="127.0.0.1", port=0, tcp_port=0, runs_dir=runs_dir,
+                                 max_runs=1)
+        self.app = create_app(self.settings)
+        self.server = uvicorn.Server(uvicorn.Config(
+            self.app, host="127.0.0.1", port=0, log_level="warning", lifespan="on",
+            ws_max_size=self.settings.max_frame + 16, ws_per_message_deflate=False))
+        self.thread = threading.Thread(target=self.server.run, name="wavesph-server", daemon=True)
+
+    def __enter__(self) -> "InProcessServer":
+        self.thread.start()
+        deadline = time.monotonic() + 30
+        while not self.server.started:
+            if time.monotonic() > deadline or not self.thread.is_alive():
+                raise RuntimeError("the in-process server did not start")
+            time.sleep(0.02)
+        self.port = self.server.servers[0].sockets[0].getsockname()[1]
+        self.tcp_port = self.app.state.tcp_port
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.server.should_exit = True
+        self.thread.join(timeout=30)
+
+
+def wait_for_state(http: Any, run_id: str, states: set[str] | frozenset[str], timeout: float) -> dict:
+    """Poll GET /runs/{run_id} until its state is one of ``states`` or ``timeout`` [s] passed;
+    returns the last run record."""
+    deadline = time.monotonic() + timeout
+    while True:
+        info = http.get(f"/runs/{run_id}").json()
+        if info["state"] in states or time.monotonic() > deadline:
+            return info
+        time.sleep(0.05)
