@@ -11,10 +11,11 @@ import numpy as np
 import pytest
 
 from wave_client.boussinesq import BoussinesqModel, airy_celerity, nwogu_celerity, nwogu_wavenumber
-from wave_client.boussinesq.checks import solitary_run, standing_wave_speed
 from wave_client.boussinesq import stepping
-from wave_client.boussinesq.dispersion import airy_wavenumber, alpha
+from wave_client.boussinesq.checks import solitary_run, standing_wave_speed
+from wave_client.boussinesq.dispersion import alpha
 from wave_client.boussinesq.solitary import nwogu_solitary
+from wave_client.theories import wavenumber as airy_wavenumber
 
 G = 9.81
 

@@ -55,18 +55,3 @@ def nwogu_wavenumber(omega: ArrayLike, depth: float, beta: float = BETA, g: floa
         k2 = (b - np.sqrt(b * b - 4.0 * a1 * s)) / (2.0 * a1)
     return np.sqrt(k2) / depth
 
-
-def airy_wavenumber(omega: ArrayLike, depth: float, g: float = G) -> np.ndarray:
-    """Wavenumber k [1/m] solving omega^2 = g k tanh(k d) (Newton, from Eckart's guess)."""
-    omega = np.asarray(omega, dtype=float)
-    k0 = omega**2 / g
-    k = k0 / np.sqrt(np.tanh(k0 * depth))
-    for _ in range(50):
-        th = np.tanh(k * depth)
-        f = g * k * th - omega**2
-        df = g * th + g * k * depth * (1.0 - th * th)
-        dk = f / df
-        k = k - dk
-        if np.all(np.abs(dk) <= 1e-13 * np.abs(k)):
-            break
-    return k

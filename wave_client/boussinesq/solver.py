@@ -487,13 +487,6 @@ class BoussinesqModel:
         al = 0.5 * self.beta**2 + self.beta
         return self.g * k / (w * (1.0 - al * (k * h) ** 2))
 
-    def release(self) -> None:
-        """Remove the coupling boundary; the grid beyond it restarts from rest."""
-        self._free = None
-        if self._pins:
-            self._pins.clear()
-            self._sync_pins(refactor=True)
-
     def _sync_pins(self, refactor: bool) -> None:
         idx = np.array(sorted(self._pins), dtype=np.int64)
         self._pin_idx = idx
