@@ -178,6 +178,18 @@ def shapiro_filter(f: np.ndarray, work: np.ndarray, i_end: int) -> None:
 
 
 @njit(cache=True)
+def push_history(e_hist: np.ndarray, f_hist: np.ndarray, e_new: np.ndarray, f_new: np.ndarray) -> None:
+    """Shift the three-level histories of E and F back by one step and store the newest."""
+    for i in range(NG, e_new.size - NG):
+        e_hist[2, i] = e_hist[1, i]
+        e_hist[1, i] = e_hist[0, i]
+        e_hist[0, i] = e_new[i]
+        f_hist[2, i] = f_hist[1, i]
+        f_hist[1, i] = f_hist[0, i]
+        f_hist[0, i] = f_new[i]
+
+
+@njit(cache=True)
 def rk4_step(t0: float, dt: float, eta: np.ndarray, u: np.ndarray, uu: np.ndarray,
              e0: np.ndarray, f0: np.ndarray, h: np.ndarray, coef_a: np.ndarray, coef_b: np.ndarray,
              lower: np.ndarray, cprime: np.ndarray, minv: np.ndarray, sponge: np.ndarray,
@@ -262,13 +274,7 @@ def advance_steps(n_steps: int, t0: float, dt: float, n_hist: int, tol: float, m
             src = source_signal(t1, src_amp, src_omega, src_phase, src_ramp)
             rhs(eta, u, h, coef_a, coef_b, sponge, src_shape, src, g, dx,
                 work_q, work_d, e_new, f_new)
-            for i in range(NG, n - NG):
-                e_hist[2, i] = e_hist[1, i]
-                e_hist[1, i] = e_hist[0, i]
-                e_hist[0, i] = e_new[i]
-                f_hist[2, i] = f_hist[1, i]
-                f_hist[1, i] = f_hist[0, i]
-                f_hist[0, i] = f_new[i]
+            push_history(e_hist, f_hist, e_new, f_new)
             n_hist += 1
             if not np.isfinite(eta[NG]):
                 return -(step + 1)
@@ -320,13 +326,7 @@ def advance_steps(n_steps: int, t0: float, dt: float, n_hist: int, tol: float, m
         if it > stats[1]:
             stats[1] = it
         # shift history and accept the new state
-        for i in range(NG, n - NG):
-            e_hist[2, i] = e_hist[1, i]
-            e_hist[1, i] = e_hist[0, i]
-            e_hist[0, i] = e_new[i]
-            f_hist[2, i] = f_hist[1, i]
-            f_hist[1, i] = f_hist[0, i]
-            f_hist[0, i] = f_new[i]
+        push_history(e_hist, f_hist, e_new, f_new)
         for i in range(n):
             eta[i] = eta_new[i]
             u[i] = u_new[i]

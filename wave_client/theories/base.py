@@ -24,6 +24,14 @@ def require_positive(name: str, value: float) -> float:
     return v
 
 
+def require_integer(name: str, value: int, lo: int, hi: int | None = None) -> int:
+    """Return ``value`` as int if it is an integer in [lo, hi], or raise ValueError naming it."""
+    if int(value) != value or value < lo or (hi is not None and value > hi):
+        rng = f"from {lo} to {hi}" if hi is not None else f">= {lo}"
+        raise ValueError(f"{name} must be an integer {rng}, got {value!r}")
+    return int(value)
+
+
 def check_not_breaking(height: float, period: float, depth: float, name: str = "height") -> None:
     """Raise ValueError naming the height parameter (``name``) if the wave exceeds a breaking limit.
 
@@ -127,3 +135,17 @@ class WaveTheory:
         self, x: np.ndarray, z: np.ndarray, t: float, eta: np.ndarray
     ) -> tuple[np.ndarray, np.ndarray]:
         raise NotImplementedError
+
+
+class RegularWaveTheory(WaveTheory):
+    """A regular wave of height H [m] and period T [s] on depth d [m]: validated parameters,
+    refused if it breaks (there is no steady wave to impose)."""
+
+    def __init__(self, height: float, period: float, depth: float, *, ramp_time: float = 0.0,
+                 g: float = G) -> None:
+        super().__init__(ramp_time)
+        self.height = require_positive("height", height)
+        self.period = require_positive("period", period)
+        self.depth = require_positive("depth", depth)
+        self.g = require_positive("g", g)
+        check_not_breaking(self.height, self.period, self.depth)

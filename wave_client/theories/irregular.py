@@ -27,7 +27,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike
 
-from wave_client.theories.base import G, WaveTheory, check_not_breaking, require_positive
+from wave_client.theories.base import G, WaveTheory, check_not_breaking, require_integer, require_positive
 from wave_client.theories.linear import depth_profiles, wavenumber
 
 
@@ -70,8 +70,7 @@ class JonswapSea(WaveTheory):
         self.depth = require_positive("depth", depth)
         self.g = require_positive("g", g)
         self.gamma = require_positive("gamma", gamma)
-        if int(n_components) != n_components or n_components < 1:
-            raise ValueError(f"n_components must be a positive integer, got {n_components!r}")
+        n_components = require_integer("n_components", n_components, 1)
         f_lo = require_positive("f_min_factor", f_min_factor)
         f_hi = require_positive("f_max_factor", f_max_factor)
         if not f_lo < 1.0 < f_hi:

@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike
 
-from wave_client.theories.base import G, WaveTheory, check_not_breaking, require_positive
+from wave_client.theories.base import G, RegularWaveTheory, require_positive
 
 
 def wavenumber(omega: ArrayLike, depth: float, g: float = G) -> np.ndarray:
@@ -50,18 +50,13 @@ def depth_profiles(k: ArrayLike, z: ArrayLike, depth: float) -> tuple[np.ndarray
     return ez * (1.0 + e) / den, ez * -np.expm1(-2.0 * k * (z + depth)) / den
 
 
-class _LinearMode(WaveTheory):
-    """One linear mode of height H and period T on depth d: validated parameters, omega, k, L."""
+class _LinearMode(RegularWaveTheory):
+    """One linear mode of height H and period T on depth d: omega, k and L from linear dispersion."""
 
     def __init__(
         self, height: float, period: float, depth: float, *, ramp_time: float = 0.0, g: float = G
     ) -> None:
-        super().__init__(ramp_time)
-        self.height = require_positive("height", height)
-        self.period = require_positive("period", period)
-        self.depth = require_positive("depth", depth)
-        self.g = require_positive("g", g)
-        check_not_breaking(self.height, self.period, self.depth)
+        super().__init__(height, period, depth, ramp_time=ramp_time, g=g)
         self.omega = 2.0 * np.pi / self.period
         self.k = float(wavenumber(self.omega, self.depth, self.g))
         self.length = 2.0 * np.pi / self.k

@@ -16,23 +16,16 @@ from __future__ import annotations
 import numpy as np
 import raschii
 
-from wave_client.theories.base import G, WaveTheory, check_not_breaking, require_positive
+from wave_client.theories.base import G, RegularWaveTheory, require_integer
 
 
-class _RaschiiWave(WaveTheory):
+class _RaschiiWave(RegularWaveTheory):
     """Adapter from a raschii wave object to the `WaveModel` contract."""
 
-    def __init__(self, height: float, period: float, depth: float, ramp_time: float, g: float):
-        super().__init__(ramp_time)
-        self.height = require_positive("height", height)
-        self.period = require_positive("period", period)
-        self.depth = require_positive("depth", depth)
-        self.g = require_positive("g", g)
-        check_not_breaking(self.height, self.period, self.depth)
-
-    def _build(self, make) -> None:  # make: () -> raschii wave
+    def _build(self, raschii_class: type, n: int) -> None:
+        """The raschii wave of ``n`` terms (``N``) for this height, period and depth."""
         try:
-            wave = make()
+            wave = raschii_class(self.height, self.depth, period=self.period, N=n, g=self.g)
         except raschii.RaschiiError as exc:  # includes NonConvergenceError
             raise ValueError(
                 f"{type(self).__name__} did not converge for height={self.height} m, "
@@ -64,25 +57,11 @@ class StokesWave(_RaschiiWave):
 
     _repr_fields = ("height", "period", "depth", "order", "ramp_time")
 
-    def __init__(
-        self,
-        height: float,
-        period: float,
-        depth: float,
-        *,
-        order: int = 5,
-        ramp_time: float = 0.0,
-        g: float = G,
-    ) -> None:
-        super().__init__(height, period, depth, ramp_time, g)
-        if int(order) != order or not 2 <= order <= 5:
-            raise ValueError(f"order must be an integer from 2 to 5, got {order!r}")
-        self.order = int(order)
-        self._build(
-            lambda: raschii.StokesWave(
-                self.height, self.depth, period=self.period, N=self.order, g=self.g
-            )
-        )
+    def __init__(self, height: float, period: float, depth: float, *, order: int = 5,
+                 ramp_time: float = 0.0, g: float = G) -> None:
+        super().__init__(height, period, depth, ramp_time=ramp_time, g=g)
+        self.order = require_integer("order", order, 2, 5)
+        self._build(raschii.StokesWave, self.order)
 
 
 class StreamFunctionWave(_RaschiiWave):
@@ -93,22 +72,8 @@ class StreamFunctionWave(_RaschiiWave):
 
     _repr_fields = ("height", "period", "depth", "n_fourier", "ramp_time")
 
-    def __init__(
-        self,
-        height: float,
-        period: float,
-        depth: float,
-        *,
-        n_fourier: int = 10,
-        ramp_time: float = 0.0,
-        g: float = G,
-    ) -> None:
-        super().__init__(height, period, depth, ramp_time, g)
-        if int(n_fourier) != n_fourier or not 2 <= n_fourier <= 64:
-            raise ValueError(f"n_fourier must be an integer from 2 to 64, got {n_fourier!r}")
-        self.n_fourier = int(n_fourier)
-        self._build(
-            lambda: raschii.FentonWave(
-                self.height, self.depth, period=self.period, N=self.n_fourier, g=self.g
-            )
-        )
+    def __init__(self, height: float, period: float, depth: float, *, n_fourier: int = 10,
+                 ramp_time: float = 0.0, g: float = G) -> None:
+        super().__init__(height, period, depth, ramp_time=ramp_time, g=g)
+        self.n_fourier = require_integer("n_fourier", n_fourier, 2, 64)
+        self._build(raschii.FentonWave, self.n_fourier)
