@@ -1,5 +1,6 @@
 """The wavesph server on free loopback ports in a thread of this process, for the demo and the
-coupled-flume cases, which drive it over its real HTTP and coupling sockets."""
+coupled-flume cases, which drive it over its real HTTP and coupling sockets (and for the server
+tests' harness)."""
 
 from __future__ import annotations
 
@@ -10,18 +11,21 @@ from typing import Any
 
 
 class InProcessServer:
-    """The wavesph server (HTTP + WebSocket + TCP) on free loopback ports, in a thread."""
+    """The wavesph server (HTTP + WebSocket + TCP) on free loopback ports, in a thread.
 
-    def __init__(self, runs_dir: Path) -> None:
+    ``settings``: overrides of `server.settings.Settings` (e.g. max_runs); ``engine_factory``:
+    the SPH side of coupled runs (default the server's, sph_core's OpenFlume)."""
+
+    def __init__(self, runs_dir: Path, engine_factory: Any = None, **settings: Any) -> None:
         import uvicorn
 
         from server.main import create_app
         from server.settings import Settings
 
-        self.settings = Settings(host="127.0.0.1", port=0, tcp_port=0, runs_dir=runs_dir,
-                                 max_runs=1)
-        self.app = create_app(self.settings)
-        self.server = uvicorn.Server(uvicorn.Config(
+        self.settings = Settings(host="127.0.0.1", port=0, tcp_port=0, runs_dir=runs_dir, **settings)
+        self.app = (create_app(self.settings) if engine_factory is None
+                    else create_app(self.settings, engine_factory))
+        self.server = uvicorn.Server(uvicorn.Config(  # socket options as `wavesph serve`
             self.app, host="127.0.0.1", port=0, log_level="warning", lifespan="on",
             ws_max_size=self.settings.max_frame + 16, ws_per_message_deflate=False))
         self.thread = threading.Thread(target=self.server.run, name="wavesph-server", daemon=True)

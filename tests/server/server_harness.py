@@ -2,16 +2,13 @@
 
 from __future__ import annotations
 
-import threading
 import time
 from contextlib import contextmanager
 from pathlib import Path
 
 import httpx
-import uvicorn
 
-from server.main import create_app
-from server.settings import Settings
+from cases.local_server import InProcessServer
 
 
 def scene(**overrides) -> dict:
@@ -28,24 +25,11 @@ def scene(**overrides) -> dict:
     return base
 
 
-class LiveServer:
-    def __init__(self, app, settings: Settings) -> None:
-        self.app, self.settings = app, settings
-        config = uvicorn.Config(app, host="127.0.0.1", port=0, log_level="warning",
-                                ws_max_size=settings.max_frame + 16, lifespan="on",
-                                ws_per_message_deflate=False)  # as `wavesph serve`
-        self.server = uvicorn.Server(config)
-        self.thread = threading.Thread(target=self.server.run, daemon=True)
+class LiveServer(InProcessServer):
+    """The in-process server with an HTTP client (the token sent if set) and run helpers."""
 
     def __enter__(self) -> "LiveServer":
-        self.thread.start()
-        deadline = time.monotonic() + 20
-        while not self.server.started:
-            if time.monotonic() > deadline or not self.thread.is_alive():
-                raise RuntimeError("server did not start")
-            time.sleep(0.02)
-        self.port = self.server.servers[0].sockets[0].getsockname()[1]
-        self.tcp_port = self.app.state.tcp_port
+        super().__enter__()
         self.url = f"http://127.0.0.1:{self.port}"
         self.http = httpx.Client(base_url=self.url, timeout=30,
                                  headers={"Authorization": f"Bearer {self.settings.token}"}
@@ -58,8 +42,7 @@ class LiveServer:
 
     def __exit__(self, *exc) -> None:
         self.http.close()
-        self.server.should_exit = True
-        self.thread.join(timeout=20)
+        super().__exit__(*exc)
 
     def create(self, mode: str = "coupled", **scene_overrides) -> dict:
         if mode == "coupled":
@@ -81,7 +64,5 @@ class LiveServer:
 
 @contextmanager
 def live_server(tmp_path: Path, engine_factory=None, **settings):
-    s = Settings(runs_dir=tmp_path / "runs", tcp_port=0, port=0, **settings)
-    app = create_app(s) if engine_factory is None else create_app(s, engine_factory)
-    with LiveServer(app, s) as srv:
+    with LiveServer(tmp_path / "runs", engine_factory, **settings) as srv:
         yield srv

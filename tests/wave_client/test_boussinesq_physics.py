@@ -38,6 +38,16 @@ def fit_harmonic(t: np.ndarray, y: np.ndarray, omega: float) -> tuple[float, flo
     return float(np.hypot(cc, ss)), float(np.arctan2(ss, cc))
 
 
+def record(m: BoussinesqModel, xs: np.ndarray, duration: float) -> tuple[np.ndarray, np.ndarray]:
+    """Times and elevations at xs (rows), every 4 model steps over ``duration`` [s] from now."""
+    n = int(round(duration / m.dt / 4))
+    ts, es = np.empty(n), np.empty((n, np.size(xs)))
+    for i in range(n):
+        m.advance_steps(4)
+        ts[i], es[i] = m.t, m.elevation(xs)
+    return ts, es
+
+
 @pytest.mark.parametrize("depth,period", [(0.5, 2.0), (0.5, 0.9)])
 def test_source_function_generates_target_wave(depth, period):
     """Small regular waves from the source: amplitude H/2 and phase k|x - x_s| at gauges on both
@@ -50,11 +60,7 @@ def test_source_function_generates_target_wave(depth, period):
     m.set_regular_wave(0.0, height, period, ramp_periods=2)
     xs = np.array([-wl, 0.75 * wl, 1.5 * wl, 2.25 * wl, 3.0 * wl])
     m.advance_to(20 * period)
-    n = int(round(20 * period / m.dt / 4))
-    ts, es = np.empty(n), np.empty((n, xs.size))
-    for i in range(n):
-        m.advance_steps(4)
-        ts[i], es[i] = m.t, m.elevation(xs)
+    ts, es = record(m, xs, 20 * period)
     for j, x in enumerate(xs):
         amp, phase = fit_harmonic(ts, es[:, j], omega)
         assert amp == pytest.approx(height / 2, rel=0.01), f"amplitude at x = {x:.3f} m"
@@ -157,11 +163,7 @@ def test_linear_shoaling_on_a_mild_slope():
     m.set_regular_wave(0.0, 0.002, period, ramp_periods=2)
     xg = np.array([2.0, 3.0, 20.0, 21.0, 22.0])
     m.advance_to(30 * period)
-    n = int(round(10 * period / m.dt / 4))
-    ts, es = np.empty(n), np.empty((n, xg.size))
-    for i in range(n):
-        m.advance_steps(4)
-        ts[i], es[i] = m.t, m.elevation(xg)
+    ts, es = record(m, xg, 10 * period)
     amps = np.array([fit_harmonic(ts, es[:, j], omega)[0] for j in range(xg.size)])
     ratio = amps[2:].mean() / amps[:2].mean()
 
@@ -195,9 +197,5 @@ def test_filtered_run_keeps_generated_amplitude():
                         filter_every=10)
     m.set_regular_wave(0.0, height, period, ramp_periods=2)
     m.advance_to(15 * period)
-    n = int(round(10 * period / m.dt / 4))
-    ts, es = np.empty(n), np.empty(n)
-    for i in range(n):
-        m.advance_steps(4)
-        ts[i], es[i] = m.t, m.elevation(3 * wl)
-    assert fit_harmonic(ts, es, omega)[0] == pytest.approx(height / 2, rel=0.01)
+    ts, es = record(m, np.array([3 * wl]), 10 * period)
+    assert fit_harmonic(ts, es[:, 0], omega)[0] == pytest.approx(height / 2, rel=0.01)

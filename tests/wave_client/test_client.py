@@ -268,17 +268,18 @@ def test_two_way_feedback_reaches_the_model():
 
 
 # --- failures: clear exceptions, never a hang -----------------------------------------------
+async def couple_airy(fake: "FakeSph", transport: str, run_id: str | None = "r1"):
+    """Couple the Airy wave of these tests to ``fake`` over ``transport`` until the run ends."""
+    async with PeerServer(fake, transport) as peer:
+        return await run_coupling(peer.url, AiryWave(H, T, DEPTH), CouplingOptions(window=WINDOW),
+                                  run_id=run_id, timeout=5.0, progress=False)
+
+
 @pytest.mark.parametrize("transport", ["ws", "tcp"])
 def test_server_error_frame_becomes_clear_exception(transport):
     fake = FakeSph("refuse_set")
-
-    async def scenario():
-        async with PeerServer(fake, transport) as peer:
-            await run_coupling(peer.url, AiryWave(H, T, DEPTH), CouplingOptions(window=WINDOW),
-                               run_id="r1", timeout=5.0, progress=False)
-
     with pytest.raises(ServerError, match="TIME_MISMATCH.*t0=9 s") as info:
-        run(scenario())
+        run(couple_airy(fake, transport))
     assert info.value.code is ErrorCode.TIME_MISMATCH
 
 
@@ -303,27 +304,15 @@ def test_vanished_peer_times_out(transport):
 @pytest.mark.parametrize("transport", ["ws", "tcp"])
 def test_peer_hangup_is_connection_lost(transport):
     fake = FakeSph("hangup")
-
-    async def scenario():
-        async with PeerServer(fake, transport) as peer:
-            await run_coupling(peer.url, AiryWave(H, T, DEPTH), CouplingOptions(window=WINDOW),
-                               run_id="r1", timeout=5.0, progress=False)
-
     with pytest.raises(CouplingError, match="connection lost at window 2/10") as info:
-        run(scenario())
+        run(couple_airy(fake, transport))
     assert len(info.value.report.records) == 1  # the window solved before the hangup is kept
 
 
 def test_server_bye_mid_run_ends_the_run_clearly():
     fake = FakeSph("bye")
-
-    async def scenario():
-        async with PeerServer(fake, "ws") as peer:
-            await run_coupling(peer.url, AiryWave(H, T, DEPTH), CouplingOptions(window=WINDOW),
-                               timeout=5.0, progress=False)
-
     with pytest.raises(ServerEnded, match="ended the run: run cancelled by its owner .at window 2/10"):
-        run(scenario())
+        run(couple_airy(fake, "ws", run_id=None))
 
 
 def test_model_failure_is_reported_to_the_server_then_raised():

@@ -22,8 +22,10 @@ from wave_client.theories.base import G, RegularWaveTheory, require_integer
 class _RaschiiWave(RegularWaveTheory):
     """Adapter from a raschii wave object to the `WaveModel` contract."""
 
-    def _build(self, raschii_class: type, n: int) -> None:
-        """The raschii wave of ``n`` terms (``N``) for this height, period and depth."""
+    def _build(self, raschii_class: type, name: str, n: int, lo: int, hi: int) -> int:
+        """Build the raschii wave of ``n`` terms (raschii's ``N``, the parameter ``name``, an
+        integer in [lo, hi]) for this height, period and depth; returns n."""
+        n = require_integer(name, n, lo, hi)
         try:
             wave = raschii_class(self.height, self.depth, period=self.period, N=n, g=self.g)
         except raschii.RaschiiError as exc:  # includes NonConvergenceError
@@ -40,6 +42,7 @@ class _RaschiiWave(RegularWaveTheory):
         self.length = float(wave.length)
         self.k = float(wave.k)
         self.celerity = float(wave.c)
+        return n
 
     def _eta(self, x: np.ndarray, t: float) -> np.ndarray:
         eta = self.raschii_wave.surface_elevation(x.ravel(), t, include_depth=False)
@@ -60,8 +63,7 @@ class StokesWave(_RaschiiWave):
     def __init__(self, height: float, period: float, depth: float, *, order: int = 5,
                  ramp_time: float = 0.0, g: float = G) -> None:
         super().__init__(height, period, depth, ramp_time=ramp_time, g=g)
-        self.order = require_integer("order", order, 2, 5)
-        self._build(raschii.StokesWave, self.order)
+        self.order = self._build(raschii.StokesWave, "order", order, 2, 5)
 
 
 class StreamFunctionWave(_RaschiiWave):
@@ -75,5 +77,4 @@ class StreamFunctionWave(_RaschiiWave):
     def __init__(self, height: float, period: float, depth: float, *, n_fourier: int = 10,
                  ramp_time: float = 0.0, g: float = G) -> None:
         super().__init__(height, period, depth, ramp_time=ramp_time, g=g)
-        self.n_fourier = require_integer("n_fourier", n_fourier, 2, 64)
-        self._build(raschii.FentonWave, self.n_fourier)
+        self.n_fourier = self._build(raschii.FentonWave, "n_fourier", n_fourier, 2, 64)
