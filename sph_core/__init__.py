@@ -10,5 +10,6 @@
 
 Modules: scene (config), geometry (particle layout), particles (SoA storage), neighbours (cell
 lists), kernels (Wendland C2), eos (Tait), wcsph (jitted passes and time loop), probes, output,
-simulation (the run), dambreak (the Martin & Moyce test problem), cli / demo_cli (commands).
+simulation (the run), progress (a terminal progress bar over a run). Named cases (dam break,
+flumes) live in the `cases` package; the commands in `wavesph_cli`.
 """
