@@ -137,7 +137,8 @@ class FlumeCase:
 
 
 def depth_for_case(depth: float, dp: float) -> float:
-    """Depth [m] nearest ``depth`` holding whole dp rows (the demo's rule, any depth)."""
+    """Depth [m] nearest ``depth`` holding whole dp rows (at least 4): the particles fill whole
+    rows of dp, so any other depth would put the SPH surface up to dp/2 below still water."""
     return dp * max(4, round(depth / dp))
 
 

@@ -25,6 +25,7 @@ from typing import Any
 
 import numpy as np
 
+from .coupled_flume import depth_for_case
 from .local_server import InProcessServer, wait_for_state
 from .wave_analysis import group_velocity, rmse_over_height
 
@@ -41,7 +42,7 @@ GAUGES = {"flat": 1.0, "toe": X_TOE, "beach": X_TOE + 0.5 * DEPTH / SLOPE}  # x 
 def depth_for(dp: float) -> float:
     """Still-water depth [m] nearest DEPTH holding whole particle rows: the particles fill whole
     rows of dp, so any other depth would put the SPH surface up to dp/2 below still water."""
-    return dp * max(4, round(DEPTH / dp))
+    return depth_for_case(DEPTH, dp)
 
 
 def tank_end(dp: float) -> float:
@@ -78,7 +79,6 @@ def _couple(srv: InProcessServer, scene: dict, transport: str, out: Path) -> tup
     import httpx
 
     from server.runs import TERMINAL
-
     from wave_client.coupling import CouplingError, CouplingOptions, couple
     from wave_client.theories import build_theory
 
