@@ -6,7 +6,7 @@ One flume, three ways to compute it (x in the Boussinesq model's frame: source a
                                                                   SPH inlet (open)
 
 - coupled: the Boussinesq model (wave_client, a `wavesph waves` scene) covers the far field up to
-  x_c plus an overlap of flat bed ending in a sponge; the SPH zone (server, sph_core's OpenFlume)
+  x_c plus an overlap of flat bed ending in a sponge; the SPH zone (server, an sph_core Simulation with open ends)
   starts with an open inlet at x_c. The client is `wavesph couple --model boussinesq --config
   <scene.toml>`, unchanged, over a real socket. ``two_way`` (the wave scene's ``[coupling]``):
   SPH's elevation and z_alpha velocity at the inlet gauge become the model's characteristic

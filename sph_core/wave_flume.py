@@ -22,7 +22,8 @@ import numpy as np
 
 from .boundary_data import WaveModelBoundary
 from .wave_analysis import group_velocity, reflection_coefficient, rmse_over_height
-from .flume import OpenFlume, flume_nodes
+from .open_ends import flume_nodes
+from .simulation import Simulation
 from .scene import Scene, make_scene
 
 # gauges [wavelengths from mid-flume] of the reflection analysis: L/16 apart within L/4 of
@@ -77,7 +78,7 @@ class FlumeRun:
     particles: int
     n_fluid: np.ndarray
     counts: dict[str, dict[str, int]] = field(default_factory=dict)
-    flume: OpenFlume | None = None
+    flume: Simulation | None = None
 
 
 def run_wave_flume(scene: Scene, model: Any, *, window: float, x_model_left: float = 0.0,
@@ -90,7 +91,7 @@ def run_wave_flume(scene: Scene, model: Any, *, window: float, x_model_left: flo
     sources = {side: WaveModelBoundary(model, nd, scene.still_water_level,
                                        x_model_left + (nd.x_face - nodes_x0))
                for side, nd in nodes.items()}
-    flume = OpenFlume(scene, sources=sources, run_dir=run_dir, window=window)
+    flume = Simulation(scene, sources=sources, run_dir=run_dir, window=window)
     t_end = scene.t_end if t_end is None else t_end
     n_fluid = [(flume.t, flume.n_fluid)]
     tic = time.perf_counter()
