@@ -3,7 +3,7 @@ a coupled run's time, over WebSocket and over TCP (goal: <= 2 % at 64 boundary n
 >= 10 SPH sub-steps per window).
 
 Cases, both with 64 boundary nodes: the server (child process, `wavesph serve`'s app, default
-engine: sph_core's OpenFlume) runs
+engine: an sph_core Simulation with open ends) runs
   - beach flume: the demo's flume (open inlet, 2 m flat, 1:10 beach, depth 0.24 m) at dp = 0.01 m
     (~9000 particles, H/dp = 2 for the bench's wave; a production-like SPH zone), 64 inlet levels;
   - small flume: 4 m, both ends open, depth 0.3 m, dp = 0.03 m (~1800 particles), 32 levels

@@ -50,11 +50,10 @@ def compile_times(integrator: str) -> dict:
 def time_components(sim, repeats: int) -> dict:
     """Seconds per call of each phase of a step, timed on the current state."""
     from sph_core import wcsph
+    from sph_core.neighbours import sort_by_cell
     from sph_core.particles import N_SORTED_KDK
 
-    ps, g, prm = sim.particles, sim.grid, sim.prm
-    args = (ps.f, ps.f2, N_SORTED_KDK, ps.kind, ps.kind2, ps.ids, ps.ids2, sim.cell, sim.cell2,
-            sim.order, sim.cell_start, sim.cursor, ps.n, prm, g.ncx, g.ncz)
+    ps, cells, prm = sim.particles, sim.cells, sim.prm
 
     def clock(fn) -> float:
         fn()
@@ -63,11 +62,12 @@ def time_components(sim, repeats: int) -> dict:
             fn()
         return (time.perf_counter() - t0) / repeats
 
-    # sorting an already sorted set costs the same as a real step's sort (O(N) counting sort)
-    t_sort = clock(lambda: wcsph._sort(*args))
-    t_wall = clock(lambda: wcsph.wall_pass(ps.f, ps.kind, sim.cell, sim.cell_start, ps.n, g.ncx, g.ncz, prm))
-    t_fluid = clock(lambda: wcsph.fluid_pass(ps.f, ps.kind, sim.cell, sim.cell_start, ps.n, g.ncx, g.ncz, prm))
-    t_kick = clock(lambda: wcsph.kdk_kick(ps.f, ps.kind, ps.n, 0.0, prm))
+    # sorting an already sorted set costs the same as a real step's sort (O(N) counting sort);
+    # the twin receives the copy and the live state stays as it is
+    t_sort = clock(lambda: sort_by_cell(ps.view, ps.view2, N_SORTED_KDK, ps.n, cells))
+    t_wall = clock(lambda: wcsph.wall_pass(ps.view, ps.n, cells, prm))
+    t_fluid = clock(lambda: wcsph.fluid_pass(ps.view, ps.n, cells, prm))
+    t_kick = clock(lambda: wcsph.kdk_kick(ps.view, ps.n, 0.0, prm))
     return {"sort": t_sort, "wall": t_wall, "fluid": t_fluid, "kick": t_kick}
 
 

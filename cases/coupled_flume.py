@@ -6,10 +6,9 @@ One flume, three ways to compute it (x in the Boussinesq model's frame: source a
                                                                   SPH inlet (open)
 
 - coupled: the Boussinesq model (wave_client, a `wavesph waves` scene) covers the far field up to
-  x_c plus an overlap of flat bed ending in a sponge; the SPH zone (server, sph_core's OpenFlume)
-  starts with an open inlet at x_c. The client is wave_client's `couple` with the model of the
-  scene file, as `wavesph couple --model boussinesq --config <scene.toml>` runs it, over a real
-  socket. ``two_way`` (the wave scene's ``[coupling]``):
+  x_c plus an overlap of flat bed ending in a sponge; the SPH zone (server, an sph_core Simulation with open ends)
+  starts with an open inlet at x_c. The client is `wavesph couple --model boussinesq --config
+  <scene.toml>`, unchanged, over a real socket. ``two_way`` (the wave scene's ``[coupling]``):
   SPH's elevation and z_alpha velocity at the inlet gauge become the model's characteristic
   boundary at x_c (the beach's reflection travels on into the model, the inlet lets it out);
   False: absorption-only (the model never hears of SPH; the client's seed 002 correction,

@@ -14,7 +14,7 @@ class InProcessServer:
     """The wavesph server (HTTP + WebSocket + TCP) on free loopback ports, in a thread.
 
     ``settings``: overrides of `server.settings.Settings` (e.g. max_runs); ``engine_factory``:
-    the SPH side of coupled runs (default the server's, sph_core's OpenFlume)."""
+    the SPH side of coupled runs (default the server's, an sph_core Simulation with open ends)."""
 
     def __init__(self, runs_dir: Path, engine_factory: Any = None, **settings: Any) -> None:
         import uvicorn

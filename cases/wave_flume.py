@@ -21,7 +21,8 @@ from typing import Any
 import numpy as np
 
 from sph_core.boundary_data import WaveModelBoundary
-from sph_core.flume import OpenFlume, flume_nodes
+from sph_core.open_ends import flume_nodes
+from sph_core.simulation import Simulation
 from sph_core.scene import Scene, make_scene
 
 from .wave_analysis import group_velocity, reflection_coefficient, rmse_over_height
@@ -78,7 +79,7 @@ class FlumeRun:
     particles: int
     n_fluid: np.ndarray
     counts: dict[str, dict[str, int]] = field(default_factory=dict)
-    flume: OpenFlume | None = None
+    flume: Simulation | None = None
 
 
 def run_wave_flume(scene: Scene, model: Any, *, window: float, x_model_left: float = 0.0,
@@ -91,7 +92,7 @@ def run_wave_flume(scene: Scene, model: Any, *, window: float, x_model_left: flo
     sources = {side: WaveModelBoundary(model, nd, scene.still_water_level,
                                        x_model_left + (nd.x_face - nodes_x0))
                for side, nd in nodes.items()}
-    flume = OpenFlume(scene, sources=sources, run_dir=run_dir, window=window)
+    flume = Simulation(scene, sources=sources, run_dir=run_dir, window=window)
     t_end = scene.t_end if t_end is None else t_end
     n_fluid = [(flume.t, flume.n_fluid)]
     tic = time.perf_counter()

@@ -3,7 +3,7 @@
 A coupled run drives an object with this interface. The doors (WebSocket, TCP) speak the
 protocol and call it from a worker thread, never on the event loop; per window they call
 ``checkpoint()`` (when the client may GOBACK), ``set_window(...)`` and ``solve_window()`` in one
-worker call. The production engine is server/flume_engine.py (sph_core's OpenFlume); the tests
+worker call. The production engine is server/flume_engine.py (an sph_core Simulation with open ends); the tests
 of the doors use a deterministic double. ``solve_window`` raises protocol.ProtocolError
 (BAD_VALUE) for boundary data the solver cannot use, UnstableError when the run blows up.
 """

@@ -1,4 +1,4 @@
-"""The coupled engine over sph_core's OpenFlume: what a coupling client actually drives.
+"""The coupled engine over an sph_core Simulation with open ends: what a coupling client actually drives.
 
 Protocol view of the flume (PROTOCOL.md):
 - nodes: every open end's z levels, the left end first; x = the end's face, z up from the
@@ -23,8 +23,9 @@ import numpy as np
 
 from protocol import ErrorCode, ProtocolError
 from sph_core.boundary_data import BoundaryDataError, BoundarySample
-from sph_core.flume import SIDES, OpenFlume
+from sph_core.open_ends import SIDES
 from sph_core.scene import PointProbe, Scene
+from sph_core.simulation import Simulation
 
 from .engine import BoundaryNodes, Measurement, SceneSummary
 from .schemas import RunRequest
@@ -62,8 +63,8 @@ class FlumeEngine:
         if not -depth < z_ref <= 0:
             raise ValueError(f"coupling.z_ref: {z_ref} m is not in the water column (-{depth}, 0]")
         sim_scene, self.gauge_names, gauge_x = ref_scene(scene, z_ref)
-        self.flume = OpenFlume(sim_scene, run_dir=None if run_dir is None else _fresh_dir(Path(run_dir)),
-                               window=request.coupling.window_max)
+        self.flume = Simulation(sim_scene, run_dir=None if run_dir is None else _fresh_dir(Path(run_dir)),
+                                window=request.coupling.window_max)
         f = self.flume
         self.sides = [s for s in SIDES if s in f.open_sides]
         self._slices: dict[str, slice] = {}

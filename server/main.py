@@ -19,8 +19,8 @@ log = logging.getLogger("wavesph.server")
 
 def create_app(settings: Settings | None = None,
                engine_factory: EngineFactory = flume_engine) -> FastAPI:
-    """The app. ``engine_factory`` builds the SPH side of coupled runs: by default sph_core's
-    OpenFlume (server/flume_engine.py); tests of the doors pass a deterministic double."""
+    """The app. ``engine_factory`` builds the SPH side of coupled runs: by default an sph_core
+    Simulation with open ends (server/flume_engine.py); tests of the doors pass a deterministic double."""
     settings = settings or Settings.from_env()
 
     @asynccontextmanager

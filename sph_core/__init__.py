@@ -8,8 +8,10 @@
     sim.probe_values()                   # {"front_x": ..., "<point>_p": ..., "<gauge>_eta": ...}
     sim.close()
 
-Modules: scene (config), geometry (particle layout), particles (SoA storage), neighbours (cell
-lists), kernels (Wendland C2), eos (Tait), wcsph (jitted passes and time loop), probes, output,
-simulation (the run), progress (a terminal progress bar over a run). Named cases (dam break,
-flumes) live in the `cases` package; the commands in `wavesph_cli`.
+Modules: scene (config), geometry (particle layout), particles (SoA storage), state (the typed
+containers the kernels take), neighbours (cell lists), kernels (Wendland C2), eos (Tait), wcsph
+(the physical terms as jitted passes), open_boundary (the jitted open-end terms), step (the one
+jitted time loop), open_ends (open ends as a value of the run), simulation (the run), probes,
+output, progress (a terminal progress bar over a run). Named cases (dam break, flumes) live in
+the `cases` package; the commands in `wavesph_cli`.
 """

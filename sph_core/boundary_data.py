@@ -2,12 +2,12 @@
 
     nodes = BoundaryNodes(side="left", x_face=0.0, z=z_levels, z_bed=0.0, z_top=1.5)
     src = WaveModelBoundary(model, nodes, still_water_level=1.0, x_model=0.0)   # in-process theory
-    src = WindowBoundary(nodes, still_water_level=1.0)                           # pushed windows
     s = src.sample(t)          # BoundarySample(t, u, w, eta, eta_gauge), validated
 
 A source is any object with ``nodes`` and ``sample(t) -> BoundarySample``. The solver samples it
 at the ends of each coupling window and interpolates linearly in time inside the window (seed 001,
-Algorithm 2), so a socket-driven source and a theory-driven one are the same kind of value.
+Algorithm 2); data pushed from outside (the coupling server) come as BoundarySamples to
+``Simulation.advance_window``.
 
 Datum: ``BoundaryNodes.z`` are absolute SPH heights [m] (z up, tank floor usually 0). Wave models
 measure z up from the still-water level; ``WaveModelBoundary`` converts, z_model = z - swl.
@@ -126,16 +126,6 @@ def still_sample(nodes: BoundaryNodes, t: float = 0.0) -> BoundarySample:
     return BoundarySample(t, np.zeros(nodes.size), np.zeros(nodes.size), 0.0, 0.0)
 
 
-class StillWater:
-    """A source imposing rest (u = w = 0, eta = 0): open ends of a still tank."""
-
-    def __init__(self, nodes: BoundaryNodes) -> None:
-        self.nodes = nodes
-
-    def sample(self, t: float) -> BoundarySample:
-        return still_sample(self.nodes, t)
-
-
 class WaveModelBoundary:
     """Adapter from a wave model (``wave_client.model.WaveModel`` duck type) to boundary data.
 
@@ -172,40 +162,3 @@ class WaveModelBoundary:
         s = BoundarySample(float(t), np.asarray(u, dtype=float), np.asarray(w, dtype=float),
                            float(eta[0]), float(eta[1]))
         return validate_sample(s, self.nodes, self.still_water_level, where=f"{self.nodes.side}")
-
-
-class WindowBoundary:
-    """Boundary data pushed from outside (e.g. a coupling socket), one sample per window end.
-
-    ``push(sample)`` stores a validated sample (times must increase); ``sample(t)`` returns the
-    linear interpolation between the two stored samples that bracket t (exact at a pushed time).
-    Only the last two samples are kept: the solver only needs the current window."""
-
-    def __init__(self, nodes: BoundaryNodes, still_water_level: float,
-                 initial: BoundarySample | None = None) -> None:
-        self.nodes = nodes
-        self.still_water_level = float(still_water_level)
-        first = initial if initial is not None else still_sample(nodes, 0.0)
-        self._samples: list[BoundarySample] = [
-            validate_sample(first, nodes, self.still_water_level, where=nodes.side)]
-
-    def push(self, s: BoundarySample) -> None:
-        s = validate_sample(s, self.nodes, self.still_water_level, where=self.nodes.side)
-        last = self._samples[-1]
-        if not s.t > last.t:
-            raise BoundaryDataError(f"{self.nodes.side}.t: pushed sample at t = {s.t} does not "
-                                    f"follow the last one at t = {last.t}")
-        self._samples = [last, s]
-
-    def sample(self, t: float) -> BoundarySample:
-        t = float(t)
-        a, b = self._samples[0], self._samples[-1]
-        tol = 1e-9 * max(1.0, abs(t))
-        if not a.t - tol <= t <= b.t + tol:
-            raise BoundaryDataError(f"{self.nodes.side}: no data for t = {t} s; pushed data cover "
-                                    f"[{a.t}, {b.t}] s")
-        if b.t == a.t:
-            return b
-        r = min(max((t - a.t) / (b.t - a.t), 0.0), 1.0)
-        return BoundarySample(t, (1 - r) * a.u + r * b.u, (1 - r) * a.w + r * b.w,
-                              (1 - r) * a.eta + r * b.eta, (1 - r) * a.gauge_eta + r * b.gauge_eta)

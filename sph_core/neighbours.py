@@ -13,6 +13,8 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit, prange
 
+from .state import Cells
+
 
 @dataclass(frozen=True)
 class CellGrid:
@@ -35,10 +37,25 @@ class CellGrid:
     def ncell(self) -> int:
         return self.ncx * self.ncz
 
+    def lists(self, capacity: int) -> Cells:
+        """Empty cell lists on this grid for ``capacity`` particle slots."""
+        return Cells(np.zeros(self.ncell + 2, dtype=np.int64), np.zeros(self.ncell + 1, dtype=np.int64),
+                     np.zeros(capacity, dtype=np.int64), self.ncx, self.ncz, float(self.xmin),
+                     float(self.zmin), 1.0 / self.cs)
+
 
 @njit(parallel=True, cache=True)
-def compute_cells(x, z, kind, n, xmin, zmin, inv_cs, ncx, ncz, cell):
-    """cell[i] = cz*ncx + cx of particle i (clamped to the grid); inactive -> ncx*ncz."""
+def compute_cells(ps, n, cells):
+    """ps.cell[i] = cz*ncx + cx of particle i (clamped to the grid); inactive -> ncx*ncz."""
+    x = ps.x
+    z = ps.z
+    kind = ps.kind
+    cell = ps.cell
+    ncx = cells.ncx
+    ncz = cells.ncz
+    xmin = cells.xmin
+    zmin = cells.zmin
+    inv_cs = cells.inv_cs
     ncell = ncx * ncz
     for i in prange(n):
         if kind[i] < 0:
@@ -52,10 +69,14 @@ def compute_cells(x, z, kind, n, xmin, zmin, inv_cs, ncx, ncz, cell):
 
 
 @njit(cache=True)
-def counting_sort(cell, n, ncell, cell_start, cursor, order):
-    """Stable counting sort of slots by cell: order[k] = slot that goes to position k.
+def counting_sort(cell, n, cells):
+    """Stable counting sort of slots by cell: cells.order[k] = slot that goes to position k.
 
-    cell_start (size ncell + 2) receives the first position of each cell (bin ncell = inactive)."""
+    cells.start (size ncell + 2) receives the first position of each cell (bin ncell = inactive)."""
+    ncell = cells.ncx * cells.ncz
+    cell_start = cells.start
+    cursor = cells.cursor
+    order = cells.order
     for c in range(ncell + 2):
         cell_start[c] = 0
     for i in range(n):
@@ -71,8 +92,16 @@ def counting_sort(cell, n, ncell, cell_start, cursor, order):
 
 
 @njit(parallel=True, cache=True)
-def permute(f, f2, nrows, kind, kind2, ids, ids2, cell, cell2, order, n):
-    """Gather particle k of the sorted set from slot order[k] into the twin buffers."""
+def permute(ps, ps2, nrows, order, n):
+    """Gather particle k of the sorted set from slot order[k] into the twin buffer."""
+    f = ps.f
+    f2 = ps2.f
+    kind = ps.kind
+    kind2 = ps2.kind
+    ids = ps.ids
+    ids2 = ps2.ids
+    cell = ps.cell
+    cell2 = ps2.cell
     for k in prange(n):
         i = order[k]
         for r in range(nrows):
@@ -83,12 +112,13 @@ def permute(f, f2, nrows, kind, kind2, ids, ids2, cell, cell2, order, n):
 
 
 @njit(cache=True)
-def sort_by_cell(f, f2, nrows, kind, kind2, ids, ids2, cell, cell2, order, cell_start, cursor,
-                 n, xmin, zmin, inv_cs, ncx, ncz):
-    """Bin, counting-sort and gather all particles into the twin buffers (caller swaps)."""
-    compute_cells(f[0], f[1], kind, n, xmin, zmin, inv_cs, ncx, ncz, cell)
-    counting_sort(cell, n, ncx * ncz, cell_start, cursor, order)
-    permute(f, f2, nrows, kind, kind2, ids, ids2, cell, cell2, order, n)
+def sort_by_cell(ps, ps2, nrows, n, cells):
+    """Bin, counting-sort and gather the first ``nrows`` rows of all particles into the twin
+    buffer ``ps2`` (the caller swaps); returns the slots in use after it (inactive ones dropped)."""
+    compute_cells(ps, n, cells)
+    counting_sort(ps.cell, n, cells)
+    permute(ps, ps2, nrows, cells.order, n)
+    return cells.start[cells.ncx * cells.ncz]
 
 
 def brute_force_neighbours(x: np.ndarray, z: np.ndarray, radius: float) -> list[set[int]]:

@@ -1,4 +1,10 @@
-"""Open-boundary buffers (Tafuni et al. 2018; seed 002) and the jitted time loop that hosts them.
+"""Open-boundary buffers (Tafuni et al. 2018; seed 002): the jitted open-end terms of a step.
+
+The step (step.run) calls three hooks, each a no-op when ``ends.active`` is False (closed tank):
+    update_buffers      after the drift: impose and move buffers, then the crossings (appends)
+    extrapolate_buffers after the sort: ghost-node pressure of extrapolating ends
+    measure_boundaries  after the forces: the boundary gauges (eta_meas)
+The Python side (settings, sources, windows, validation) is open_ends.OpenBoundaries.
 
 A flume has at most two open ends, index b = 0 (left, particle kinds INLET / INLET_IDLE) and
 b = 1 (right, OUTLET / OUTLET_IDLE). Each end is a buffer of width L >= 2h outside the tank face
@@ -41,26 +47,13 @@ from numba import njit, prange
 
 from .eos import density, pressure
 from .kernels import f_of_q, w_of_q
-from .particles import (AX, AZ, DRHO, FLUID, INACTIVE, INLET, M, N_SORTED_KDK, OUTLET, P, RHO, VX,
-                        VZ, X, Z)
-from .wcsph import (PR_ALPHA_F, PR_ALPHA_W, PR_B, PR_GAMMA, PR_GZ, PR_H, PR_INV_CS, PR_RHO0,
-                    PR_XMIN, PR_ZMIN, ST_DENSITY, ST_LEFT_DOMAIN, ST_NONFINITE, ST_REACHED_T,
-                    ST_STEP_LIMIT, _sort, fluid_pass, kdk_kick, kdk_kick_drift, stable_dt,
-                    wall_pass)
+from .particles import FLUID, INACTIVE, INLET, OUTLET
 
 # idle buffer particles: above the boundary's surface, kept in place but not interacting.
 # End b has active kind INLET + b and idle kind INLET_IDLE + b.
 INLET_IDLE = 4
 OUTLET_IDLE = 5
 
-# status code of the open loop beyond those of wcsph
-ST_CAPACITY = 5
-STATUS_TEXT = {ST_CAPACITY: "particle capacity exhausted by open-boundary inflow"}
-
-# per-end parameters obp[b, :]
-(OB_ON, OB_XF, OB_NX, OB_LEN, OB_SWL, OB_SQGD, OB_ABSORB, OB_IMPOSED, OB_XG, OB_ZBED, OB_ZTOP,
- OB_DZG, OB_DP, OB_GHOST) = range(14)
-N_OBP = 14
 # smallest determinant of the (h-scaled) first-order correction matrix at a ghost node; below it
 # the node has too few fluid neighbours on too few sides (free surface, corner) for a gradient,
 # and the Shepard (zeroth-order) value is used. DualSPHysics' default limit (Tafuni et al. 2018).
@@ -100,20 +93,20 @@ def window_weight(t, win_t):
 
 
 @njit(cache=True)
-def boundary_state(b, r, obp, win_eta, win_etag, eta_meas):
+def boundary_state(b, r, ends):
     """(z_s, du) of end b: the surface the buffer uses and the absorption velocity correction."""
-    eta_th = (1.0 - r) * win_eta[b, 0] + r * win_eta[b, 1]
-    etag_th = (1.0 - r) * win_etag[b, 0] + r * win_etag[b, 1]
-    em = eta_meas[b]
+    eta_th = (1.0 - r) * ends.win_eta[b, 0] + r * ends.win_eta[b, 1]
+    etag_th = (1.0 - r) * ends.win_etag[b, 0] + r * ends.win_etag[b, 1]
+    em = ends.eta_meas[b]
     du = 0.0
-    if obp[b, OB_ABSORB] > 0.5 and math.isfinite(em):
-        du = obp[b, OB_NX] * (em - etag_th) * obp[b, OB_SQGD]
+    if ends.absorb[b] and math.isfinite(em):
+        du = ends.nx[b] * (em - etag_th) * ends.sqgd[b]
     eta = eta_th
-    if obp[b, OB_IMPOSED] < 0.5 and math.isfinite(em):
+    if not ends.imposed[b] and math.isfinite(em):
         eta = em
-    zs = obp[b, OB_SWL] + eta
+    zs = ends.swl[b] + eta
     # the surface never leaves the tank (validated data; a measured one could overshoot)
-    zs = min(max(zs, obp[b, OB_ZBED]), obp[b, OB_ZTOP])
+    zs = min(max(zs, ends.z_bed[b]), ends.z_top[b])
     return zs, du
 
 
@@ -127,40 +120,122 @@ def _end_of(k):
 
 
 @njit(parallel=True, cache=True)
-def buffer_update(f, kind, n, dt, r, zs0, du0, zs1, du1, zn, win_u, win_w, prm):
+def buffer_update(ps, n, dt, r, zs0, du0, zs1, du1, ends, prm):
     """Impose velocity, move, (de)activate and set hydrostatic density of every buffer particle."""
-    rho0 = prm[PR_RHO0]
-    bb = prm[PR_B]
-    gam = prm[PR_GAMMA]
-    g = -prm[PR_GZ]
+    x = ps.x
+    z = ps.z
+    vx = ps.vx
+    vz = ps.vz
+    rho_ = ps.rho
+    p = ps.p
+    drho = ps.drho
+    ax = ps.ax
+    az = ps.az
+    kind = ps.kind
+    zn = ends.zn
+    win_u = ends.win_u
+    win_w = ends.win_w
+    rho0 = prm.rho0
+    bb = prm.b
+    gam = prm.gamma
+    g = -prm.gz
     for i in prange(n):
         b = _end_of(kind[i])
         if b < 0:
             continue
-        zi = f[Z, i]
+        zi = z[i]
         zs = zs0 if b == 0 else zs1
         du = du0 if b == 0 else du1
         u = profile_value(zn[b], win_u[b], r, zi) + du
         w = profile_value(zn[b], win_w[b], r, zi)
-        f[VX, i] = u
-        f[VZ, i] = w
-        f[X, i] += dt * u
+        vx[i] = u
+        vz[i] = w
+        x[i] += dt * u
         if zi < zs:
             kind[i] = INLET + b
             rho = rho0 * (1.0 + rho0 * g * (zs - zi) / bb) ** (1.0 / gam)
-            f[RHO, i] = rho
-            f[P, i] = pressure(rho, rho0, bb, gam)
+            rho_[i] = rho
+            p[i] = pressure(rho, rho0, bb, gam)
         else:
             kind[i] = INLET_IDLE + b
-            f[RHO, i] = rho0
-            f[P, i] = 0.0
-        f[DRHO, i] = 0.0
-        f[AX, i] = 0.0
-        f[AZ, i] = 0.0
+            rho_[i] = rho0
+            p[i] = 0.0
+        drho[i] = 0.0
+        ax[i] = 0.0
+        az[i] = 0.0
 
 
 @njit(cache=True)
-def ghost_pressure(f, kind, cell_start, xg, zg, prm, ncx, ncz):
+def buffer_transitions(ps, n, ends, r, zs0, du0, zs1, du1):
+    """Convert particles crossing a face, spawn and remove buffer particles (serial: appends).
+
+    Returns the new slot count, or -1 if the capacity is exhausted."""
+    f = ps.f
+    x = ps.x
+    z = ps.z
+    kind = ps.kind
+    ids = ps.ids
+    counters = ends.counters
+    n0 = n
+    nrows = f.shape[0]
+    for i in range(n0):
+        k = kind[i]
+        if k == FLUID:
+            for b in range(2):
+                nx = ends.nx[b]
+                d = (x[i] - ends.x_face[b]) * nx
+                if ends.on[b] and d >= 0.0:
+                    u = profile_value(ends.zn[b], ends.win_u[b], r, z[i]) + (du0 if b == 0 else du1)
+                    if u * nx > 0.0 or d >= ends.dp:
+                        zs = zs0 if b == 0 else zs1
+                        kind[i] = INLET + b if z[i] < zs else INLET_IDLE + b
+                        counters[b, C_OUT] += 1
+                    break
+            continue
+        b = _end_of(k)
+        if b < 0:
+            continue
+        nx = ends.nx[b]
+        length = ends.length[b]
+        d = (x[i] - ends.x_face[b]) * nx
+        if d < 0.0:
+            if n >= ends.capacity:
+                return -1
+            for row in range(nrows):
+                f[row, n] = f[row, i]
+            x[n] = x[i] + nx * length
+            kind[n] = k
+            ids[n] = ends.next_id[0]
+            ends.next_id[0] += 1
+            n += 1
+            counters[b, C_CREATED] += 1
+            if k == INLET + b:
+                kind[i] = FLUID
+                counters[b, C_IN] += 1
+            else:
+                kind[i] = INACTIVE
+                counters[b, C_REMOVED] += 1
+        elif d >= length:
+            kind[i] = INACTIVE
+            counters[b, C_REMOVED] += 1
+    return n
+
+
+@njit(cache=True)
+def update_buffers(ps, n, t1, dt, ends, prm):
+    """Open-end hook after the drift (data at t1 = t + dt): buffers imposed and moved, then the
+    crossings. Returns the new slot count (-1: capacity exhausted); n unchanged if no open end."""
+    if not ends.active:
+        return n
+    r = window_weight(t1, ends.win_t)
+    zs0, du0 = boundary_state(0, r, ends)
+    zs1, du1 = boundary_state(1, r, ends)
+    buffer_update(ps, n, dt, r, zs0, du0, zs1, du1, ends, prm)
+    return buffer_transitions(ps, n, ends, r, zs0, du0, zs1, du1)
+
+
+@njit(cache=True)
+def ghost_pressure(ps, cells, xg, zg, prm):
     """First-order consistent SPH interpolation of the fluid pressure at a ghost node (xg, zg)
     (Liu & Liu 2006; Tafuni et al. 2018, eq. 13): with r_j = (x_j - xg, z_j - zg), V_j = m_j/rho_j,
     the Taylor series p_j = p_g + r_j . grad p_g tested with W_gj and grad W_gj = F_gj r_j gives
@@ -170,17 +245,18 @@ def ghost_pressure(f, kind, cell_start, xg, zg, prm, ncx, ncz):
     matrix is the identity for a full, regular support). Returns (p_g, p_x, p_z, order): order 1
     if the determinant exceeds GHOST_DET_MIN, 0 for the Shepard value sum V W p / sum V W with no
     gradient, -1 if the node has no fluid neighbour."""
-    x = f[X]
-    z = f[Z]
-    h = prm[PR_H]
-    aw = prm[PR_ALPHA_W]
-    af = prm[PR_ALPHA_F]
-    xmin = prm[PR_XMIN]
-    zmin = prm[PR_ZMIN]
-    inv_cs = prm[PR_INV_CS]
+    x = ps.x
+    z = ps.z
+    kind = ps.kind
+    cell_start = cells.start
+    ncx = cells.ncx
+    ncz = cells.ncz
+    h = prm.h
+    aw = prm.alpha_w
+    af = prm.alpha_f
     s2 = 4.0 * h * h
-    cx = min(max(int((xg - xmin) * inv_cs), 0), ncx - 1)
-    cz = min(max(int((zg - zmin) * inv_cs), 0), ncz - 1)
+    cx = min(max(int((xg - cells.xmin) * cells.inv_cs), 0), ncx - 1)
+    cz = min(max(int((zg - cells.zmin) * cells.inv_cs), 0), ncz - 1)
     cxl = max(cx - 1, 0)
     cxh = min(cx + 1, ncx - 1)
     a00 = a01 = a02 = a10 = a11 = a12 = a20 = a21 = a22 = 0.0
@@ -196,12 +272,12 @@ def ghost_pressure(f, kind, cell_start, xg, zg, prm, ncx, ncz):
             if r2 >= s2:
                 continue
             q = math.sqrt(r2) / h
-            v = f[M, j] / f[RHO, j]
+            v = ps.m[j] / ps.rho[j]
             w = v * w_of_q(q, aw)
             fv = v * f_of_q(q, af) * h  # h-scaled gradient weight: F r_j h, with r_j / h below
             sx = dx / h
             sz = dz / h
-            pj = f[P, j]
+            pj = ps.p[j]
             a00 += w
             a01 += w * sx
             a02 += w * sz
@@ -230,7 +306,7 @@ def ghost_pressure(f, kind, cell_start, xg, zg, prm, ncx, ncz):
 
 
 @njit(parallel=True, cache=True)
-def buffer_extrapolate(f, kind, cell_start, n, obp, prm, ncx, ncz):
+def buffer_extrapolate(ps, n, cells, ends, prm):
     """Pressure and density of the active buffer particles of ends with ghost extrapolation
     (seed 002 outlet; Tafuni et al. 2018): buffer particle i at depth d past the face x_f gets the
     fluid's pressure at its ghost node x_g = 2 x_f - x_i (same z, d inside the fluid), carried to
@@ -238,100 +314,65 @@ def buffer_extrapolate(f, kind, cell_start, n, obp, prm, ncx, ncz):
         p_i = max(p_g + (x_i - x_g) dp/dx, 0),   rho_i = rho0 (1 + p_i/B)^(1/gamma)
     (not below zero: buffer particles have no free surface of their own to hold a suction, as the
     hydrostatic option). A ghost node without fluid keeps the hydrostatic value of buffer_update."""
-    rho0 = prm[PR_RHO0]
-    bb = prm[PR_B]
-    gam = prm[PR_GAMMA]
+    x = ps.x
+    z = ps.z
+    p_ = ps.p
+    rho = ps.rho
+    kind = ps.kind
+    ghost = ends.ghost
+    x_face = ends.x_face
+    rho0 = prm.rho0
+    bb = prm.b
+    gam = prm.gamma
     for i in prange(n):
         k = kind[i]
         if k != INLET and k != OUTLET:
             continue
         b = 0 if k == INLET else 1
-        if obp[b, OB_GHOST] < 0.5:
+        if not ghost[b]:
             continue
-        xi = f[X, i]
-        xg = 2.0 * obp[b, OB_XF] - xi
-        pg, px, pz, order = ghost_pressure(f, kind, cell_start, xg, f[Z, i], prm, ncx, ncz)
+        xi = x[i]
+        xg = 2.0 * x_face[b] - xi
+        pg, px, pz, order = ghost_pressure(ps, cells, xg, z[i], prm)
         if order < 0:
             continue
         p = max(pg + (xi - xg) * px, 0.0)
-        f[P, i] = p
-        f[RHO, i] = density(p, rho0, bb, gam)
+        p_[i] = p
+        rho[i] = density(p, rho0, bb, gam)
 
 
 @njit(cache=True)
-def buffer_transitions(f, kind, ids, n, capacity, obp, r, zs0, du0, zs1, du1, zn, win_u,
-                       counters, next_id):
-    """Convert particles crossing a face, spawn and remove buffer particles (serial: appends).
-
-    Returns the new slot count, or -1 if the capacity is exhausted."""
-    n0 = n
-    nrows = f.shape[0]
-    for i in range(n0):
-        k = kind[i]
-        if k == FLUID:
-            for b in range(2):
-                nx = obp[b, OB_NX]
-                d = (f[X, i] - obp[b, OB_XF]) * nx
-                if obp[b, OB_ON] > 0.5 and d >= 0.0:
-                    u = profile_value(zn[b], win_u[b], r, f[Z, i]) + (du0 if b == 0 else du1)
-                    if u * nx > 0.0 or d >= obp[b, OB_DP]:
-                        zs = zs0 if b == 0 else zs1
-                        kind[i] = INLET + b if f[Z, i] < zs else INLET_IDLE + b
-                        counters[b, C_OUT] += 1
-                    break
-            continue
-        b = _end_of(k)
-        if b < 0:
-            continue
-        nx = obp[b, OB_NX]
-        length = obp[b, OB_LEN]
-        d = (f[X, i] - obp[b, OB_XF]) * nx
-        if d < 0.0:
-            if n >= capacity:
-                return -1
-            for row in range(nrows):
-                f[row, n] = f[row, i]
-            f[X, n] = f[X, i] + nx * length
-            kind[n] = k
-            ids[n] = next_id[0]
-            next_id[0] += 1
-            n += 1
-            counters[b, C_CREATED] += 1
-            if k == INLET + b:
-                kind[i] = FLUID
-                counters[b, C_IN] += 1
-            else:
-                kind[i] = INACTIVE
-                counters[b, C_REMOVED] += 1
-        elif d >= length:
-            kind[i] = INACTIVE
-            counters[b, C_REMOVED] += 1
-    return n
+def extrapolate_buffers(ps, n, cells, ends, prm):
+    """Open-end hook after the sort: ghost-node pressure of the extrapolating ends' buffers."""
+    if ends.active and (ends.ghost[0] or ends.ghost[1]):
+        buffer_extrapolate(ps, n, cells, ends, prm)
 
 
 @njit(cache=True)
-def surface_z(f, kind, cell_start, xp, z_lo, z_hi, dz, prm, ncx, ncz):
+def surface_z(ps, cells, xp, z_lo, z_hi, dz, prm):
     """Free-surface height at x = xp by the vertical-line method (seed 004, eq. 23):
     rho_f(z) = sum_j m_j W(x - x_j) over fluid and active buffer particles on points z_lo + k dz;
     the surface is the highest z where rho_f falls through rho0/2 (linear between points).
     Returns NaN when no point reaches rho0/2 (dry)."""
-    x = f[X]
-    z = f[Z]
-    h = prm[PR_H]
-    aw = prm[PR_ALPHA_W]
-    level = 0.5 * prm[PR_RHO0]
-    xmin = prm[PR_XMIN]
-    zmin = prm[PR_ZMIN]
-    inv_cs = prm[PR_INV_CS]
+    x = ps.x
+    z = ps.z
+    m = ps.m
+    kind = ps.kind
+    cell_start = cells.start
+    ncx = cells.ncx
+    ncz = cells.ncz
+    h = prm.h
+    aw = prm.alpha_w
+    level = 0.5 * prm.rho0
     s2 = 4.0 * h * h
     nz = int((z_hi - z_lo) / dz) + 1
-    cx = min(max(int((xp - xmin) * inv_cs), 0), ncx - 1)
+    cx = min(max(int((xp - cells.xmin) * cells.inv_cs), 0), ncx - 1)
     cxl = max(cx - 1, 0)
     cxh = min(cx + 1, ncx - 1)
     prev = 0.0
     for k in range(nz - 1, -1, -1):
         zk = z_lo + k * dz
-        cz = min(max(int((zk - zmin) * inv_cs), 0), ncz - 1)
+        cz = min(max(int((zk - cells.zmin) * cells.inv_cs), 0), ncz - 1)
         s = 0.0
         for zz in range(max(cz - 1, 0), min(cz + 2, ncz)):
             row = zz * ncx
@@ -342,7 +383,7 @@ def surface_z(f, kind, cell_start, xp, z_lo, z_hi, dz, prm, ncx, ncz):
                     ddz = zk - z[j]
                     r2 = ddx * ddx + ddz * ddz
                     if r2 < s2:
-                        s += f[M, j] * w_of_q(math.sqrt(r2) / h, aw)
+                        s += m[j] * w_of_q(math.sqrt(r2) / h, aw)
         if s >= level:
             if k == nz - 1:
                 return zk
@@ -352,81 +393,13 @@ def surface_z(f, kind, cell_start, xp, z_lo, z_hi, dz, prm, ncx, ncz):
 
 
 @njit(cache=True)
-def measure_boundaries(f, kind, cell_start, obp, eta_meas, prm, ncx, ncz):
-    """eta_meas[b] = surface at the boundary gauge of end b minus the still-water level."""
+def measure_boundaries(ps, cells, ends, prm):
+    """Open-end hook after the forces: eta_meas[b] = surface at the boundary gauge of end b minus
+    the still-water level."""
+    if not ends.active:
+        return
     for b in range(2):
-        if obp[b, OB_ON] > 0.5:
-            zsurf = surface_z(f, kind, cell_start, obp[b, OB_XG], obp[b, OB_ZBED], obp[b, OB_ZTOP],
-                              obp[b, OB_DZG], prm, ncx, ncz)
-            eta_meas[b] = zsurf - obp[b, OB_SWL]
-
-
-@njit(cache=True)
-def advance_open(f, f2, kind, kind2, ids, ids2, cell, cell2, order, cell_start, cursor, n,
-                 capacity, prm, ncx, ncz, t, dt, t_stop, max_steps, obp, zn, win_t, win_u, win_w,
-                 win_eta, win_etag, eta_meas, counters, next_id):
-    """Leapfrog (kick-drift-kick, as ``wcsph.advance``) with open-boundary buffers.
-
-    Per step: kick-drift of the fluid; buffers imposed and moved (data at t + dt); crossings;
-    sort (inactive slots dropped: n shrinks); ghost-node pressure of extrapolating ends; walls,
-    forces, second kick; boundary gauges.
-    Returns (t, dt_next, steps, status, swapped, n_flagged, v_max, n)."""
-    swapped = 0
-    steps = 0
-    status = ST_REACHED_T
-    n_flag = 0
-    v2max = 0.0
-    ncell = ncx * ncz
-    while True:
-        if t >= t_stop:
-            status = ST_REACHED_T
-            break
-        if steps >= max_steps:
-            status = ST_STEP_LIMIT
-            break
-        dts = dt
-        last = False
-        if t + dts >= t_stop:
-            dts = t_stop - t
-            last = True
-        n_out = kdk_kick_drift(f, kind, n, dts, prm)
-        if n_out > 0:
-            status = ST_LEFT_DOMAIN
-            n_flag = n_out
-            break
-        r = window_weight(t + dts, win_t)
-        zs0, du0 = boundary_state(0, r, obp, win_eta, win_etag, eta_meas)
-        zs1, du1 = boundary_state(1, r, obp, win_eta, win_etag, eta_meas)
-        buffer_update(f, kind, n, dts, r, zs0, du0, zs1, du1, zn, win_u, win_w, prm)
-        n_new = buffer_transitions(f, kind, ids, n, capacity, obp, r, zs0, du0, zs1, du1, zn,
-                                   win_u, counters, next_id)
-        if n_new < 0:
-            status = ST_CAPACITY
-            n_flag = n
-            break
-        n = n_new
-        _sort(f, f2, N_SORTED_KDK, kind, kind2, ids, ids2, cell, cell2, order, cell_start, cursor,
-              n, prm, ncx, ncz)
-        f, f2 = f2, f
-        kind, kind2 = kind2, kind
-        ids, ids2 = ids2, ids
-        cell, cell2 = cell2, cell
-        swapped = 1 - swapped
-        n = cell_start[ncell]  # inactive slots were sorted to the end
-        buffer_extrapolate(f, kind, cell_start, n, obp, prm, ncx, ncz)
-        wall_pass(f, kind, cell, cell_start, n, ncx, ncz, prm)
-        fluid_pass(f, kind, cell, cell_start, n, ncx, ncz, prm)
-        n_bad, n_band, v2max, a2max, rmax = kdk_kick(f, kind, n, dts, prm)
-        measure_boundaries(f, kind, cell_start, obp, eta_meas, prm, ncx, ncz)
-        t = t_stop if last else t + dts
-        steps += 1
-        if n_bad > 0:
-            status = ST_NONFINITE
-            n_flag = n_bad
-            break
-        if n_band > 0:
-            status = ST_DENSITY
-            n_flag = n_band
-            break
-        dt = stable_dt(v2max, a2max, rmax, prm)
-    return t, dt, steps, status, swapped, n_flag, math.sqrt(v2max), n
+        if ends.on[b]:
+            zsurf = surface_z(ps, cells, ends.x_gauge[b], ends.z_bed[b], ends.z_top[b],
+                              ends.dz_gauge, prm)
+            ends.eta_meas[b] = zsurf - ends.swl[b]

@@ -1,9 +1,10 @@
 """Particles as structure-of-arrays with spare capacity.
 
 All real-valued fields live in one float64 array ``f[field, slot]`` (each field row contiguous);
-``kind`` (int8) and ``ids`` (int64) are separate. Slots ``[0, n)`` are in use; ``n <= capacity``
-leaves room for open boundaries to create particles. Every array has a twin buffer: reordering
-by cell gathers into the twin and the two are swapped, so nothing is allocated per step.
+``kind`` (int8), ``ids`` (int64) and ``cell`` (int64) are separate. Slots ``[0, n)`` are in use;
+``n <= capacity`` leaves room for open boundaries to create particles. Every array has a twin
+buffer: reordering by cell gathers into the twin and the two are swapped, so nothing is
+allocated per step. ``view`` / ``view2`` are the kernels' typed views (``state.Particles``).
 
 Row layout (2D). The first ``N_SORTED_*`` rows are carried through a reorder; the others are
 recomputed after it. A 3D build adds Y, VY, AY, VWY rows; kernels name rows, never positions.
@@ -12,14 +13,15 @@ recomputed after it. A 3D build adds Y, VY, AY, VWY rows; kernels name rows, nev
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
 # particle kinds
 FLUID = 0
 WALL = 1
-INLET = 2      # reserved: open-boundary buffers (issue 3)
-OUTLET = 3     # reserved
+INLET = 2      # active open-boundary buffer particle of the left end (open_boundary.py)
+OUTLET = 3     # ... of the right end
 INACTIVE = -1  # a free slot inside [0, n): skipped by every pass, sorted to the end
 
 # float rows, carried through reordering
@@ -50,6 +52,7 @@ class Checkpoint:
     steps: int
     cell: np.ndarray | None = None        # cell lists of the copy (set by the Simulation), so a
     cell_start: np.ndarray | None = None  # restore needs no re-sort and continues bit for bit
+    open_state: Any = None                # open_ends.OpenState of a run with open ends
 
 
 class ParticleSet:
@@ -65,8 +68,17 @@ class ParticleSet:
         self.kind2 = self.kind.copy()
         self.ids = np.full(self.capacity, -1, dtype=np.int64)
         self.ids2 = self.ids.copy()
+        self.cell = np.zeros(self.capacity, dtype=np.int64)
+        self.cell2 = np.zeros(self.capacity, dtype=np.int64)
         self.n = 0
         self.next_id = 0
+        self._views()
+
+    def _views(self) -> None:
+        from .state import particles_view
+
+        self.view = particles_view(self.f, self.kind, self.ids, self.cell)
+        self.view2 = particles_view(self.f2, self.kind2, self.ids2, self.cell2)
 
     def add(self, x: np.ndarray, z: np.ndarray, kind: int, rho: np.ndarray, mass: np.ndarray) -> np.ndarray:
         """Append particles at rest; return their ids."""
@@ -92,6 +104,8 @@ class ParticleSet:
         self.f, self.f2 = self.f2, self.f
         self.kind, self.kind2 = self.kind2, self.kind
         self.ids, self.ids2 = self.ids2, self.ids
+        self.cell, self.cell2 = self.cell2, self.cell
+        self.view, self.view2 = self.view2, self.view
 
     def field(self, row: int) -> np.ndarray:
         """View of one field over the slots in use."""

@@ -1,12 +1,17 @@
-"""A Simulation owns the particles, the clock, the probes and the run directory.
+"""A Simulation owns the particles, the clock, the open ends, the probes and the run directory.
 
     sim = Simulation(scene, run_dir=None)   # run_dir: CSV probes, VTK snapshots, meta.json
+    sim = Simulation(scene, sources={"left": src}, window=0.02)   # a scene with open ends
     sim.advance_to(t_end, progress=None)    # raises UnstableError(step, t, cause)
+    sim.advance_window(t1, left=sample, right=sample)   # open ends driven from outside
     sim.checkpoint() -> Checkpoint; sim.restore(c)   # exact state copy (protocol `goback`)
     sim.probe_values() -> dict[str, float | None]    # configured probes at the current state
+    sim.boundary_gauges(); sim.boundary_counts()     # open ends (empty for a closed tank)
 
-The time loop itself is one jitted call (``wcsph.advance``) that runs until the next output
-time; Python only handles probes, snapshots, metadata and the progress callback.
+Every scene runs the same loop: the open inlet/outlet ends are a value (``self.open``, an
+``open_ends.OpenBoundaries``: named constructors ``from_scene`` / ``closed``), and the time loop
+is one jitted call (``step.run``) up to the next output time (and, with open ends, the next window
+end); Python only handles boundary data, probes, snapshots, metadata and the progress callback.
 """
 
 from __future__ import annotations
@@ -14,22 +19,24 @@ from __future__ import annotations
 import math
 import time
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any, Callable, Mapping
 
 import numba
 import numpy as np
 
-from . import wcsph
+from . import step, wcsph
+from .boundary_data import BoundaryData, BoundaryDataError, BoundarySample
 from .eos import hydrostatic_density, tait_b
 from .geometry import build_layout
 from .kernels import wendland_alpha
-from .neighbours import CellGrid
+from .neighbours import CellGrid, compute_cells, counting_sort
+from .open_ends import OpenBoundaries
 from .output import RunWriter
-from .particles import (DRHO, FLUID, INACTIVE, M, N_FIELDS, P, RHO, VX, VZ, WALL, X, Z, Checkpoint,
-                        ParticleSet)
+from .particles import FLUID, INACTIVE, M, P, RHO, VX, VZ, WALL, X, Z, Checkpoint, ParticleSet
 from .probes import (fluid_neighbour_counts, interpolate_points, line_mass_density,
                      surface_from_line)
 from .scene import ElevationProbe, FrontProbe, PointProbe, Scene
+from .state import Params
 
 STEPS_PER_CALL = 200  # steps per jitted call between progress callbacks
 
@@ -45,9 +52,14 @@ class UnstableError(RuntimeError):
 
 
 class Simulation:
-    """WCSPH run of one scene; see the module docstring for the contract."""
+    """WCSPH run of one scene; see the module docstring for the contract.
 
-    def __init__(self, scene: Scene, run_dir: str | Path | None = None, spare: float = 0.1) -> None:
+    ``sources`` (side -> BoundaryData) and ``window`` [s] apply to scenes with open ends;
+    ``spare`` is the spare particle capacity (default 0.1, 0.3 with open ends: inflow)."""
+
+    def __init__(self, scene: Scene, run_dir: str | Path | None = None,
+                 spare: float | None = None, sources: Mapping[str, BoundaryData] | None = None,
+                 window: float = 0.02) -> None:
         self.scene = scene
         c = scene.constants
         layout = build_layout(scene)
@@ -55,6 +67,9 @@ class Simulation:
         self.h = h
         self.c0 = scene.c0
         self.b = tait_b(c.rho0, self.c0)
+        self.open = OpenBoundaries.from_scene(scene, sources, window)
+        if spare is None:
+            spare = 0.3 if self.open.active else 0.1
         n = layout.wall_x.size + layout.fluid_x.size
         self.particles = ps = ParticleSet(max(int(n * (1.0 + spare)), n + 1))
         vol = dp * dp
@@ -65,50 +80,35 @@ class Simulation:
         # pressure is hydrostatic and the particle volume is exactly dp^2
         ps.add(layout.fluid_x, layout.fluid_z, FLUID, rho_f, rho_f * vol)
         self.n_layers = layout.n_layers
+        self.open.attach(ps, scene, self.b, layout.n_layers * dp)
         t = scene.tank
         wall = layout.n_layers * dp
         self.grid = CellGrid.covering(t.x0 - wall, t.x1 + wall, t.z0 - wall, t.z1, 2.0 * h)
+        self.cells = self.grid.lists(ps.capacity)
         aw = wendland_alpha(h)
-        prm = np.zeros(wcsph.N_PRM)
-        prm[wcsph.PR_H] = h
-        prm[wcsph.PR_ALPHA_W] = aw
-        prm[wcsph.PR_ALPHA_F] = 5.0 * aw / (h * h)
-        prm[wcsph.PR_RHO0] = c.rho0
-        prm[wcsph.PR_C0] = self.c0
-        prm[wcsph.PR_B] = self.b
-        prm[wcsph.PR_GAMMA] = 7.0
-        prm[wcsph.PR_GX] = 0.0
-        prm[wcsph.PR_GZ] = -c.g
-        prm[wcsph.PR_ALPHA] = c.alpha
-        prm[wcsph.PR_NU] = c.nu
-        prm[wcsph.PR_DELTA] = c.delta
-        prm[wcsph.PR_CFL] = c.cfl
-        prm[wcsph.PR_RHO_LO], prm[wcsph.PR_RHO_HI] = c.density_band
-        prm[wcsph.PR_NOSLIP] = 1.0 if c.wall_slip == "no_slip" else 0.0
         # a fluid particle whose centre passes the first dummy layer (dp/2 behind the wall face)
         # has gone through the wall; the top z1 is open
-        prm[wcsph.PR_FX0], prm[wcsph.PR_FX1] = t.x0 - 0.5 * dp, t.x1 + 0.5 * dp
-        prm[wcsph.PR_FZ0], prm[wcsph.PR_FZ1] = t.z0 - 0.5 * dp, t.z1
-        prm[wcsph.PR_XMIN], prm[wcsph.PR_ZMIN] = self.grid.xmin, self.grid.zmin
-        prm[wcsph.PR_INV_CS] = 1.0 / self.grid.cs
-        self.prm = prm
+        fx0, fx1 = self.open.fluid_box(t.x0 - 0.5 * dp, t.x1 + 0.5 * dp, dp)
+        lo, hi = c.density_band
+        self.prm = Params(h=h, alpha_w=aw, alpha_f=5.0 * aw / (h * h), rho0=c.rho0, c0=self.c0,
+                          b=self.b, gamma=7.0, gx=0.0, gz=-c.g, alpha=c.alpha, nu=c.nu,
+                          delta=c.delta, cfl=c.cfl, rho_lo=lo, rho_hi=hi,
+                          noslip=c.wall_slip == "no_slip", fx0=fx0, fx1=fx1,
+                          fz0=t.z0 - 0.5 * dp, fz1=t.z1)
         self.integrator = wcsph.INTEGRATORS[c.integrator]
         self.passes_per_step = wcsph.PASSES_PER_STEP[c.integrator]
-        cap = ps.capacity
-        self.cell = np.zeros(cap, dtype=np.int64)
-        self.cell2 = np.zeros(cap, dtype=np.int64)
-        self.order = np.zeros(cap, dtype=np.int64)
-        self.cell_start = np.zeros(self.grid.ncell + 2, dtype=np.int64)
-        self.cursor = np.zeros(self.grid.ncell + 1, dtype=np.int64)
-        self._counts = np.zeros(cap, dtype=np.int64)
-        self.dt = float(wcsph.initialise(*self._arrays(), ps.n, prm, self.grid.ncx, self.grid.ncz))
-        self._swap()
+        self._counts = np.zeros(ps.capacity, dtype=np.int64)
+        dt, n_new = step.initialise(ps.view, ps.view2, self.cells, self.prm, self.open.ends, ps.n)
+        self.dt = float(dt)
+        ps.swap()
+        ps.n = int(n_new)
         self.t = scene.t_start
+        self.open.start(self.t)
         self.steps = 0
         self.wall_time = 0.0
         self.v_max = 0.0
         self.fluid_mass0 = self.fluid_mass()
-        self.fluid_count0 = self.n_fluid
+        self.n_fluid0 = self.n_fluid
         self.excluded: list[dict[str, float]] = []  # particles removed for density (_exclude)
         # probes
         self._points = [p for p in scene.probes if isinstance(p, PointProbe)]
@@ -131,14 +131,19 @@ class Simulation:
         self._record_outputs()
 
     # ---------------------------------------------------------------- state access
-    def _arrays(self) -> tuple:
-        ps = self.particles
-        return (ps.f, ps.f2, ps.kind, ps.kind2, ps.ids, ps.ids2, self.cell, self.cell2, self.order,
-                self.cell_start, self.cursor)
+    @property
+    def nodes(self) -> dict:
+        """BoundaryNodes of each open end (where a source gives u, w)."""
+        return self.open.nodes
 
-    def _swap(self) -> None:
-        self.particles.swap()
-        self.cell, self.cell2 = self.cell2, self.cell
+    @property
+    def open_sides(self) -> tuple[str, ...]:
+        return self.open.sides
+
+    @property
+    def window(self) -> float:
+        """Coupling window [s] of the open ends (advance_to samples the sources at its ends)."""
+        return self.open.window
 
     @property
     def n_particles(self) -> int:
@@ -180,10 +185,11 @@ class Simulation:
         """Configured probes at the current state [SI]; None marks a dry probe."""
         g = self.grid
         f, kind = self.particles.f, self.particles.kind
-        aw = self.prm[wcsph.PR_ALPHA_W]
+        aw = self.prm.alpha_w
+        cell_start = self.cells.start
         out: dict[str, float | None] = {}
         if self._points:
-            interpolate_points(f, kind, self.cell_start, self._px, self._pz, self.h, aw, g.xmin,
+            interpolate_points(f, kind, cell_start, self._px, self._pz, self.h, aw, g.xmin,
                                g.zmin, 1.0 / g.cs, g.ncx, g.ncz, self._pout)
             for k, p in enumerate(self._points):
                 wet = self._pout[k, 3] > 0.05
@@ -191,7 +197,7 @@ class Simulation:
                     out[f"{p.name}_{suffix}"] = float(self._pout[k, j]) if wet else None
         rho0 = self.scene.constants.rho0
         for p in self._elev:
-            line_mass_density(f, kind, self.cell_start, float(p.x), self._line_z, self.h, aw,
+            line_mass_density(f, kind, cell_start, float(p.x), self._line_z, self.h, aw,
                               g.xmin, g.zmin, 1.0 / g.cs, g.ncx, g.ncz, self._line_rho)
             zs = surface_from_line(self._line_z, self._line_rho, p.threshold * rho0)
             out[f"{p.name}_z_surface"] = zs
@@ -200,7 +206,7 @@ class Simulation:
                 out[f"{p.name}_eta"] = None if zs is None else zs - swl
         if self._fronts:
             ps = self.particles
-            fluid_neighbour_counts(f, kind, self.cell, self.cell_start, ps.n, self.h, g.ncx,
+            fluid_neighbour_counts(f, kind, ps.cell, cell_start, ps.n, self.h, g.ncx,
                                    g.ncz, self._counts)
             counts = self._counts[: ps.n]
             x = ps.field(X)
@@ -218,7 +224,8 @@ class Simulation:
                 "c0": self.c0, "h": self.h, "integrator": self.scene.constants.integrator,
                 "passes_per_step": self.passes_per_step, "threads": numba.get_num_threads(),
                 "particle_steps_per_s": (self.n_particles * self.steps / self.wall_time
-                                         if self.wall_time > 0 else None)}
+                                         if self.wall_time > 0 else None),
+                **({"open_boundaries": self.boundary_counts()} if self.open.active else {})}
 
     def _record_outputs(self) -> None:
         """Probes and snapshots whose time has come (t = k * cadence)."""
@@ -257,7 +264,9 @@ class Simulation:
 
     # ---------------------------------------------------------------- time loop
     def advance_to(self, t_end: float, progress: Callable[["Simulation"], None] | None = None) -> None:
-        """Advance to time ``t_end`` [s], recording outputs on their cadence.
+        """Advance to time ``t_end`` [s], recording outputs on their cadence; with open ends in
+        windows of ``self.window``, sampling every source at each window end (sides without a
+        source keep the data of the last window).
 
         Raises UnstableError (status ``unstable`` in meta.json) if the guard trips; the outputs
         written so far stay on disk."""
@@ -265,16 +274,45 @@ class Simulation:
             raise ValueError(f"t_end: must be finite, got {t_end}")
         if self.status == "unstable":
             raise RuntimeError("advance_to: the run is unstable; restore a checkpoint first")
-        self._advance_recording(t_end, progress)
+        if not self.open.active:
+            self._advance_recording(t_end, progress)
+            return
+        eps = 1e-9 * self.window
+        while self.t < t_end - eps:
+            t1 = min(self.t + self.window, t_end)
+            if t_end - t1 < eps:
+                t1 = t_end
+            self.advance_window(t1, progress=progress)
+
+    def advance_window(self, t1: float, left: BoundarySample | None = None,
+                       right: BoundarySample | None = None,
+                       progress: Callable[["Simulation"], None] | None = None) -> None:
+        """Advance one coupling window to ``t1`` with the data at t1 of each open end (given, or
+        sampled from that side's source); raises BoundaryDataError (state untouched) or
+        UnstableError."""
+        if not (math.isfinite(t1) and t1 > self.t):
+            raise ValueError(f"t1: must be finite and after t = {self.t}, got {t1}")
+        if self.status == "unstable":
+            raise RuntimeError("advance_window: the run is unstable; restore a checkpoint first")
+        try:
+            end = self.open.end_samples(t1, {"left": left, "right": right})
+        except BoundaryDataError as exc:
+            self.status = "failed"
+            if self.writer:
+                self.writer.update_meta(**self._meta_fields(), cause=f"boundary data: {exc}")
+            raise
+        self.open.load_window(self.t, t1, end)
+        self._advance_recording(t1, progress)
+        self.open.samples = end
 
     def _advance_recording(self, t_end: float,
                            progress: Callable[["Simulation"], None] | None) -> None:
-        """The run loop shared by every solver: step to each output time, record, report, and keep
-        meta.json honest on any way out (UnstableError, Ctrl-C, a bug)."""
+        """Step to each output time, record, report, and keep meta.json honest on any way out
+        (UnstableError, Ctrl-C, a bug)."""
         self.status = "running"
         try:
             while self.t < t_end:
-                self._run_until(self._next_output_time(t_end))
+                self._run(self._next_output_time(t_end), STEPS_PER_CALL)
                 self._record_outputs()
                 if progress is not None:
                     progress(self)
@@ -289,32 +327,53 @@ class Simulation:
         if self.writer:
             self.writer.update_meta(**self._meta_fields())
 
-    def _run_until(self, t_stop: float) -> None:
-        """One call of the jitted closed-tank loop up to ``t_stop`` (or STEPS_PER_CALL steps)."""
-        self._advance_closed(t_stop, STEPS_PER_CALL)
-
     def advance_steps(self, n_steps: int) -> None:
         """Take exactly ``n_steps`` steps without recording outputs (benchmarks, tests)."""
-        self._advance_closed(math.inf, int(n_steps))
+        self._run(math.inf, int(n_steps))
 
-    def _advance_closed(self, t_stop: float, max_steps: int) -> None:
+    def _run(self, t_stop: float, max_steps: int) -> None:
+        """One call of the jitted loop up to ``t_stop`` or ``max_steps`` steps."""
         ps = self.particles
+        ends = self.open.ends
+        ends.next_id[0] = ps.next_id
         tic = time.perf_counter()
-        t, dt, steps, status, swapped, n_flag, vmax = wcsph.advance(
-            *self._arrays(), ps.n, self.prm, self.grid.ncx, self.grid.ncz, self.integrator,
-            self.t, self.dt, t_stop, max_steps)
+        t, dt, steps, status, swapped, n_flag, vmax, n = step.run(
+            ps.view, ps.view2, self.cells, self.prm, ends, self.integrator, ps.n, self.t, self.dt,
+            t_stop, max_steps)
         self.wall_time += time.perf_counter() - tic
         if swapped:
-            self._swap()
+            ps.swap()
+        ps.n = int(n)
+        if self.open.active:
+            ps.next_id = int(ends.next_id[0])
         self.t, self.dt, self.steps, self.v_max = float(t), float(dt), self.steps + steps, vmax
+        if status == wcsph.ST_CAPACITY:
+            self.status = "unstable"
+            cause = (f"{wcsph.STATUS_TEXT[status]}: {ps.capacity} slots; more fluid entered than "
+                     "left (build the run with a larger spare)")
+            if self.writer:
+                self.writer.update_meta(**self._meta_fields(), cause=cause,
+                                        unstable_step=self.steps, unstable_t=self.t)
+            raise UnstableError(self.steps, self.t, cause)
         if status not in (wcsph.ST_REACHED_T, wcsph.ST_STEP_LIMIT):
             self._stopped(status, n_flag)
+
+    # ---------------------------------------------------------------- open ends
+    def boundary_gauges(self) -> dict[str, float | None]:
+        """Elevation [m above still water] at each open end's gauge, from the last step; None if
+        dry or not measured yet."""
+        return self.open.gauges()
+
+    def boundary_counts(self) -> dict[str, dict[str, int]]:
+        """Per open end: particles that became fluid (``in``), fluid that left (``out``), buffer
+        particles created and removed, since the start."""
+        return self.open.counts()
 
     def _exclude(self, bad: np.ndarray, ids: np.ndarray, x: np.ndarray, z: np.ndarray,
                  rho: np.ndarray) -> bool:
         """Remove the fluid particles ``bad`` (indices into the fluid selection) from the run
         and log them, if the scene's exclude_limit allows; False if it does not."""
-        limit = self.scene.constants.exclude_limit * self.fluid_count0
+        limit = self.scene.constants.exclude_limit * self.n_fluid0
         if bad.size == 0 or len(self.excluded) + bad.size > limit:
             return False
         slots = np.nonzero(self.particles.mask(FLUID))[0][bad]
@@ -359,22 +418,26 @@ class Simulation:
 
     # ---------------------------------------------------------------- checkpoints
     def checkpoint(self) -> Checkpoint:
-        """An exact copy of the state (particles, clock, dt)."""
+        """An exact copy of the state (particles, clock, dt, open-end state)."""
         c = self.particles.snapshot(self.t, self.dt, self.steps)
-        c.cell = self.cell[: c.n].copy()
-        c.cell_start = self.cell_start.copy()
+        c.cell = self.particles.cell[: c.n].copy()
+        c.cell_start = self.cells.start.copy()
+        c.open_state = self.open.state()
         return c
 
     def restore(self, c: Checkpoint) -> None:
         """Return exactly to a checkpoint; the cell lists are rebuilt for its particle order."""
-        self.particles.restore(c)
+        ps = self.particles
+        ps.restore(c)
         self.t, self.dt, self.steps = c.t, c.dt, c.steps
         self.excluded = [e for e in self.excluded if e["step"] <= c.steps]
-        if c.cell is not None and c.cell_start is not None and c.cell_start.size == self.cell_start.size:
-            self.cell[: c.n] = c.cell
-            self.cell_start[:] = c.cell_start
+        if (c.cell is not None and c.cell_start is not None
+                and c.cell_start.size == self.cells.start.size):
+            ps.cell[: c.n] = c.cell
+            self.cells.start[:] = c.cell_start
         else:
             self._rebuild_cells()
+        self.open.set_state(c.open_state)
         self.status = "paused"
         o = self.scene.output
         self._k_probe = int(math.floor(self.t / o.probe_every + 1e-9)) + 1 if o.probe_every else 0
@@ -383,13 +446,10 @@ class Simulation:
 
     def _rebuild_cells(self) -> None:
         """Cell lists for the current order without moving particles (for probes after restore)."""
-        from .neighbours import compute_cells, counting_sort
-
-        ps, g = self.particles, self.grid
-        compute_cells(ps.f[X], ps.f[Z], ps.kind, ps.n, g.xmin, g.zmin, 1.0 / g.cs, g.ncx, g.ncz,
-                      self.cell)
-        counting_sort(self.cell, ps.n, g.ncell, self.cell_start, self.cursor, self.order)
-        if not np.array_equal(self.order[: ps.n], np.arange(ps.n)):
+        ps = self.particles
+        compute_cells(ps.view, ps.n, self.cells)
+        counting_sort(ps.cell, ps.n, self.cells)
+        if not np.array_equal(self.cells.order[: ps.n], np.arange(ps.n)):
             # the checkpoint was not taken in cell order (cannot happen for our own checkpoints)
             raise RuntimeError("restore: checkpoint particles are not sorted by cell")
 

@@ -1,4 +1,6 @@
-"""Weakly-compressible SPH: one fused interaction pass per force evaluation, jitted time loop.
+"""Weakly-compressible SPH: the physical terms of a step, each a jitted pass over the particles.
+
+The step that calls them is ``step.run`` (one skeleton for every integrator and scene).
 
 Equations (i fluid, j neighbour, r_ij = r_i - r_j, grad_i W_ij = -F_ij r_ij, V_j = m_j / rho_j):
 
@@ -34,30 +36,26 @@ from numba import njit, prange
 
 from .eos import density, pressure
 from .kernels import f_of_q, w_of_q
-from .neighbours import sort_by_cell
-from .particles import (AX, AZ, DRHO, FLUID, INLET, M, N_SORTED_KDK, N_SORTED_PC, OUTLET, P, RHO,
-                        RHON, VWX, VWZ, VX, VXN, VZ, VZN, WALL, XN, ZN, X, Z)
+from .particles import FLUID, INLET, OUTLET, WALL
 
-# indices into the float parameter vector ``prm``
-(PR_H, PR_ALPHA_W, PR_ALPHA_F, PR_RHO0, PR_C0, PR_B, PR_GAMMA, PR_GX, PR_GZ, PR_ALPHA, PR_NU,
- PR_DELTA, PR_CFL, PR_RHO_LO, PR_RHO_HI, PR_NOSLIP, PR_FX0, PR_FX1, PR_FZ0, PR_FZ1, PR_XMIN,
- PR_ZMIN, PR_INV_CS) = range(23)
-N_PRM = 23
-
-# status codes returned by the time loop
+# status codes returned by the time loop (step.run)
 ST_REACHED_T = 0
 ST_STEP_LIMIT = 1
 ST_NONFINITE = 2
 ST_DENSITY = 3
 ST_LEFT_DOMAIN = 4
+ST_CAPACITY = 5
 STATUS_TEXT = {
     ST_NONFINITE: "non-finite velocity or density (NaN/inf)",
     # the loop stops; Simulation excludes the particles if within Constants.exclude_limit
     ST_DENSITY: "density outside the sane band",
     ST_LEFT_DOMAIN: "fluid particle left the tank (through a wall or over its top)",
+    ST_CAPACITY: "particle capacity exhausted by open-boundary inflow",
 }
 
 INTEGRATORS = {"kdk": 0, "symplectic_pc": 1}
+KDK = 0
+SYMPLECTIC_PC = 1
 
 # fast-math for the interaction passes, without the no-NaN/no-inf assumptions: the stability
 # guard must still see a NaN produced there
@@ -66,27 +64,32 @@ PASSES_PER_STEP = {"kdk": 1, "symplectic_pc": 2}
 
 
 @njit(parallel=True, cache=True, fastmath=FASTMATH)
-def wall_pass(f, kind, cell, cell_start, n, ncx, ncz, prm):
+def wall_pass(ps, n, cells, prm):
     """Adami et al. (2012) pressure, density and no-slip velocity of every wall particle."""
-    x = f[X]
-    z = f[Z]
-    vx = f[VX]
-    vz = f[VZ]
-    ax = f[AX]
-    az = f[AZ]
-    rho = f[RHO]
-    p = f[P]
-    vwx = f[VWX]
-    vwz = f[VWZ]
-    h = prm[PR_H]
+    x = ps.x
+    z = ps.z
+    vx = ps.vx
+    vz = ps.vz
+    ax = ps.ax
+    az = ps.az
+    rho = ps.rho
+    p = ps.p
+    vwx = ps.vwx
+    vwz = ps.vwz
+    kind = ps.kind
+    cell = ps.cell
+    cell_start = cells.start
+    ncx = cells.ncx
+    ncz = cells.ncz
+    h = prm.h
     inv_h = 1.0 / h
     s2 = 4.0 * h * h
-    aw = prm[PR_ALPHA_W]
-    gx = prm[PR_GX]
-    gz = prm[PR_GZ]
-    rho0 = prm[PR_RHO0]
-    b = prm[PR_B]
-    gam = prm[PR_GAMMA]
+    aw = prm.alpha_w
+    gx = prm.gx
+    gz = prm.gz
+    rho0 = prm.rho0
+    b = prm.b
+    gam = prm.gamma
     for i in prange(n):
         if kind[i] == WALL:
             xi = x[i]
@@ -132,39 +135,44 @@ def wall_pass(f, kind, cell, cell_start, n, ncx, ncz, prm):
 
 
 @njit(parallel=True, cache=True, fastmath=FASTMATH)
-def fluid_pass(f, kind, cell, cell_start, n, ncx, ncz, prm):
+def fluid_pass(ps, n, cells, prm):
     """The fused gather over fluid particles: continuity, delta-SPH, pressure, viscosity, gravity.
 
-    Writes AX, AZ, DRHO of each fluid particle; returns nothing (reductions are in the kicks)."""
-    x = f[X]
-    z = f[Z]
-    vx = f[VX]
-    vz = f[VZ]
-    ax = f[AX]
-    az = f[AZ]
-    rho = f[RHO]
-    p = f[P]
-    m = f[M]
-    drho = f[DRHO]
-    vwx = f[VWX]
-    vwz = f[VWZ]
-    h = prm[PR_H]
+    Writes ax, az, drho of each fluid particle; returns nothing (reductions are in the kicks)."""
+    x = ps.x
+    z = ps.z
+    vx = ps.vx
+    vz = ps.vz
+    ax = ps.ax
+    az = ps.az
+    rho = ps.rho
+    p = ps.p
+    m = ps.m
+    drho = ps.drho
+    vwx = ps.vwx
+    vwz = ps.vwz
+    kind = ps.kind
+    cell = ps.cell
+    cell_start = cells.start
+    ncx = cells.ncx
+    ncz = cells.ncz
+    h = prm.h
     inv_h = 1.0 / h
     s2 = 4.0 * h * h
     eta2 = 0.01 * h * h
-    af = prm[PR_ALPHA_F]
-    rho0 = prm[PR_RHO0]
-    c0 = prm[PR_C0]
-    gam = prm[PR_GAMMA]
-    gx = prm[PR_GX]
-    gz = prm[PR_GZ]
+    af = prm.alpha_f
+    rho0 = prm.rho0
+    c0 = prm.c0
+    gam = prm.gamma
+    gx = prm.gx
+    gz = prm.gz
     g = math.sqrt(gx * gx + gz * gz)
     gdir_z = gz / g if g > 0 else 0.0
     gdir_x = gx / g if g > 0 else 0.0
-    av = prm[PR_ALPHA] * c0 * h
-    nu4 = 4.0 * prm[PR_NU]
-    ddiff = 2.0 * prm[PR_DELTA] * h * c0
-    noslip = prm[PR_NOSLIP] > 0.5
+    av = prm.alpha * c0 * h
+    nu4 = 4.0 * prm.nu
+    ddiff = 2.0 * prm.delta * h * c0
+    noslip = prm.noslip
     for i in prange(n):
         if kind[i] == FLUID:
             xi = x[i]
@@ -230,24 +238,25 @@ def fluid_pass(f, kind, cell, cell_start, n, ncx, ncz, prm):
 
 
 @njit(parallel=True, cache=True)
-def kdk_kick_drift(f, kind, n, dt, prm):
+def kdk_kick_drift(ps, n, dt, prm):
     """First half-kick and drift of the leapfrog; returns the number of fluid particles outside the tank."""
-    x = f[X]
-    z = f[Z]
-    vx = f[VX]
-    vz = f[VZ]
-    ax = f[AX]
-    az = f[AZ]
-    rho = f[RHO]
-    p = f[P]
-    drho = f[DRHO]
-    rho0 = prm[PR_RHO0]
-    b = prm[PR_B]
-    gam = prm[PR_GAMMA]
-    fx0 = prm[PR_FX0]
-    fx1 = prm[PR_FX1]
-    fz0 = prm[PR_FZ0]
-    fz1 = prm[PR_FZ1]
+    x = ps.x
+    z = ps.z
+    vx = ps.vx
+    vz = ps.vz
+    ax = ps.ax
+    az = ps.az
+    rho = ps.rho
+    p = ps.p
+    drho = ps.drho
+    kind = ps.kind
+    rho0 = prm.rho0
+    b = prm.b
+    gam = prm.gamma
+    fx0 = prm.fx0
+    fx1 = prm.fx1
+    fz0 = prm.fz0
+    fz1 = prm.fz1
     hdt = 0.5 * dt
     n_out = 0
     for i in prange(n):
@@ -267,17 +276,18 @@ def kdk_kick_drift(f, kind, n, dt, prm):
 
 
 @njit(parallel=True, cache=True)
-def kdk_kick(f, kind, n, dt, prm):
+def kdk_kick(ps, n, dt, prm):
     """Second half-kick; returns (#non-finite, #outside density band, max |v|^2, max |a|^2, max rho)."""
-    vx = f[VX]
-    vz = f[VZ]
-    ax = f[AX]
-    az = f[AZ]
-    rho = f[RHO]
-    drho = f[DRHO]
-    rho0 = prm[PR_RHO0]
-    lo = prm[PR_RHO_LO] * rho0
-    hi = prm[PR_RHO_HI] * rho0
+    vx = ps.vx
+    vz = ps.vz
+    ax = ps.ax
+    az = ps.az
+    rho = ps.rho
+    drho = ps.drho
+    kind = ps.kind
+    rho0 = prm.rho0
+    lo = prm.rho_lo * rho0
+    hi = prm.rho_hi * rho0
     hdt = 0.5 * dt
     n_bad = 0
     n_band = 0
@@ -305,55 +315,71 @@ def kdk_kick(f, kind, n, dt, prm):
 
 
 @njit(parallel=True, cache=True)
-def pc_predict(f, kind, n, dt, prm):
+def pc_predict(ps, n, dt, prm):
     """Symplectic predictor: save state n, half-step x, v, rho with a^n; p from rho^{n+1/2}."""
-    x = f[X]
-    z = f[Z]
-    vx = f[VX]
-    vz = f[VZ]
-    rho = f[RHO]
-    p = f[P]
+    x = ps.x
+    z = ps.z
+    vx = ps.vx
+    vz = ps.vz
+    ax = ps.ax
+    az = ps.az
+    rho = ps.rho
+    p = ps.p
+    drho = ps.drho
+    xn = ps.xn
+    zn = ps.zn
+    vxn = ps.vxn
+    vzn = ps.vzn
+    rhon = ps.rhon
+    kind = ps.kind
     hdt = 0.5 * dt
-    rho0 = prm[PR_RHO0]
-    b = prm[PR_B]
-    gam = prm[PR_GAMMA]
+    rho0 = prm.rho0
+    b = prm.b
+    gam = prm.gamma
     for i in prange(n):
         if kind[i] == FLUID:
-            f[XN, i] = x[i]
-            f[ZN, i] = z[i]
-            f[VXN, i] = vx[i]
-            f[VZN, i] = vz[i]
-            f[RHON, i] = rho[i]
+            xn[i] = x[i]
+            zn[i] = z[i]
+            vxn[i] = vx[i]
+            vzn[i] = vz[i]
+            rhon[i] = rho[i]
             x[i] += hdt * vx[i]
             z[i] += hdt * vz[i]
-            vx[i] += hdt * f[AX, i]
-            vz[i] += hdt * f[AZ, i]
-            r = rho[i] + hdt * f[DRHO, i]
+            vx[i] += hdt * ax[i]
+            vz[i] += hdt * az[i]
+            r = rho[i] + hdt * drho[i]
             rho[i] = r
             p[i] = pressure(r, rho0, b, gam)
 
 
 @njit(parallel=True, cache=True)
-def pc_correct(f, kind, n, dt, prm):
+def pc_correct(ps, n, dt, prm):
     """Symplectic corrector from the half-step rates; returns the same tuple as ``kdk_kick``
     plus the count of fluid particles outside the tank."""
-    x = f[X]
-    z = f[Z]
-    vx = f[VX]
-    vz = f[VZ]
-    ax = f[AX]
-    az = f[AZ]
-    rho = f[RHO]
-    p = f[P]
-    rho0 = prm[PR_RHO0]
-    b = prm[PR_B]
-    gam = prm[PR_GAMMA]
-    lo = prm[PR_RHO_LO] * rho0
-    hi = prm[PR_RHO_HI] * rho0
-    fx0 = prm[PR_FX0]
-    fx1 = prm[PR_FX1]
-    fz0 = prm[PR_FZ0]
-    fz1 = prm[PR_FZ1]
+    x = ps.x
+    z = ps.z
+    vx = ps.vx
+    vz = ps.vz
+    ax = ps.ax
+    az = ps.az
+    rho = ps.rho
+    p = ps.p
+    drho = ps.drho
+    xn = ps.xn
+    zn = ps.zn
+    vxn = ps.vxn
+    vzn = ps.vzn
+    rhon = ps.rhon
+    kind = ps.kind
+    rho0 = prm.rho0
+    b = prm.b
+    gam = prm.gamma
+    lo = prm.rho_lo * rho0
+    hi = prm.rho_hi * rho0
+    fx0 = prm.fx0
+    fx1 = prm.fx1
+    fz0 = prm.fz0
+    fz1 = prm.fz1
     n_bad = 0
     n_band = 0
     n_out = 0
@@ -362,14 +388,14 @@ def pc_correct(f, kind, n, dt, prm):
     rmax = 0.0
     for i in prange(n):
         if kind[i] == FLUID:
-            eps = -f[DRHO, i] / rho[i] * dt
-            r = f[RHON, i] * (2.0 - eps) / (2.0 + eps)
-            u0 = f[VXN, i]
-            w0 = f[VZN, i]
+            eps = -drho[i] / rho[i] * dt
+            r = rhon[i] * (2.0 - eps) / (2.0 + eps)
+            u0 = vxn[i]
+            w0 = vzn[i]
             u = u0 + dt * ax[i]
             w = w0 + dt * az[i]
-            xi = f[XN, i] + 0.5 * dt * (u + u0)
-            zi = f[ZN, i] + 0.5 * dt * (w + w0)
+            xi = xn[i] + 0.5 * dt * (u + u0)
+            zi = zn[i] + 0.5 * dt * (w + w0)
             vx[i] = u
             vz[i] = w
             rho[i] = r
@@ -391,120 +417,28 @@ def pc_correct(f, kind, n, dt, prm):
 
 
 @njit(parallel=True, cache=True)
-def update_pressure(f, kind, n, prm):
+def update_pressure(ps, n, prm):
     """p = EOS(rho) for every fluid particle."""
-    rho0 = prm[PR_RHO0]
-    b = prm[PR_B]
-    gam = prm[PR_GAMMA]
+    rho = ps.rho
+    p = ps.p
+    kind = ps.kind
+    rho0 = prm.rho0
+    b = prm.b
+    gam = prm.gamma
     for i in prange(n):
         if kind[i] == FLUID:
-            f[P, i] = pressure(f[RHO, i], rho0, b, gam)
+            p[i] = pressure(rho[i], rho0, b, gam)
 
 
 @njit(cache=True)
 def stable_dt(v2max, a2max, rmax, prm):
     """dt = min(CFL h/(c_max + v_max), CFL sqrt(h/a_max), 0.125 h^2/nu)."""
-    h = prm[PR_H]
-    cfl = prm[PR_CFL]
-    rho0 = prm[PR_RHO0]
-    cmax = prm[PR_C0] * max(rmax / rho0, 1.0) ** (0.5 * (prm[PR_GAMMA] - 1.0))
+    h = prm.h
+    cfl = prm.cfl
+    cmax = prm.c0 * max(rmax / prm.rho0, 1.0) ** (0.5 * (prm.gamma - 1.0))
     dt = cfl * h / (cmax + math.sqrt(v2max))
     if a2max > 0.0:
         dt = min(dt, cfl * math.sqrt(h / math.sqrt(a2max)))
-    if prm[PR_NU] > 0.0:
-        dt = min(dt, 0.125 * h * h / prm[PR_NU])
+    if prm.nu > 0.0:
+        dt = min(dt, 0.125 * h * h / prm.nu)
     return dt
-
-
-@njit(cache=True)
-def _sort(f, f2, nrows, kind, kind2, ids, ids2, cell, cell2, order, cell_start, cursor, n,
-          prm, ncx, ncz):
-    sort_by_cell(f, f2, nrows, kind, kind2, ids, ids2, cell, cell2, order, cell_start, cursor,
-                 n, prm[PR_XMIN], prm[PR_ZMIN], prm[PR_INV_CS], ncx, ncz)
-
-
-@njit(cache=True)
-def initialise(f, f2, kind, kind2, ids, ids2, cell, cell2, order, cell_start, cursor, n, prm,
-               ncx, ncz):
-    """Sort, evaluate rates at the initial state and return the first dt (state ends in f2 twins)."""
-    update_pressure(f, kind, n, prm)
-    _sort(f, f2, N_SORTED_PC, kind, kind2, ids, ids2, cell, cell2, order, cell_start, cursor,
-          n, prm, ncx, ncz)
-    wall_pass(f2, kind2, cell2, cell_start, n, ncx, ncz, prm)
-    fluid_pass(f2, kind2, cell2, cell_start, n, ncx, ncz, prm)
-    n_bad, n_band, v2max, a2max, rmax = kdk_kick(f2, kind2, n, 0.0, prm)
-    return stable_dt(v2max, a2max, rmax, prm)
-
-
-@njit(cache=True)
-def advance(f, f2, kind, kind2, ids, ids2, cell, cell2, order, cell_start, cursor, n, prm,
-            ncx, ncz, integrator, t, dt, t_stop, max_steps):
-    """Run steps until t reaches t_stop or max_steps were taken, or the state turns unstable.
-
-    Returns (t, dt_next, steps, status, swapped, n_flagged, v_max). ``swapped`` = 1 means the
-    current state is in the twin buffers (the caller swaps its references)."""
-    swapped = 0
-    steps = 0
-    status = ST_REACHED_T
-    n_flag = 0
-    v2max = 0.0
-    while True:
-        if t >= t_stop:
-            status = ST_REACHED_T
-            break
-        if steps >= max_steps:
-            status = ST_STEP_LIMIT
-            break
-        dts = dt
-        last = False
-        if t + dts >= t_stop:
-            dts = t_stop - t
-            last = True
-        if integrator == 0:
-            n_out = kdk_kick_drift(f, kind, n, dts, prm)
-            if n_out > 0:
-                status = ST_LEFT_DOMAIN
-                n_flag = n_out
-                break
-            _sort(f, f2, N_SORTED_KDK, kind, kind2, ids, ids2, cell, cell2, order, cell_start,
-                  cursor, n, prm, ncx, ncz)
-            f, f2 = f2, f
-            kind, kind2 = kind2, kind
-            ids, ids2 = ids2, ids
-            cell, cell2 = cell2, cell
-            swapped = 1 - swapped
-            wall_pass(f, kind, cell, cell_start, n, ncx, ncz, prm)
-            fluid_pass(f, kind, cell, cell_start, n, ncx, ncz, prm)
-            n_bad, n_band, v2max, a2max, rmax = kdk_kick(f, kind, n, dts, prm)
-            n_out = 0
-        else:
-            # rates at x^n (the sort happens here, at the start of the step)
-            _sort(f, f2, N_SORTED_PC, kind, kind2, ids, ids2, cell, cell2, order, cell_start,
-                  cursor, n, prm, ncx, ncz)
-            f, f2 = f2, f
-            kind, kind2 = kind2, kind
-            ids, ids2 = ids2, ids
-            cell, cell2 = cell2, cell
-            swapped = 1 - swapped
-            wall_pass(f, kind, cell, cell_start, n, ncx, ncz, prm)
-            fluid_pass(f, kind, cell, cell_start, n, ncx, ncz, prm)
-            pc_predict(f, kind, n, dts, prm)
-            wall_pass(f, kind, cell, cell_start, n, ncx, ncz, prm)
-            fluid_pass(f, kind, cell, cell_start, n, ncx, ncz, prm)
-            n_bad, n_band, n_out, v2max, a2max, rmax = pc_correct(f, kind, n, dts, prm)
-        t = t_stop if last else t + dts
-        steps += 1
-        if n_bad > 0:
-            status = ST_NONFINITE
-            n_flag = n_bad
-            break
-        if n_out > 0:
-            status = ST_LEFT_DOMAIN
-            n_flag = n_out
-            break
-        if n_band > 0:
-            status = ST_DENSITY
-            n_flag = n_band
-            break
-        dt = stable_dt(v2max, a2max, rmax, prm)
-    return t, dt, steps, status, swapped, n_flag, math.sqrt(v2max)

@@ -32,7 +32,7 @@ def test_c_client_against_the_server(srv, engines, c_client):
 
 
 def test_c_client_drives_the_sph_flume(tmp_path, c_client):
-    """The real thing: C client -> TCP port -> server -> sph_core OpenFlume, and back."""
+    """The real thing: C client -> TCP port -> server -> an sph_core Simulation with open ends, and back."""
     from test_server_flume import FLUME, WINDOW
 
     with live_server(tmp_path) as srv:

@@ -1,4 +1,4 @@
-"""The production coupled engine (sph_core's OpenFlume) behind the real server doors.
+"""The production coupled engine (an sph_core Simulation with open ends) behind the real server doors.
 
 The server must be transparent: a flume driven over TCP gives exactly the gauge readings of the
 same flume driven in-process with the same boundary data. The wave data are linear (Airy)

@@ -1,4 +1,4 @@
-"""Boundary-data sources: validation, the wave-model adapter's datum, pushed windows."""
+"""Boundary-data sources: validation, the wave-model adapter's datum."""
 
 from __future__ import annotations
 
@@ -8,8 +8,7 @@ import numpy as np
 import pytest
 
 from sph_core.boundary_data import (BoundaryData, BoundaryDataError, BoundaryNodes,
-                                    BoundarySample, StillWater, WaveModelBoundary, WindowBoundary,
-                                    validate_sample)
+                                    BoundarySample, WaveModelBoundary, validate_sample)
 
 SWL = 0.5
 
@@ -79,25 +78,3 @@ def test_wave_model_adapter_converts_the_datum_and_reads_the_gauge():
 def test_wave_model_adapter_refuses_a_depth_mismatch():
     with pytest.raises(BoundaryDataError, match="model.depth"):
         WaveModelBoundary(LinearShallowModel(depth=0.7), nodes(), SWL, x_model=0.0)
-
-
-def test_window_boundary_interpolates_between_pushed_samples_and_refuses_the_future():
-    nd = nodes()
-    src = WindowBoundary(nd, SWL)
-    src.push(BoundarySample(0.5, np.ones(6), np.full(6, 2.0), 0.1, 0.2))
-    mid = src.sample(0.25)
-    np.testing.assert_allclose(mid.u, 0.5)
-    np.testing.assert_allclose(mid.w, 1.0)
-    assert mid.eta == pytest.approx(0.05) and mid.gauge_eta == pytest.approx(0.1)
-    assert src.sample(0.5).eta == pytest.approx(0.1)
-    with pytest.raises(BoundaryDataError, match="no data for t = 0.6"):
-        src.sample(0.6)
-    with pytest.raises(BoundaryDataError, match="does not follow"):
-        src.push(BoundarySample(0.5, np.ones(6), np.ones(6), 0.0))
-    with pytest.raises(BoundaryDataError, match="left.u: non-finite"):
-        src.push(BoundarySample(0.7, np.full(6, np.nan), np.ones(6), 0.0))
-
-
-def test_still_water_source_is_at_rest():
-    s = StillWater(nodes()).sample(4.0)
-    assert s.t == 4.0 and s.eta == 0.0 and not s.u.any() and not s.w.any()

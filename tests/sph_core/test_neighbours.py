@@ -13,16 +13,14 @@ def test_sorted_cells_give_brute_force_neighbours():
     ps.add(rng.uniform(0, 1, n), rng.uniform(0, 0.5, n), FLUID, np.ones(n), np.ones(n))
     ps.kind[[5, 17, 300]] = INACTIVE
     grid = CellGrid.covering(0, 1, 0, 0.5, 2 * h)
-    cap = ps.capacity
-    cell, cell2, order = (np.zeros(cap, np.int64) for _ in range(3))
-    cell_start = np.zeros(grid.ncell + 2, np.int64)
-    cursor = np.zeros(grid.ncell + 1, np.int64)
+    cells = grid.lists(ps.capacity)
+    cell_start = cells.start
     ids_before = set(ps.ids[: ps.n].tolist())
     x_by_id = dict(zip(ps.ids[: n].tolist(), ps.f[X, :n].tolist()))
-    sort_by_cell(ps.f, ps.f2, N_SORTED_KDK, ps.kind, ps.kind2, ps.ids, ps.ids2, cell, cell2, order,
-                 cell_start, cursor, ps.n, grid.xmin, grid.zmin, 1 / grid.cs, grid.ncx, grid.ncz)
+    n_active = sort_by_cell(ps.view, ps.view2, N_SORTED_KDK, ps.n, cells)
     ps.swap()
-    cell = cell2
+    cell = ps.cell
+    assert n_active == ps.n - 3                                          # inactive dropped
     assert set(ps.ids[: ps.n].tolist()) == ids_before                 # a permutation
     assert all(x_by_id[i] == x for i, x in zip(ps.ids[:n].tolist(), ps.f[X, :n].tolist()))
     assert np.all(np.diff(cell[: ps.n]) >= 0)                            # sorted by cell

@@ -11,23 +11,23 @@ import numpy as np
 import pytest
 
 from sph_core import open_boundary as ob
-from sph_core.boundary_data import (BoundaryDataError, BoundaryNodes, BoundarySample, StillWater,
-                                    WindowBoundary)
-from sph_core.flume import OpenFlume, flume_nodes
+from sph_core.boundary_data import BoundaryDataError, BoundaryNodes, BoundarySample
+from sph_core.open_ends import flume_nodes
 from sph_core.particles import FLUID, OUTLET, P, Z
 from sph_core.scene import make_scene
+from sph_core.simulation import Simulation
 
 D = 0.3          # still-water depth [m]; the tank floor is z = 0
 DP = 0.02
 G = 9.81
 
 
-def flume_scene(length: float = 0.6, **extra) -> object:
+def flume_scene(length: float = 0.6, integrator: str = "kdk", **extra) -> object:
     return make_scene({
         "dp": DP, "t_end": 10.0, "still_water_level": D,
         "tank": {"x0": 0.0, "x1": length, "z0": 0.0, "z1": D + 0.12},
         "water_blocks": [{"x0": 0.0, "x1": length, "z0": 0.0, "z1": D}],
-        "constants": {"c0": 10.0 * math.sqrt(G * D)},
+        "constants": {"c0": 10.0 * math.sqrt(G * D), "integrator": integrator},
         "open_boundaries": [{"side": "left", "elevation": "imposed"},
                             {"side": "right", "elevation": "extrapolated"}],
         **extra})
@@ -48,7 +48,7 @@ class Oscillating:
 
 def test_still_water_with_open_ends_stays_still():
     sc = flume_scene()
-    fl = OpenFlume(sc, sources={s: StillWater(n) for s, n in flume_nodes(sc).items()})
+    fl = Simulation(sc)  # no sources: the open ends hold still water
     fl.advance_to(1.0)
     st = fl.fluid_state()
     assert fl.n_fluid == fl.n_fluid0
@@ -66,25 +66,26 @@ def test_outlet_pressure_extrapolated_from_a_hydrostatic_column_is_hydrostatic()
     hydrostatic density); the ghost nodes carry it into the outlet buffer to round-off, from the
     floor (fluid on one side in z) up to the surface row, where the support is cut off."""
     sc = flume_scene()
-    fl = OpenFlume(sc, sources={s: StillWater(n) for s, n in flume_nodes(sc).items()})
-    assert fl.obp[1, ob.OB_GHOST] == 1.0 and fl.obp[0, ob.OB_GHOST] == 0.0  # the defaults
+    fl = Simulation(sc)
+    assert fl.open.ends.ghost[1] and not fl.open.ends.ghost[0]  # the defaults
     ps = fl.particles
     kind, z = ps.kind[: ps.n], ps.f[Z, : ps.n]
     fluid = kind == FLUID
     np.testing.assert_allclose(ps.f[P, : ps.n][fluid], 1000.0 * G * (D - z[fluid]), rtol=1e-9)
     out = kind == OUTLET
     ps.f[P, : ps.n][out] = 0.0
-    ob.buffer_extrapolate(ps.f, ps.kind, fl.cell_start, ps.n, fl.obp, fl.prm, fl.grid.ncx,
-                          fl.grid.ncz)
+    ob.buffer_extrapolate(ps.view, ps.n, fl.cells, fl.open.ends, fl.prm)
     assert out.sum() == 3 * round(D / DP)  # three columns up to the surface
     np.testing.assert_allclose(ps.f[P, : ps.n][out], 1000.0 * G * (D - z[out]), rtol=1e-9,
                                atol=1e-6)
 
 
-def test_oscillating_flow_crosses_both_ways_with_exact_mass_balance():
-    sc = flume_scene()
+@pytest.mark.parametrize("integrator", ["kdk", "symplectic_pc"])
+def test_oscillating_flow_crosses_both_ways_with_exact_mass_balance(integrator):
+    """Any integrator runs open ends: the same step skeleton calls the same buffer hooks."""
+    sc = flume_scene(integrator=integrator)
     nodes = flume_nodes(sc)
-    fl = OpenFlume(sc, sources={s: Oscillating(n) for s, n in nodes.items()}, window=0.02)
+    fl = Simulation(sc, sources={s: Oscillating(n) for s, n in nodes.items()}, window=0.02)
     capacity = fl.particles.capacity
     fl.advance_to(1.0)
     counts = fl.boundary_counts()
@@ -115,7 +116,7 @@ def test_oscillating_flow_crosses_both_ways_with_exact_mass_balance():
 def test_bad_boundary_data_stop_the_run_and_keep_its_data(tmp_path, bad, match):
     sc = flume_scene(output={"probe_every": 0.01},
                      probes=[{"kind": "elevation", "name": "mid", "x": 0.3}])
-    fl = OpenFlume(sc, run_dir=tmp_path)
+    fl = Simulation(sc, run_dir=tmp_path)
     fl.advance_window(0.05, left=BoundarySample(0.05, np.zeros(fl.nodes["left"].size),
                                                 np.zeros(fl.nodes["left"].size), 0.0))
     before = fl.fluid_state()
@@ -134,7 +135,7 @@ def test_bad_boundary_data_stop_the_run_and_keep_its_data(tmp_path, bad, match):
 
 def test_checkpoint_restore_is_exact():
     sc = flume_scene()
-    fl = OpenFlume(sc, sources={s: Oscillating(n) for s, n in flume_nodes(sc).items()})
+    fl = Simulation(sc, sources={s: Oscillating(n) for s, n in flume_nodes(sc).items()})
     fl.advance_to(0.3)
     cp = fl.checkpoint()
     fl.advance_to(0.5)
@@ -153,15 +154,12 @@ def test_pushed_windows_drive_the_flume_like_the_source_they_sample():
     sc = flume_scene()
     nodes = flume_nodes(sc)
     theory = {s: Oscillating(n) for s, n in nodes.items()}
-    a = OpenFlume(sc, sources=theory, window=0.05)
-    pushed = {s: WindowBoundary(n, D) for s, n in nodes.items()}
-    b = OpenFlume(sc, sources=pushed, window=0.05)
+    a = Simulation(sc, sources=theory, window=0.05)
+    b = Simulation(sc, window=0.05)
     for k in range(1, 9):
         t1 = 0.05 * k
         a.advance_to(t1)  # pulls theory samples at t1
-        for s in nodes:
-            pushed[s].push(theory[s].sample(t1))
-        b.advance_to(t1)
+        b.advance_window(t1, **{s: theory[s].sample(t1) for s in nodes})  # pushed, as the server
     sa, sb = a.fluid_state(), b.fluid_state()
     assert a.boundary_counts() == b.boundary_counts()
     for k in ("id", "x", "z", "vx", "rho"):
@@ -193,7 +191,7 @@ def test_inlet_with_a_beach_and_a_structure_keeps_running_and_counting():
             eta = 0.02 * math.sin(2 * math.pi * t / 1.0) * min(t / 0.5, 1.0)
             return BoundarySample(t, np.full(nodes.size, eta * c / 0.2), np.zeros(nodes.size), eta)
 
-    fl = OpenFlume(sc, sources={"left": Push()}, window=0.02)
+    fl = Simulation(sc, sources={"left": Push()}, window=0.02)
     fl.advance_to(1.5)
     counts = fl.boundary_counts()["left"]
     assert counts["in"] > 0 and counts["out"] > 0

@@ -13,21 +13,26 @@ from sph_core import open_boundary as ob
 from sph_core.particles import FLUID, P, X, Z
 from sph_core.scene import make_scene
 from sph_core.simulation import Simulation
+from sph_core.state import closed_ends
 
 G, D = 9.81, 0.5
 
 
-def ends(absorb: bool = True, imposed: tuple[bool, bool] = (True, False)) -> np.ndarray:
-    obp = np.zeros((2, ob.N_OBP))
-    for b, nx in enumerate((-1.0, 1.0)):
-        obp[b, ob.OB_ON] = 1.0
-        obp[b, ob.OB_NX] = nx
-        obp[b, ob.OB_SWL] = D
-        obp[b, ob.OB_SQGD] = math.sqrt(G / D)
-        obp[b, ob.OB_ABSORB] = float(absorb)
-        obp[b, ob.OB_IMPOSED] = float(imposed[b])
-        obp[b, ob.OB_ZTOP] = 2 * D
-    return obp
+def ends(eta_th: np.ndarray, meas: np.ndarray, absorb: bool = True,
+         imposed: tuple[bool, bool] = (True, False)):
+    """Two open ends over a flat bed, still water D, window elevations eta_th[end, level] (the
+    source's gauge elevation the same), measured gauge elevations meas[end]."""
+    e = closed_ends(capacity=1)
+    e.on[:] = True
+    e.swl[:] = D
+    e.sqgd[:] = math.sqrt(G / D)
+    e.absorb[:] = absorb
+    e.imposed[:] = imposed
+    e.z_top[:] = 2 * D
+    e.win_eta[:] = eta_th
+    e.win_etag[:] = eta_th
+    e.eta_meas[:] = meas
+    return e._replace(active=True)
 
 
 def test_seed_002_corrections_have_the_published_signs():
@@ -35,15 +40,15 @@ def test_seed_002_corrections_have_the_published_signs():
     v_out = v_th - (eta_th - eta_out,meas) sqrt(g/d)."""
     eta_th = np.array([[0.01, 0.01], [0.02, 0.02]])  # [end, window level]
     meas = np.array([0.03, 0.05])
-    zs_in, du_in = ob.boundary_state(0, 0.5, ends(), eta_th, eta_th, meas)
-    zs_out, du_out = ob.boundary_state(1, 0.5, ends(), eta_th, eta_th, meas)
+    zs_in, du_in = ob.boundary_state(0, 0.5, ends(eta_th, meas))
+    zs_out, du_out = ob.boundary_state(1, 0.5, ends(eta_th, meas))
     assert du_in == pytest.approx(-(0.03 - 0.01) * math.sqrt(G / D))
     assert du_out == pytest.approx(-(0.02 - 0.05) * math.sqrt(G / D))
     # inlet: imposed surface; outlet: extrapolated (measured) surface
     assert zs_in == pytest.approx(D + 0.01) and zs_out == pytest.approx(D + 0.05)
     # correction off, or a dry gauge (NaN): theory only
-    assert ob.boundary_state(0, 0.5, ends(absorb=False), eta_th, eta_th, meas)[1] == 0.0
-    zs, du = ob.boundary_state(1, 0.5, ends(), eta_th, eta_th, np.array([np.nan, np.nan]))
+    assert ob.boundary_state(0, 0.5, ends(eta_th, meas, absorb=False))[1] == 0.0
+    zs, du = ob.boundary_state(1, 0.5, ends(eta_th, np.array([np.nan, np.nan])))
     assert du == 0.0 and zs == pytest.approx(D + 0.02)
 
 
@@ -75,13 +80,12 @@ def test_ghost_node_interpolation_reproduces_a_linear_field_exactly():
     f[Z, : ps.n][fl] += rng.uniform(-0.3, 0.3, fl.sum()) * dp
     a, b, c = 50.0, 300.0, -9810.0
     f[P, : ps.n][fl] = a + b * f[X, : ps.n][fl] + c * f[Z, : ps.n][fl]
-    args = (sim.prm, sim.grid.ncx, sim.grid.ncz)
     for xg, zg in [(0.3, 0.15), (0.6, 0.15), (0.59, 0.01), (0.3, 0.29)]:
-        pg, px, pz, order = ob.ghost_pressure(f, ps.kind, sim.cell_start, xg, zg, *args)
+        pg, px, pz, order = ob.ghost_pressure(ps.view, sim.cells, xg, zg, sim.prm)
         assert order == 1, (xg, zg)
         assert pg == pytest.approx(a + b * xg + c * zg, rel=1e-9, abs=1e-6), (xg, zg)
         assert (px, pz) == pytest.approx((b, c), rel=1e-7), (xg, zg)
-    assert ob.ghost_pressure(f, ps.kind, sim.cell_start, 0.3, 0.39, *args)[3] == -1
+    assert ob.ghost_pressure(ps.view, sim.cells, 0.3, 0.39, sim.prm)[3] == -1
 
 
 def test_decay_aware_reflection_fit_separates_damping_from_reflection():

@@ -1,0 +1,256 @@
+"""Open inlet/outlet ends of a run, as a value the Simulation carries (no subclass, no own loop).
+
+    ends = OpenBoundaries.from_scene(scene, sources={"left": src_in, "right": src_out}, window=T/50)
+    ends = OpenBoundaries.closed()        # a closed tank: every open-end hook of the step is a no-op
+    sim = Simulation(scene, sources=..., window=...)   # builds one of them from scene.open_boundaries
+    sim.advance_to(t_end)                  # windows of `window`, each source sampled at its end
+    sim.advance_window(t1, left=sample_in, right=sample_out)   # driven from outside (the server)
+    sim.boundary_gauges(); sim.boundary_counts()
+
+The scene's ``open_boundaries`` say which tank walls are open (see ``scene.OpenBoundary``);
+``nodes[side]`` (``BoundaryNodes``) are the z levels where a source gives u and w. Inside a window
+[t0, t1] the jitted loop interpolates the two end samples linearly in time (seed 001,
+Algorithm 2), so no Python runs between sub-steps. Bad boundary data raise ``BoundaryDataError``
+before any step is taken. The jitted physics is open_boundary.py; the kernels see this value as
+``state.OpenEnds`` (``self.ends``), whose window arrays ``load_window`` fills in place.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Mapping
+
+import numpy as np
+
+from .boundary_data import (BoundaryData, BoundaryDataError, BoundaryNodes, BoundarySample,
+                            still_sample, validate_sample)
+from .eos import GAMMA, hydrostatic_density
+from .open_boundary import INLET_IDLE
+from .particles import INLET, M, P, RHO, WALL, X, Z, ParticleSet
+from .scene import OUTLET_PRESSURE, OpenBoundary, Scene
+from .state import OpenEnds, closed_ends
+
+SIDES = ("left", "right")
+
+
+@dataclass
+class OpenState:
+    """What a checkpoint keeps of the open ends beyond the particles: gauges, counters, the
+    samples at the window start."""
+
+    eta_meas: np.ndarray
+    counters: np.ndarray
+    samples: dict[str, BoundarySample]
+
+
+class OpenBoundaries:
+    """The open ends of a run: their settings, data sources and window (module docstring)."""
+
+    def __init__(self, sides: tuple[str, ...], nodes: Mapping[str, BoundaryNodes],
+                 sources: Mapping[str, BoundaryData], window: float, ends: OpenEnds,
+                 still_water_level: float) -> None:
+        self.sides = sides
+        self.nodes = dict(nodes)
+        self.sources = dict(sources)
+        self.window = float(window)
+        self.ends = ends
+        self.swl = still_water_level
+        # samples at the window start: at rest until the first window is loaded
+        self.samples = {s: still_sample(self.nodes[s], 0.0) for s in sides}
+
+    # ---------------------------------------------------------------- named constructors
+    @classmethod
+    def closed(cls, capacity: int = 1) -> "OpenBoundaries":
+        """No open end: the step's open-end hooks do nothing."""
+        return cls((), {}, {}, math.inf, closed_ends(capacity), math.nan)
+
+    @classmethod
+    def from_scene(cls, scene: Scene, sources: Mapping[str, BoundaryData] | None = None,
+                   window: float = 0.02, capacity: int = 1) -> "OpenBoundaries":
+        """The scene's open ends with their data sources (sides without a source hold their last
+        data, at first rest). Raises ValueError naming the scene field that rules them out."""
+        if not scene.open_boundaries:
+            if sources:
+                raise ValueError(f"sources: no open boundary on side(s) {sorted(sources)}")
+            return cls.closed(capacity)
+        if not (math.isfinite(window) and window > 0):
+            raise ValueError(f"window: must be a positive number of seconds, got {window}")
+        cells = (scene.tank.x1 - scene.tank.x0) / scene.dp
+        if "right" in {o.side for o in scene.open_boundaries} and abs(cells - round(cells)) > 1e-6:
+            # the right buffer continues the fluid lattice laid out from x0: a partial spacing
+            # would leave a gap (or an overlap) of particles at the face
+            raise ValueError(f"tank.x1: x1 - x0 = {scene.tank.x1 - scene.tank.x0} m must be a "
+                             f"whole number of particle spacings dp = {scene.dp} m with a right "
+                             "open end")
+        reach = 4.0 * scene.h  # the buffer (2h) and the support of its outermost fluid
+        for i, bed in enumerate(scene.beds):
+            xs = [pt[0] for pt in bed.points]
+            for o in scene.open_boundaries:
+                xf = scene.tank.x0 if o.side == "left" else scene.tank.x1
+                if min(xs) - reach < xf < max(xs) + reach:
+                    # buffers stand on the tank floor: a bed there would cut through them
+                    raise ValueError(f"beds.{i}: comes within {reach:.3g} m of the {o.side} open "
+                                     "end; open ends need the flat tank floor there")
+        sides = tuple(o.side for o in scene.open_boundaries)
+        sources = dict(sources or {})
+        unknown = set(sources) - set(sides)
+        if unknown:
+            raise ValueError(f"sources: no open boundary on side(s) {sorted(unknown)}")
+        nodes = flume_nodes(scene)
+        for side, src in sources.items():
+            if src.nodes.size != nodes[side].size or not np.allclose(src.nodes.z, nodes[side].z):
+                raise BoundaryDataError(f"sources.{side}.nodes: not the flume's nodes "
+                                        f"(use flume_nodes(scene)['{side}'])")
+        swl = float(scene.still_water_level)
+        nn = next(iter(nodes.values())).size
+        e = closed_ends(capacity, nn)
+        dp, c = scene.dp, scene.constants
+        depth = swl - scene.tank.z0
+        for o in scene.open_boundaries:
+            b = SIDES.index(o.side)
+            nd = nodes[o.side]
+            e.on[b] = True
+            e.x_face[b] = nd.x_face
+            e.nx[b] = -1.0 if b == 0 else 1.0
+            e.swl[b] = swl
+            e.sqgd[b] = math.sqrt(c.g / depth)
+            e.absorb[b] = o.absorb
+            e.imposed[b] = o.elevation == "imposed"
+            e.ghost[b] = buffer_pressure(o) == "extrapolated"
+            e.x_gauge[b] = nd.x_gauge
+            e.z_bed[b] = nd.z_bed
+            e.z_top[b] = nd.z_top
+            e.zn[b] = nd.z
+        for b in range(2):  # an end without boundary keeps valid (unused) node levels
+            if not e.on[b]:
+                e.zn[b] = e.zn[1 - b]
+        e = e._replace(active=True, dz_gauge=0.25 * dp, dp=dp)
+        return cls(sides, nodes, sources, window, e, swl)
+
+    # ---------------------------------------------------------------- setup
+    @property
+    def active(self) -> bool:
+        return bool(self.ends.active)
+
+    def attach(self, ps: ParticleSet, scene: Scene, b_tait: float, buffer_length: float) -> None:
+        """Turn the tank wall columns of the open sides into buffer particles of ``ps`` and size
+        the jitted state for its capacity."""
+        self.ends = self.ends._replace(capacity=ps.capacity)
+        if not self.active:
+            return
+        tank, dp, c = scene.tank, scene.dp, scene.constants
+        self.ends.length[:] = buffer_length
+        n = ps.n
+        x, z, kind = ps.f[X, :n], ps.f[Z, :n], ps.kind[:n]
+        for side in self.sides:
+            b = SIDES.index(side)
+            xf, nx = self.ends.x_face[b], self.ends.nx[b]
+            # the wall columns outside this face (above the floor) become the buffer lattice
+            sel = np.nonzero((kind == WALL) & ((x - xf) * nx > 0) & (z > tank.z0))[0]
+            wet = z[sel] < self.swl
+            kind[sel] = np.where(wet, INLET + b, INLET_IDLE + b)
+            rho = np.where(wet, hydrostatic_density(z[sel], self.swl, c.rho0, c.g, b_tait),
+                           c.rho0)
+            ps.f[RHO, sel] = rho
+            ps.f[P, sel] = b_tait * ((rho / c.rho0) ** GAMMA - 1.0)
+            ps.f[M, sel] = rho * dp * dp
+
+    def fluid_box(self, x0: float, x1: float, dp: float) -> tuple[float, float]:
+        """x range a fluid particle may reach: fluid may enter a buffer before it is converted."""
+        e = self.ends
+        if e.on[0]:
+            x0 = e.x_face[0] - e.length[0] - dp
+        if e.on[1]:
+            x1 = e.x_face[1] + e.length[1] + dp
+        return x0, x1
+
+    # ---------------------------------------------------------------- windows
+    def start(self, t: float) -> None:
+        """Window start data at time t: the sources' samples there, else rest."""
+        self.samples = {s: (validate_sample(self.sources[s].sample(t), self.nodes[s], self.swl,
+                                            where=s) if s in self.sources
+                            else still_sample(self.nodes[s], t))
+                        for s in self.sides}
+        self.load_window(t, t, self.samples)
+
+    def end_samples(self, t1: float, given: Mapping[str, BoundarySample | None]
+                    ) -> dict[str, BoundarySample]:
+        """Validated data at t1 for every open end: given, else the side's source, else the last
+        window's data held. Raises BoundaryDataError naming the side and field."""
+        end: dict[str, BoundarySample] = {}
+        for side in SIDES:
+            s = given.get(side)
+            if side not in self.sides:
+                if s is not None:
+                    raise BoundaryDataError(f"{side}: the flume has no open boundary there")
+                continue
+            if s is None:
+                last = self.samples[side]
+                s = (self.sources[side].sample(t1) if side in self.sources
+                     else BoundarySample(t1, last.u, last.w, last.eta, last.eta_gauge))
+            end[side] = validate_sample(s, self.nodes[side], self.swl, where=side)
+            if abs(end[side].t - t1) > 1e-9 * max(1.0, abs(t1)):
+                raise BoundaryDataError(f"{side}.t: sample at t = {end[side].t} for a window "
+                                        f"ending at {t1}")
+        return end
+
+    def load_window(self, t0: float, t1: float, end: Mapping[str, BoundarySample]) -> None:
+        """The jitted window: data of the current start samples at t0, of ``end`` at t1."""
+        e = self.ends
+        e.win_t[:] = (t0, t1)
+        for side in self.sides:
+            b = SIDES.index(side)
+            for lv, s in enumerate((self.samples[side], end[side])):
+                e.win_u[b, lv] = s.u
+                e.win_w[b, lv] = s.w
+                e.win_eta[b, lv] = s.eta
+                e.win_etag[b, lv] = s.gauge_eta
+
+    # ---------------------------------------------------------------- readings and state
+    def gauges(self) -> dict[str, float | None]:
+        out: dict[str, float | None] = {}
+        for side in self.sides:
+            v = self.ends.eta_meas[SIDES.index(side)]
+            out[side] = float(v) if math.isfinite(v) else None
+        return out
+
+    def counts(self) -> dict[str, dict[str, int]]:
+        return {side: dict(zip(("in", "out", "created", "removed"),
+                               (int(v) for v in self.ends.counters[SIDES.index(side)])))
+                for side in self.sides}
+
+    def state(self) -> OpenState | None:
+        if not self.active:
+            return None
+        return OpenState(self.ends.eta_meas.copy(), self.ends.counters.copy(), dict(self.samples))
+
+    def set_state(self, s: OpenState | None) -> None:
+        if s is None:
+            return
+        self.ends.eta_meas[:] = s.eta_meas
+        self.ends.counters[:] = s.counters
+        self.samples = dict(s.samples)
+
+
+def buffer_pressure(o: OpenBoundary) -> str:
+    """How the buffer of open end ``o`` gets its pressure: ``hydrostatic`` or ``extrapolated``."""
+    if o.pressure is not None:
+        return o.pressure
+    return OUTLET_PRESSURE if o.elevation == "extrapolated" else "hydrostatic"
+
+
+def flume_nodes(scene: Scene) -> dict[str, BoundaryNodes]:
+    """The boundary nodes of each open end of ``scene``: z levels from the floor to the top of
+    the tank at spacing <= dp/2, the face x, the boundary gauge ``gauge_offset`` (default 2h)
+    inside the face."""
+    t, dp = scene.tank, scene.dp
+    nz = int(math.ceil((t.z1 - t.z0) / (0.5 * dp))) + 1
+    z = np.linspace(t.z0, t.z1, nz)
+    out = {}
+    for o in scene.open_boundaries:
+        xf = t.x0 if o.side == "left" else t.x1
+        off = o.gauge_offset if o.gauge_offset is not None else 2.0 * scene.h
+        xg = xf + off if o.side == "left" else xf - off
+        out[o.side] = BoundaryNodes(o.side, xf, z, t.z0, t.z1, xg)
+    return out

@@ -1,0 +1,142 @@
+"""The state the jitted kernels read and write, in four typed containers (numba named tuples).
+
+    Particles  one particle buffer: the float rows (named views of one 2D array), kind, ids, cell
+    Cells      the cell lists of the current order and the grid they index
+    Params     the run's constants (kernel, EOS, viscosity, time step, the tank's domain box)
+    OpenEnds   the open inlet/outlet ends: settings per end, the window's boundary data, and the
+               measured state (gauges, counters); ``active`` False makes every open-end hook a no-op
+
+A kernel takes the containers it needs, so its signature says what it touches: e.g.
+``fluid_pass(ps, n, cells, prm)``. Arrays inside are shared (writes go to the run's storage);
+the scalars are values. Every container's numba type is the same for every scene (a closed tank
+carries an inactive ``OpenEnds`` of the same shapes), so each kernel compiles once and caches.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+
+from .particles import (AX, AZ, DRHO, M, P, RHO, RHON, VWX, VWZ, VX, VXN, VZ, VZN, XN, ZN, X, Z)
+
+
+class Particles(NamedTuple):
+    """One particle buffer (the run keeps two and swaps them at every sort).
+
+    ``f[row, slot]`` is the storage (copied whole by the sort and by buffer cloning); the named
+    arrays are views of its rows. Rows x..m are carried through a sort, xn..rhon (the symplectic
+    predictor's state at t^n) too for that integrator, drho/vwx/vwz are recomputed after it."""
+
+    f: np.ndarray
+    x: np.ndarray
+    z: np.ndarray
+    vx: np.ndarray
+    vz: np.ndarray
+    ax: np.ndarray
+    az: np.ndarray
+    rho: np.ndarray
+    p: np.ndarray
+    m: np.ndarray
+    xn: np.ndarray
+    zn: np.ndarray
+    vxn: np.ndarray
+    vzn: np.ndarray
+    rhon: np.ndarray
+    drho: np.ndarray
+    vwx: np.ndarray      # wall particles: velocity for the viscous term (Adami no-slip)
+    vwz: np.ndarray
+    kind: np.ndarray     # int8: particles.FLUID, WALL, INLET, ...
+    ids: np.ndarray      # int64 identity, kept through sorts
+    cell: np.ndarray     # int64 cell index of the slot (set by the sort)
+
+
+def particles_view(f: np.ndarray, kind: np.ndarray, ids: np.ndarray, cell: np.ndarray) -> Particles:
+    """Named views of the storage ``f`` (no copy)."""
+    return Particles(f, f[X], f[Z], f[VX], f[VZ], f[AX], f[AZ], f[RHO], f[P], f[M], f[XN], f[ZN],
+                     f[VXN], f[VZN], f[RHON], f[DRHO], f[VWX], f[VWZ], kind, ids, cell)
+
+
+class Cells(NamedTuple):
+    """Cell lists: the particles of cell c = cz * ncx + cx are slots start[c]:start[c + 1] (the
+    bin ncx * ncz holds inactive slots); cursor and order are the sort's scratch."""
+
+    start: np.ndarray
+    cursor: np.ndarray
+    order: np.ndarray
+    ncx: int
+    ncz: int
+    xmin: float
+    zmin: float
+    inv_cs: float
+
+
+class Params(NamedTuple):
+    """Constants of a run [SI]."""
+
+    h: float
+    alpha_w: float       # Wendland C2: W = alpha_w (...), F = alpha_f (...)
+    alpha_f: float
+    rho0: float
+    c0: float
+    b: float             # Tait B
+    gamma: float
+    gx: float
+    gz: float
+    alpha: float         # artificial viscosity
+    nu: float            # laminar viscosity
+    delta: float         # delta-SPH
+    cfl: float
+    rho_lo: float        # density band (fraction of rho0); outside: the run stops
+    rho_hi: float
+    noslip: bool
+    fx0: float           # box a fluid particle must stay in (else ST_LEFT_DOMAIN)
+    fx1: float
+    fz0: float
+    fz1: float
+
+
+class OpenEnds(NamedTuple):
+    """Open ends b = 0 (left, kinds INLET/INLET_IDLE) and b = 1 (right, OUTLET/OUTLET_IDLE).
+
+    Per-end settings are arrays of 2; the window [win_t[0], win_t[1]] holds the boundary data at
+    its two ends (level 0, 1) on the nodes zn[b]; eta_meas, counters and next_id are written by
+    the step. See open_boundary.py for the physics."""
+
+    active: bool          # any end open; False: every open-end hook returns at once
+    capacity: int         # slots of the particle buffers (inflow may append up to it)
+    on: np.ndarray        # bool[2]
+    x_face: np.ndarray    # face x [m]
+    nx: np.ndarray        # outward normal (-1 left, +1 right)
+    length: np.ndarray    # buffer width [m]
+    swl: np.ndarray       # still-water level [m]
+    sqgd: np.ndarray      # sqrt(g / depth) of the absorption correction [1/s]
+    absorb: np.ndarray    # bool[2]: absorption correction on
+    imposed: np.ndarray   # bool[2]: surface imposed (else measured)
+    ghost: np.ndarray     # bool[2]: buffer pressure extrapolated from ghost nodes
+    x_gauge: np.ndarray   # boundary gauge x [m]
+    z_bed: np.ndarray
+    z_top: np.ndarray
+    dz_gauge: float       # spacing of the gauge's line points [m]
+    dp: float
+    zn: np.ndarray        # [2, nodes] node heights
+    win_t: np.ndarray     # [2]
+    win_u: np.ndarray     # [2 ends, 2 levels, nodes]
+    win_w: np.ndarray
+    win_eta: np.ndarray   # [2 ends, 2 levels] target elevation
+    win_etag: np.ndarray  # [2 ends, 2 levels] source's elevation at the gauge
+    eta_meas: np.ndarray  # [2] measured elevation at the gauges (NaN: dry / not measured)
+    counters: np.ndarray  # int64[2, 4]: C_IN, C_OUT, C_CREATED, C_REMOVED
+    next_id: np.ndarray   # int64[1]: id of the next created particle
+
+
+def closed_ends(capacity: int, n_nodes: int = 2) -> OpenEnds:
+    """An inactive OpenEnds (a closed tank): same types as an open one, hooks do nothing."""
+    z2 = lambda: np.zeros(2)  # noqa: E731
+    b2 = lambda: np.zeros(2, dtype=np.bool_)  # noqa: E731
+    return OpenEnds(False, int(capacity), b2(), z2(), np.array([-1.0, 1.0]), z2(), z2(), z2(),
+                    b2(), b2(), b2(), z2(), z2(), np.ones(2), 0.0, 0.0,
+                    np.tile(np.linspace(0.0, 1.0, n_nodes), (2, 1)), z2(),
+                    np.zeros((2, 2, n_nodes)), np.zeros((2, 2, n_nodes)), np.zeros((2, 2)),
+                    np.zeros((2, 2)), np.full(2, np.nan), np.zeros((2, 4), dtype=np.int64),
+                    np.zeros(1, dtype=np.int64))

@@ -1,0 +1,165 @@
+"""The one jitted time loop: every scene, every integrator, with or without open ends.
+
+    t, dt, steps, status, swapped, n_flag, v_max, n = run(ps, ps2, cells, prm, ends, integrator,
+                                                          n, t, dt, t_stop, max_steps)
+
+State lives in the typed containers of ``state.py`` (Particles ``ps`` and its twin ``ps2``,
+Cells, Params, OpenEnds); ``swapped`` = 1 means the current state is in the twin (the caller
+swaps its references), ``n`` the slots in use after the call (a sort drops inactive slots, open
+ends append).
+
+One step, as the two integrators order the same stages (wcsph.py has the equations):
+
+    kdk (one force evaluation)               symplectic_pc (two)
+    ------------------------------------     ------------------------------------
+    kick + drift (fluid)                     sort                          [S]
+    update_buffers                  [D]      extrapolate_buffers           [S']
+    sort                            [S]      forces at x^n                 [F]
+    extrapolate_buffers             [S']     measure_boundaries            [G]
+    forces                          [F]      predict (half step)
+    kick (guards, max |v|, |a|, rho)         forces at x^{n+1/2}           [F]
+    measure_boundaries              [G]      correct (guards)
+                                             update_buffers                [D]
+
+[F] forces = ``wall_pass`` (Adami wall state) then ``fluid_pass`` (continuity, delta-SPH,
+pressure, viscosity, gravity): ``_forces`` below. The open-end hooks ([D] after the drift:
+buffers imposed and moved, crossings; [S'] after the sort: ghost-node pressure; [G] after the
+forces: boundary gauges) return at once when ``ends.active`` is False, so a closed tank runs the
+same code. Buffer particles are not FLUID: the integrators never move them; update_buffers does,
+once per step, with the window's data at t + dt.
+
+Where a new physical term goes (one jitted function, one line here):
+- a pass that needs neighbours before the forces (e.g. the kernel-gradient correction matrix
+  L_i of each fluid particle, stored in new Particles rows): call it in ``_forces`` before
+  ``fluid_pass``; the pair loop of fluid_pass then multiplies its gradient by L_i;
+- a change of the rates (a new force or density term): its own pass after ``fluid_pass`` in
+  ``_forces`` adding into ps.ax / ps.az / ps.drho (or a term inside fluid_pass's pair loop if it
+  must share the neighbour search);
+- a position correction after the update (particle shifting): a pass after ``kdk_kick`` /
+  ``pc_correct`` in ``_step_kdk`` / ``_step_pc``, on the sorted state (cells valid for kdk; for
+  symplectic_pc the cells are those of x^n);
+- damping / absorption of the velocity (e.g. a sponge layer): after the kick / corrector, same
+  place as shifting.
+Rows added to Particles go after ``rhon`` and before ``drho`` if a sort must carry them (and
+N_SORTED_* grow), else at the end (particles.py).
+"""
+
+from __future__ import annotations
+
+import math
+
+from numba import njit
+
+from .neighbours import sort_by_cell
+from .open_boundary import extrapolate_buffers, measure_boundaries, update_buffers
+from .particles import N_SORTED_KDK, N_SORTED_PC
+from .wcsph import (KDK, ST_CAPACITY, ST_DENSITY, ST_LEFT_DOMAIN, ST_NONFINITE, ST_REACHED_T,
+                    ST_STEP_LIMIT, fluid_pass, kdk_kick, kdk_kick_drift, pc_correct, pc_predict,
+                    stable_dt, update_pressure, wall_pass)
+
+
+@njit(cache=True)
+def _forces(ps, n, cells, prm):
+    """Rates of every fluid particle (ax, az, drho) at the current, sorted state."""
+    wall_pass(ps, n, cells, prm)
+    fluid_pass(ps, n, cells, prm)
+
+
+@njit(cache=True)
+def initialise(ps, ps2, cells, prm, ends, n):
+    """Sort, evaluate rates at the initial state, measure the boundary gauges; returns (dt, n).
+    The sorted state ends in ``ps2`` (the caller swaps)."""
+    update_pressure(ps, n, prm)
+    n = sort_by_cell(ps, ps2, N_SORTED_PC, n, cells)
+    extrapolate_buffers(ps2, n, cells, ends, prm)
+    _forces(ps2, n, cells, prm)
+    n_bad, n_band, v2max, a2max, rmax = kdk_kick(ps2, n, 0.0, prm)
+    measure_boundaries(ps2, cells, ends, prm)
+    return stable_dt(v2max, a2max, rmax, prm), n
+
+
+@njit(cache=True)
+def _step_kdk(ps, ps2, cells, prm, ends, n, t, dt):
+    """One leapfrog step; the state ends in ps2. Returns (n, status, n_flag, v2max, a2max, rmax)."""
+    n_out = kdk_kick_drift(ps, n, dt, prm)
+    if n_out > 0:
+        return n, ST_LEFT_DOMAIN, n_out, 0.0, 0.0, 0.0, False
+    n_new = update_buffers(ps, n, t + dt, dt, ends, prm)
+    if n_new < 0:
+        return n, ST_CAPACITY, n, 0.0, 0.0, 0.0, False
+    n = sort_by_cell(ps, ps2, N_SORTED_KDK, n_new, cells)
+    extrapolate_buffers(ps2, n, cells, ends, prm)
+    _forces(ps2, n, cells, prm)
+    n_bad, n_band, v2max, a2max, rmax = kdk_kick(ps2, n, dt, prm)
+    measure_boundaries(ps2, cells, ends, prm)
+    return _verdict(n, n_bad, n_band, 0, v2max, a2max, rmax)
+
+
+@njit(cache=True)
+def _step_pc(ps, ps2, cells, prm, ends, n, t, dt):
+    """One symplectic predictor-corrector step; the state ends in ps2. Same returns as _step_kdk."""
+    n = sort_by_cell(ps, ps2, N_SORTED_PC, n, cells)
+    extrapolate_buffers(ps2, n, cells, ends, prm)
+    _forces(ps2, n, cells, prm)
+    measure_boundaries(ps2, cells, ends, prm)
+    pc_predict(ps2, n, dt, prm)
+    _forces(ps2, n, cells, prm)
+    n_bad, n_band, n_out, v2max, a2max, rmax = pc_correct(ps2, n, dt, prm)
+    if n_bad == 0 and n_out == 0:
+        n_new = update_buffers(ps2, n, t + dt, dt, ends, prm)
+        if n_new < 0:
+            return n, ST_CAPACITY, n, v2max, a2max, rmax, True
+        n = n_new
+    return _verdict(n, n_bad, n_band, n_out, v2max, a2max, rmax)
+
+
+@njit(cache=True)
+def _verdict(n, n_bad, n_band, n_out, v2max, a2max, rmax):
+    """Status after a completed step (the guards in the order they are reported)."""
+    if n_bad > 0:
+        return n, ST_NONFINITE, n_bad, v2max, a2max, rmax, True
+    if n_out > 0:
+        return n, ST_LEFT_DOMAIN, n_out, v2max, a2max, rmax, True
+    if n_band > 0:
+        return n, ST_DENSITY, n_band, v2max, a2max, rmax, True
+    return n, ST_REACHED_T, 0, v2max, a2max, rmax, True
+
+
+@njit(cache=True)
+def run(ps, ps2, cells, prm, ends, integrator, n, t, dt, t_stop, max_steps):
+    """Run steps until t reaches t_stop or max_steps were taken, or a guard trips.
+
+    Returns (t, dt_next, steps, status, swapped, n_flagged, v_max, n)."""
+    swapped = 0
+    steps = 0
+    status = ST_REACHED_T
+    n_flag = 0
+    v2max = 0.0
+    while True:
+        if t >= t_stop:
+            status = ST_REACHED_T
+            break
+        if steps >= max_steps:
+            status = ST_STEP_LIMIT
+            break
+        dts = dt
+        last = False
+        if t + dts >= t_stop:
+            dts = t_stop - t
+            last = True
+        if integrator == KDK:
+            n, status, n_flag, v2, a2max, rmax, done = _step_kdk(ps, ps2, cells, prm, ends, n, t,
+                                                                  dts)
+        else:
+            n, status, n_flag, v2, a2max, rmax, done = _step_pc(ps, ps2, cells, prm, ends, n, t,
+                                                                 dts)
+        if done:  # the step got to its sort: the state is in the twin
+            ps, ps2 = ps2, ps
+            swapped = 1 - swapped
+            t = t_stop if last else t + dts
+            steps += 1
+            v2max = v2
+        if status != ST_REACHED_T:
+            break
+        dt = stable_dt(v2max, a2max, rmax, prm)
+    return t, dt, steps, status, swapped, n_flag, math.sqrt(v2max), n
