@@ -45,7 +45,7 @@ def case_theory(theory: str, height: float, period: float, depth: float, ramp: f
     return build_theory(name, height=height, period=period, depth=depth, ramp_time=ramp, **opts)
 
 
-def run(theory: str, height: float, period: float, depth: float, dp: float, periods: float,
+def run_flume_case(theory: str, height: float, period: float, depth: float, dp: float, periods: float,
         ramp_periods: float = 1.0, absorb: bool = True, case: str | None = None) -> dict:
     ramp = ramp_periods * period
     model = case_theory(theory, height, period, depth, ramp)
@@ -84,7 +84,7 @@ def main(argv: list[str] | None = None) -> int:
     else:
         ap.error("give --case, or --theory with --H --T --d")
     dp = a.dp if a.dp else height / 10.0
-    out = run(theory, height, period, depth, dp, a.periods, a.ramp_periods, not a.no_absorb,
+    out = run_flume_case(theory, height, period, depth, dp, a.periods, a.ramp_periods, not a.no_absorb,
               a.case)
     print(json.dumps(out), flush=True)
     return 0
