@@ -37,7 +37,6 @@ ALLOWED: dict[str, tuple[set[str], str]] = {
     "get_run": ({"server/deps.py", "server/routers/runs.py"}, "server rename pending"),
     "module runs": ({"server/runs.py", "server/routers/runs.py"}, "server rename pending"),
     # pending in the solver rewrite (issue 10, core worktree): remove when merged
-    "STATUS_TEXT": ({"sph_core/wcsph.py", "sph_core/open_boundary.py"}, "solver rewrite pending"),
     # deliberate
     "module couple": ({"wavesph_cli/couple.py", "server/routers/couple.py"},
                       "`wavesph couple` and the /runs/{id}/couple endpoint: each named for its "
