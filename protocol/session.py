@@ -222,11 +222,6 @@ class SphSession:
             code, text = ErrorCode.INTERNAL, f"{type(exc).__name__}: {exc}"
         return self._frame(Error(int(code), _clip(text)))
 
-    def bye_frame(self, reason: str) -> bytes:
-        """Server-initiated BYE (run finished or server stopping)."""
-        self.state = State.CLOSED
-        return self._frame(Bye(_clip(reason)))
-
     def _frame(self, msg: Message) -> bytes:
         return encode_frame(msg, self._reply_seq)
 

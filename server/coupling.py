@@ -1,7 +1,6 @@
 """The coupling door logic shared by the WebSocket and TCP endpoints.
 
-A transport gives ``recv()`` (a list of (seq, message), or None when the peer closed) and
-``send(bytes)``; ``serve_client`` runs the protocol session (protocol.SphSession) against the
+A transport (transports.DoorTransport) gives ``recv()`` and ``send(bytes)``; ``serve_client`` runs the protocol session (protocol.SphSession) against the
 run's engine. Engine calls go to the worker pool; every read has a timeout; the run's state
 says how the session ended, and the gauge rows of every solved window are on disk already.
 """
@@ -11,8 +10,6 @@ from __future__ import annotations
 import asyncio
 import logging
 import time
-from typing import Protocol
-
 import numpy as np
 
 from protocol import (Capability, ErrorCode, Nodes, ProtocolError, Result, SphSession, Welcome,
@@ -22,19 +19,11 @@ from protocol.session import Measure, PeerError, Reply, Restore, SetWindow, Solv
 
 from .engine import CouplingEngine, Measurement
 from .runs import FAILED, FINISHED, RUNNING, UNSTABLE, Run, RunManager
-from .transports import PeerGone
+from .transports import DoorTransport, PeerGone
 
 log = logging.getLogger("wavesph.server")
 
 SERVER_NAME = "wavesph-server 0.1 (protocol 1)"
-
-
-class Transport(Protocol):
-    max_payload: int
-
-    async def recv(self) -> list[tuple[int, Message]] | None: ...
-    async def send(self, data: bytes) -> None: ...
-    async def close(self) -> None: ...
 
 
 class _SessionEnd(Exception):
@@ -58,7 +47,7 @@ def welcome_for(run: Run, engine: CouplingEngine, idle_timeout: float) -> tuple[
     return welcome, Nodes(nodes.x, nodes.z, nodes.side, nodes.gauge_x)
 
 
-async def serve_client(manager: RunManager, run: Run, transport: Transport,
+async def serve_client(manager: RunManager, run: Run, transport: DoorTransport,
                        first: list[tuple[int, Message]]) -> None:
     """Run one client's session on ``run`` (already attached); sets the run's final state."""
     settings, engine = manager.settings, run.engine
@@ -175,7 +164,7 @@ class _Cancel(Exception):
     pass
 
 
-async def _recv(transport: Transport, timeout: float, run: Run) -> list[tuple[int, Message]]:
+async def _recv(transport: DoorTransport, timeout: float, run: Run) -> list[tuple[int, Message]]:
     """Next frames, or _Gone / TimeoutError / _Cancel; ProtocolError passes through."""
     recv = asyncio.ensure_future(transport.recv())
     cancel = asyncio.ensure_future(run.cancelled.wait())

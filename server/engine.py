@@ -33,7 +33,7 @@ class SceneSummary:
 
 
 @dataclass(frozen=True)
-class BoundaryNodes:
+class EngineNodes:
     """Boundary nodes (z up from still water) and gauges, in the order of every array."""
 
     x: np.ndarray
@@ -60,7 +60,7 @@ class CouplingEngine(Protocol):
     steps: int                 # SPH steps since the start
     n_particles: int
 
-    def nodes(self) -> BoundaryNodes: ...
+    def nodes(self) -> EngineNodes: ...
     def set_window(self, t0: float, t1: float, u: np.ndarray, w: np.ndarray, eta: np.ndarray) -> None:
         """Boundary values at t1; the values in force at t0 are those of the previous window."""
     def solve_window(self) -> Measurement:

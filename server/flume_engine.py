@@ -26,7 +26,7 @@ from sph_core.boundary_data import BoundaryDataError, BoundarySample
 from sph_core.flume import SIDES, OpenFlume
 from sph_core.scene import PointProbe, Scene
 
-from .engine import BoundaryNodes, Measurement, SceneSummary
+from .engine import EngineNodes, Measurement, SceneSummary
 from .schemas import RunRequest
 
 REF = "_ref"  # suffix of the point probes the engine adds at z_ref
@@ -75,7 +75,7 @@ class FlumeEngine:
             xs.append(np.full(nd.size, nd.x_face))
             zs.append(nd.z - swl)
             side_ids.append(np.full(nd.size, SIDES.index(s), dtype=np.uint32))
-        self._nodes = BoundaryNodes(np.concatenate(xs), np.concatenate(zs), np.concatenate(side_ids),
+        self._nodes = EngineNodes(np.concatenate(xs), np.concatenate(zs), np.concatenate(side_ids),
                                     np.array(gauge_x), list(self.gauge_names))
         self.summary = SceneSummary(g=scene.constants.g, depth=depth, still_water_level=swl,
                                     z_ref=z_ref, t_start=f.t, t_end=scene.t_end, dt_sph=f.dt)
@@ -97,7 +97,7 @@ class FlumeEngine:
         return self.flume.n_particles
 
     # -- contract --------------------------------------------------------------------------
-    def nodes(self) -> BoundaryNodes:
+    def nodes(self) -> EngineNodes:
         return self._nodes
 
     def set_window(self, t0: float, t1: float, u: np.ndarray, w: np.ndarray, eta: np.ndarray) -> None:

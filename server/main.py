@@ -13,6 +13,7 @@ from .routers import couple, runs
 from .runs import RunManager
 from .settings import Settings
 from .tcp import start_tcp_server
+from .theory_client import serve_theory
 
 log = logging.getLogger("wavesph.server")
 
@@ -25,7 +26,7 @@ def create_app(settings: Settings | None = None,
 
     @asynccontextmanager
     async def lifespan(app: FastAPI):
-        manager = RunManager(settings, engine_factory)
+        manager = RunManager(settings, engine_factory, serve_theory)
         app.state.manager = manager
         tcp = None
         if settings.tcp_port is not None:

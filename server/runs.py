@@ -15,7 +15,7 @@ import uuid
 from collections import deque
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
-from typing import Any
+from typing import Any, Awaitable, Callable
 
 from protocol.session import set_payload_size
 
@@ -72,10 +72,16 @@ class Run:
         return self.info.state in TERMINAL
 
 
+SourceDriver = Callable[["RunManager", Run], Awaitable[None]]
+"""Drives an attached run with its request's built-in wave source (theory_client.serve_theory)."""
+
+
 class RunManager:
-    def __init__(self, settings: Settings, engine_factory: EngineFactory) -> None:
+    def __init__(self, settings: Settings, engine_factory: EngineFactory,
+                 source_driver: SourceDriver | None = None) -> None:
         self.settings = settings
         self.engine_factory = engine_factory
+        self.source_driver = source_driver
         self.store = RunStore(settings.runs_dir)
         self.runs: dict[str, Run] = {}
         self.queue: deque[str] = deque()
@@ -268,10 +274,10 @@ class RunManager:
             run.info.started = time.time()
             self._set_state(run, WAITING)
             if run.request.source is not None:  # standalone, driven by a built-in theory client
-                from .theory_source import serve_theory
-
+                if self.source_driver is None:
+                    raise RuntimeError("this server has no driver for built-in wave sources")
                 self.attach(run.info.id)
-                run.task_client = asyncio.get_running_loop().create_task(serve_theory(self, run))
+                run.task_client = asyncio.get_running_loop().create_task(self.source_driver(self, run))
             woke = await _first_of(run.attached, run.cancelled, self.settings.client_wait_timeout)
             if woke is None:
                 self._set_state(run, FAILED, f"no client connected within "

@@ -14,7 +14,9 @@ from sph_core.scene import Scene
 from .theory_source import TheorySource
 
 
-class CouplingOptions(BaseModel):
+class RunCouplingOptions(BaseModel):
+    """The `coupling` part of POST /runs (the client's own options are wave_client's)."""
+
     model_config = ConfigDict(extra="forbid")
 
     window_max: float = Field(0.05, gt=0, description="longest coupling window the client may use [s]")
@@ -31,7 +33,7 @@ class RunRequest(BaseModel):
     mode: Literal["coupled", "standalone"] = Field(
         "coupled", description="coupled: wait for a client on /runs/{id}/couple or the TCP port; "
                                "standalone: run the scene as it is (open ends: driven by `source`)")
-    coupling: CouplingOptions = CouplingOptions()
+    coupling: RunCouplingOptions = RunCouplingOptions()
     source: TheorySource | None = Field(None, description="built-in wave theory driving the open "
                                                           "ends of a standalone run")
 

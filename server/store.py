@@ -17,15 +17,11 @@ import os
 from pathlib import Path
 from typing import Any
 
+from sph_core.output import write_json_atomic
+
 from .schemas import RunInfo
 
 META = "meta.json"
-
-
-def write_json_atomic(path: Path, data: Any) -> None:
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(json.dumps(data, indent=2, default=str))
-    os.replace(tmp, path)
 
 
 class RunStore:

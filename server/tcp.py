@@ -10,14 +10,14 @@ from protocol.session import HELLO_LIMIT
 
 from .coupling import error_frame, serve_client
 from .runs import RunManager
-from .transports import TcpTransport
+from .transports import TcpDoor
 
 log = logging.getLogger("wavesph.server")
 
 
 async def start_tcp_server(manager: RunManager, host: str, port: int) -> asyncio.base_events.Server:
     async def handle(reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> None:
-        transport = TcpTransport(reader, writer, min(HELLO_LIMIT, manager.settings.max_frame))
+        transport = TcpDoor(reader, writer, min(HELLO_LIMIT, manager.settings.max_frame))
         try:
             await _handle(manager, transport)
         except Exception:  # noqa: BLE001 -- one bad connection never stops the port
@@ -27,7 +27,7 @@ async def start_tcp_server(manager: RunManager, host: str, port: int) -> asyncio
     return await asyncio.start_server(handle, host, port)
 
 
-async def _handle(manager: RunManager, transport: TcpTransport) -> None:
+async def _handle(manager: RunManager, transport: TcpDoor) -> None:
     seq = 0
     try:
         frames = await asyncio.wait_for(transport.recv(), manager.settings.hello_timeout)
@@ -52,7 +52,7 @@ async def _handle(manager: RunManager, transport: TcpTransport) -> None:
     await serve_client(manager, run, transport, frames)
 
 
-async def _refuse(transport: TcpTransport, code: ErrorCode, text: str, seq: int) -> None:
+async def _refuse(transport: TcpDoor, code: ErrorCode, text: str, seq: int) -> None:
     try:
         await asyncio.wait_for(transport.send(error_frame(code, text, seq)), 5.0)
     except Exception:  # noqa: BLE001

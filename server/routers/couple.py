@@ -11,7 +11,7 @@ from protocol.session import HELLO_LIMIT
 
 from ..coupling import error_frame, serve_client
 from ..deps import websocket_token_ok
-from ..transports import WebSocketTransport
+from ..transports import WebSocketDoor
 
 router = APIRouter(tags=["coupling"])
 
@@ -23,7 +23,7 @@ async def couple(ws: WebSocket, run_id: str) -> None:
         return
     await ws.accept()
     manager = ws.app.state.manager
-    transport = WebSocketTransport(ws, min(HELLO_LIMIT, manager.settings.max_frame))
+    transport = WebSocketDoor(ws, min(HELLO_LIMIT, manager.settings.max_frame))
     seq = 0
     try:
         frames = await asyncio.wait_for(transport.recv(), manager.settings.hello_timeout)
@@ -47,7 +47,7 @@ async def couple(ws: WebSocket, run_id: str) -> None:
     await serve_client(manager, run, transport, frames)
 
 
-async def _refuse(transport: WebSocketTransport, code: ErrorCode, text: str, seq: int) -> None:
+async def _refuse(transport: WebSocketDoor, code: ErrorCode, text: str, seq: int) -> None:
     try:
         await transport.send(error_frame(code, text, seq))
     except Exception:  # noqa: BLE001 -- the peer may already be gone
