@@ -1,4 +1,11 @@
-"""Run manager: run records, the queue and its concurrency cap, standalone stepping in workers.
+"""Run manager: run records, the queue and its caps, standalone stepping in workers.
+
+Three caps, so that runs whose client never comes cannot block the server:
+- ``max_runs`` stepping slots: a standalone run holds one while it steps, a coupled run from the
+  moment its client attaches (HELLO accepted) to the end of the session. A coupled run that waits
+  for its client holds none; a client arriving when every slot is busy is refused (BUSY, retry).
+- ``max_waiting`` coupled runs built (engine in memory) and waiting for their client;
+- ``max_queued`` runs in the queue; one more is refused (HTTP 429 with Retry-After).
 
 Everything here runs on the event loop except the SPH work, which goes to a thread pool
 (``Run.executor``): numba releases the GIL in its parallel loops, and Python threads switch every
@@ -33,6 +40,10 @@ TERMINAL = frozenset({FINISHED, CANCELLED, FAILED, UNSTABLE})
 
 class Cancelled(Exception):
     """Raised inside a worker when the run's owner cancelled it."""
+
+
+class QueueFull(Exception):
+    """The queue holds ``max_queued`` runs already (HTTP 429)."""
 
 
 class Run:
@@ -85,8 +96,12 @@ class RunManager:
         self.store = RunStore(settings.runs_dir)
         self.runs: dict[str, Run] = {}
         self.queue: deque[str] = deque()
-        self.active: set[str] = set()
+        self.active: set[str] = set()    # runs holding a stepping slot
+        self.waiting: set[str] = set()   # coupled runs built or being built, no client yet
+        # stepping: one worker per slot; building engines has its own worker, so a run being
+        # built never delays the windows of the runs that step
         self.executor = ThreadPoolExecutor(max_workers=settings.max_runs, thread_name_prefix="sph")
+        self.builder = ThreadPoolExecutor(max_workers=1, thread_name_prefix="sph-build")
         self.stopping = False
         self._load_existing()
 
@@ -126,7 +141,13 @@ class RunManager:
             self.runs[rid].info.queue_position = i + 1
 
     # ------------------------------------------------------------------ lifecycle
+    def _check_queue_room(self) -> None:
+        if len(self.queue) >= self.settings.max_queued:
+            raise QueueFull(f"the queue holds {len(self.queue)} runs, the server's max_queued: "
+                            f"retry when a run has ended")
+
     def submit(self, request: RunRequest) -> Run:
+        self._check_queue_room()
         run_id = uuid.uuid4().hex  # 128 random bits: also the credential on the TCP port
         scene_bytes = canonical_scene(request.scene)
         from protocol import scene_hash
@@ -148,6 +169,7 @@ class RunManager:
         if not run.info.resumable:
             raise ValueError(f"run {run.info.id} is {run.info.status}: only a failed or cancelled "
                              f"coupled run with a saved state can be resumed")
+        self._check_queue_room()
         run.reset_live_parts()
         run.resume_from = run.state_file
         run.info.resumed += 1
@@ -158,16 +180,27 @@ class RunManager:
         self._schedule()
 
     def _schedule(self) -> None:
-        while self.queue and len(self.active) < self.settings.max_runs:
-            run = self.runs[self.queue.popleft()]
+        """Start every queued run that has room, in queue order: a coupled run needs a waiting
+        place, any other run a stepping slot (so one kind never waits behind the other)."""
+        for rid in list(self.queue):
+            run = self.runs[rid]
+            if _waits_for_client(run.request):
+                if len(self.waiting) >= self.settings.max_waiting:
+                    continue
+                self.waiting.add(rid)
+            else:
+                if len(self.active) >= self.settings.max_runs:
+                    continue
+                self.active.add(rid)
+            self.queue.remove(rid)
             run.info.queue_position = None
-            self.active.add(run.info.id)
             body = self._coupled(run) if _windowed(run.request) else self._standalone(run)
             run.task = asyncio.get_running_loop().create_task(body, name=f"run-{run.info.id}")
         self._queue_positions()
 
     def _release(self, run: Run) -> None:
         self.active.discard(run.info.id)
+        self.waiting.discard(run.info.id)
         self._schedule()
 
     def cancel(self, run: Run) -> None:
@@ -201,6 +234,7 @@ class RunManager:
             if not run.terminal:
                 self._set_state(run, FAILED, "server stopped before the run ended")
         self.executor.shutdown(wait=False, cancel_futures=True)
+        self.builder.shutdown(wait=False, cancel_futures=True)
 
     # ------------------------------------------------------------------ standalone
     async def _standalone(self, run: Run) -> None:
@@ -257,10 +291,10 @@ class RunManager:
         """Build the engine, then hold the slot until the client's session ends (see coupling.py)."""
         loop = asyncio.get_running_loop()
         try:
-            run.engine = await loop.run_in_executor(self.executor, self.engine_factory,
+            run.engine = await loop.run_in_executor(self.builder, self.engine_factory,
                                                     run.request, run.dir)
             if run.resume_from is not None:
-                await loop.run_in_executor(self.executor, run.engine.load_state, run.resume_from)
+                await loop.run_in_executor(self.builder, run.engine.load_state, run.resume_from)
             run.info.particles = run.engine.n_particles
             run.info.t, run.info.steps = run.engine.t, run.engine.steps
             need = set_payload_size(run.engine.nodes().x.size)
@@ -292,20 +326,34 @@ class RunManager:
             if run.gauges:
                 run.gauges.close()
             if run.engine:
-                await loop.run_in_executor(self.executor, run.engine.close)
+                await loop.run_in_executor(self.builder, run.engine.close)
             self._release(run)
 
     def attach(self, run_id: str) -> Run:
-        """Give a connecting client its run; ValueError says why not (sent as ERROR BUSY)."""
+        """Give a connecting client its run and a stepping slot; ValueError says why not (sent as
+        ERROR BUSY)."""
         run = self.runs.get(run_id)
         if run is None:
             raise ValueError(f"no run {run_id!r} on this server")
         if run.client_attached or run.info.state != WAITING:
             why = "already has a coupling client" if run.client_attached else f"is {run.info.status}"
             raise ValueError(f"run {run_id} {why}")
+        if run_id not in self.active:  # a coupled run takes its stepping slot now
+            if len(self.active) >= self.settings.max_runs:
+                raise ValueError(f"run {run_id} is waiting for a client, but all "
+                                 f"{self.settings.max_runs} stepping slots of this server are "
+                                 f"in use: retry later (the run keeps waiting)")
+            self.waiting.discard(run_id)
+            self.active.add(run_id)
+            self._schedule()  # its waiting place is free for the next queued coupled run
         run.client_attached = True
         run.attached.set()
         return run
+
+
+def _waits_for_client(request: RunRequest) -> bool:
+    """Coupled runs wait for a client without a stepping slot; theory-driven ones do not wait."""
+    return request.mode == "coupled"
 
 
 def _windowed(request: RunRequest) -> bool:

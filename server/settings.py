@@ -18,8 +18,14 @@ class Settings(BaseModel):
     tcp_port: int | None = Field(8766, ge=0, le=65535, description="TCP coupling port; None disables it")
     runs_dir: Path = Field(Path("runs"), description="one sub-directory per run")
     token: str | None = Field(None, min_length=16, description="API token (required off loopback)")
-    max_runs: int = Field(2, ge=1, description="runs stepping or holding a coupling slot at once")
+    max_runs: int = Field(2, ge=1, description="runs stepping at once (a coupled run from its "
+                                               "client's HELLO on)")
+    max_waiting: int = Field(4, ge=1, description="coupled runs built and waiting for their client "
+                                                  "(each holds its particles in memory)")
+    max_queued: int = Field(32, ge=0, description="runs in the queue; beyond: HTTP 429")
     max_particles: int = Field(2_000_000, ge=1, description="particle-count cap per run")
+    max_probes: int = Field(1000, ge=0, description="probes of one scene")
+    max_body: int = Field(1024 * 1024, ge=1024, description="largest POST /runs body [bytes]")
     max_frame: int = Field(16 * 1024 * 1024, ge=4104, le=16 * 1024 * 1024,
                            description="largest coupling frame payload [bytes]")
     hello_timeout: float = Field(30.0, gt=0, description="[s] for the first frame after connect")

@@ -1,0 +1,180 @@
+"""Faults and bad input of issue 15, one reproducing case each (real server on 127.0.0.1)."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import pytest
+
+from server_harness import live_server, scene
+
+
+def _strict(token: str):
+    raise AssertionError(f"{token} in a reply: not JSON")
+
+
+def _coupled_body(**overrides) -> dict:
+    return {"scene": scene(open_boundaries=[{"side": "left"}], **overrides), "mode": "coupled"}
+
+
+# 1. runs whose client never comes ---------------------------------------------------------------
+def test_waiting_coupled_runs_do_not_hold_the_stepping_slots(tmp_path, factory):
+    with live_server(tmp_path, factory, max_runs=2) as srv:
+        idle = [srv.create(), srv.create()]  # clients that never come
+        for run in idle:
+            srv.wait_state(run["id"], "waiting_for_client")
+        standalone = srv.create(mode="standalone", t_end=0.05)
+        assert srv.wait_state(standalone["id"], "finished", timeout=60)["status"] == "finished"
+        for run in idle:
+            assert srv.http.get(f"/runs/{run['id']}").json()["state"] == "waiting_for_client"
+
+
+def test_full_queue_is_a_429_with_retry_after(tmp_path, factory):
+    with live_server(tmp_path, factory, max_waiting=1, max_queued=2) as srv:
+        first = srv.create()
+        srv.wait_state(first["id"], "waiting_for_client")
+        queued = [srv.create(), srv.create()]
+        assert all(srv.http.get(f"/runs/{r['id']}").json()["state"] == "queued" for r in queued)
+        r = srv.http.post("/runs", json=_coupled_body())
+        assert r.status_code == 429 and int(r.headers["retry-after"]) > 0
+        assert "max_queued" in r.json()["detail"]
+        assert len(srv.http.get("/runs").json()) == 3  # the refused run was not created
+        srv.http.delete(f"/runs/{queued[0]['id']}")
+        assert srv.http.post("/runs", json=_coupled_body()).status_code == 201
+
+
+# 2. big scenes: a probe cap, and validation off the event loop -----------------------------------
+def test_probe_count_is_capped(srv):
+    probes = [{"kind": "elevation", "name": f"p{i}", "x": 0.5} for i in range(20_000)]
+    r = srv.http.post("/runs", json={"scene": scene(probes=probes), "mode": "standalone"})
+    assert r.status_code == 422
+    (err,) = r.json()["detail"]
+    assert err["loc"] == ["body", "scene", "probes"] and "max_probes" in err["msg"]
+
+
+def test_duplicate_probe_names_are_named(srv):
+    probes = [{"kind": "elevation", "name": f"p{i % 500}", "x": 0.5} for i in range(1000)]
+    r = srv.http.post("/runs", json={"scene": scene(probes=probes), "mode": "standalone"})
+    assert r.status_code == 422 and "duplicate names ['p0', 'p1'" in r.text
+
+
+def test_request_validation_runs_off_the_event_loop(tmp_path, factory, monkeypatch):
+    import threading
+    import time
+
+    import httpx
+
+    import server.routers.runs as runs_router
+
+    real = runs_router.parse_run_request
+
+    def slow(raw, settings):  # stands for a heavy validation: it must not stall the server
+        time.sleep(1.0)
+        return real(raw, settings)
+
+    monkeypatch.setattr(runs_router, "parse_run_request", slow)
+    with live_server(tmp_path, factory) as srv:
+        done = []
+        post = threading.Thread(target=lambda: done.append(
+            httpx.post(srv.url + "/runs", json=_coupled_body(), timeout=30).status_code))
+        post.start()
+        time.sleep(0.2)
+        for _ in range(3):  # each well under the 1 s validation
+            assert srv.http.get("/runs", timeout=0.5).status_code == 200
+        post.join(timeout=30)
+        assert done == [201]
+
+
+# 3. NaN, Infinity, overflow: 422 naming the field, never 500, never NaN in the reply ------------
+@pytest.mark.parametrize("text, loc", [
+    ('"dp": NaN', ["body", "scene", "dp"]),
+    ('"t_end": Infinity', ["body", "scene", "t_end"]),
+    ('"t_end": -Infinity', ["body", "scene", "t_end"]),
+    ('"still_water_level": NaN', ["body", "scene", "still_water_level"]),
+    ('"dp": 1e400', ["body", "scene", "dp"]),
+    ('"constants": {"g": NaN}', ["body", "scene", "constants", "g"]),
+    ('"beds": [{"points": [[0.0, 0.0], [NaN, 0.1], [1.0, 0.2]]}]', ["body", "scene", "beds", 0, "points", 1, 0]),
+])
+def test_non_finite_numbers_are_a_422_naming_the_field(srv, text, loc):
+    base = _coupled_body()
+    base["scene"].pop(text.split('"')[1], None)
+    # the raw JSON token goes in as text: json.dumps would not write 1e400 (Python clients do
+    # send NaN and Infinity by default)
+    raw = json.dumps(base).replace('"scene": {', '"scene": {' + text + ", ", 1)
+    r = srv.http.post("/runs", content=raw, headers={"content-type": "application/json"})
+    assert r.status_code == 422, r.text
+    detail = json.loads(r.text, parse_constant=_strict)["detail"]  # the reply is strict JSON
+    assert [e["loc"] for e in detail] == [loc]
+    assert srv.http.get("/runs").json() == []
+
+
+@pytest.mark.parametrize("overrides", [
+    {"tank": {"x0": -1e308, "x1": 1e308, "z0": 0.0, "z1": 0.5}},
+    {"dp": 5e-324},
+])
+def test_overflowing_particle_estimate_is_the_particle_cap(srv, overrides):
+    body = _coupled_body()
+    body["scene"].update(overrides)
+    body["scene"]["water_blocks"] = [{"x0": 0.0, "x1": 1.0, "z0": 0.0, "z1": 0.3}]
+    r = srv.http.post("/runs", json=body)
+    assert r.status_code == 422, r.text
+    assert r.json()["detail"][0]["loc"] == ["body", "scene", "dp"]
+
+
+def test_estimate_particles_never_raises():
+    from server.schemas import estimate_particles
+    from sph_core.scene import Scene
+
+    s = Scene.model_validate(scene(dp=5e-324))
+    assert estimate_particles(s) == math.inf
+    s = Scene.model_validate(scene(tank={"x0": -1e308, "x1": 1e308, "z0": 0.0, "z1": 1e308}))
+    assert estimate_particles(s) == math.inf
+    assert 100 < estimate_particles(Scene.model_validate(scene())) < 1000
+
+
+# 5. everything a run needs, checked before the 201 ----------------------------------------------
+@pytest.mark.parametrize("change, loc", [
+    ({"coupling": {"window_max": 1e-300}}, ["body", "coupling", "window_max"]),
+    ({"coupling": {"z_ref": -5.0}}, ["body", "coupling", "z_ref"]),
+    ({"coupling": {"window_max": "Infinity"}}, ["body", "coupling", "window_max"]),
+])
+def test_coupling_options_a_run_cannot_use_are_a_422(srv, change, loc):
+    body = {**_coupled_body(), **change}
+    r = srv.http.post("/runs", content=json.dumps(body).replace('"Infinity"', "Infinity"),
+                      headers={"content-type": "application/json"})
+    assert r.status_code == 422, r.text
+    assert r.json()["detail"][0]["loc"] == loc
+
+
+def test_tiny_source_window_is_a_422(srv):
+    body = {**_coupled_body(), "mode": "standalone",
+            "source": {"theory": "linear", "H": 0.02, "T": 1.0, "window": 1e-300}}
+    r = srv.http.post("/runs", json=body)
+    assert r.status_code == 422, r.text
+    assert r.json()["detail"][0]["loc"] == ["body", "source", "window"]
+
+
+# 8. body size, no echo, the answers in OpenAPI --------------------------------------------------
+def test_body_over_max_body_is_a_413(tmp_path, factory):
+    with live_server(tmp_path, factory, max_body=64 * 1024) as srv:
+        body = _coupled_body(name="x" * 100_000)
+        r = srv.http.post("/runs", json=body)
+        assert r.status_code == 413 and "max_body" in r.text
+
+
+def test_422_does_not_echo_the_input_and_400_for_non_json(srv):
+    r = srv.http.post("/runs", json={**_coupled_body(), "mode": "m" * 500_000})
+    assert r.status_code == 422 and len(r.content) < 2000
+    assert r.json()["detail"][0]["loc"] == ["body", "mode"]
+    r = srv.http.post("/runs", content=b"{not json", headers={"content-type": "application/json"})
+    assert r.status_code == 400 and "not JSON" in r.json()["detail"]
+
+
+def test_openapi_lists_the_error_answers_and_the_body(srv):
+    paths = srv.http.get("/openapi.json").json()["paths"]
+    post = paths["/runs"]["post"]
+    assert {"201", "400", "413", "422", "429"} <= set(post["responses"])
+    assert post["requestBody"]["content"]["application/json"]["schema"]["$ref"].endswith("/RunRequest")
+    assert {"404"} <= set(paths["/runs/{run_id}"]["get"]["responses"])
+    assert {"404", "409"} <= set(paths["/runs/{run_id}/resume"]["post"]["responses"])
