@@ -10,6 +10,7 @@ from fastapi.exceptions import RequestValidationError
 from fastapi.openapi.utils import get_openapi
 from fastapi.responses import JSONResponse
 
+from .deps import redact_tokens_in_server_logs
 from .engine import EngineFactory
 from .flume_engine import flume_engine
 from .routers import couple, runs
@@ -31,6 +32,7 @@ def create_app(settings: Settings | None = None,
 
     @asynccontextmanager
     async def lifespan(app: FastAPI):
+        redact_tokens_in_server_logs()  # after uvicorn configured its logging
         manager = RunManager(settings, engine_factory, serve_theory)
         app.state.manager = manager
         tcp = None

@@ -111,9 +111,11 @@ class RunManager:
         for info, request in self.store.load_all():
             try:
                 req = RunRequest.model_validate(request)
-            except ValueError:
+            except ValueError as exc:
+                log.warning("run store: skipping run %s: its request.json is not valid: %s",
+                            info.id, str(exc).splitlines()[0][:200])
                 continue
-            run = Run(info, req, self.store.root / info.id)
+            run = Run(info, req, self.store.run_dir(info.id))
             self.runs[info.id] = run
             if not run.terminal:
                 self._set_state(run, FAILED, "server stopped before the run ended")

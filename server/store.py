@@ -13,7 +13,9 @@ from __future__ import annotations
 
 import csv
 import json
+import logging
 import os
+import re
 from pathlib import Path
 from typing import Any
 
@@ -22,6 +24,9 @@ from sph_core.output import write_json_atomic
 from .schemas import RunInfo
 
 META = "meta.json"
+RUN_ID = re.compile(r"[A-Za-z0-9_-]{1,64}")  # a run's directory name: never a path
+
+log = logging.getLogger("wavesph.server")
 
 
 class RunStore:
@@ -29,25 +34,41 @@ class RunStore:
         self.root = Path(root)
         self.root.mkdir(parents=True, exist_ok=True)
 
+    def run_dir(self, run_id: str) -> Path:
+        """The run's directory, inside the store whatever the id says (ValueError if not a name)."""
+        if not RUN_ID.fullmatch(run_id):
+            raise ValueError(f"run id {run_id[:80]!r} is not a plain name ({RUN_ID.pattern})")
+        return self.root / run_id
+
     def create(self, run_id: str, request: dict[str, Any], scene_bytes: bytes) -> Path:
-        d = self.root / run_id
+        d = self.run_dir(run_id)
         d.mkdir()
         write_json_atomic(d / "request.json", request)
         (d / "scene.json").write_bytes(scene_bytes)
         return d
 
     def save(self, info: RunInfo) -> None:
-        write_json_atomic(self.root / info.id / META, info.model_dump(mode="json"))
+        write_json_atomic(self.run_dir(info.id) / META, info.model_dump(mode="json"))
 
     def load_all(self) -> list[tuple[RunInfo, dict[str, Any]]]:
-        """Every run found on disk with its request; unreadable directories are skipped."""
+        """Every run found on disk with its request. The directory's name is the run's id (a
+        directory moved or copied keeps working); an entry that cannot be read is skipped with
+        a log line, never stops the server."""
         out = []
         for d in sorted(self.root.iterdir()):
+            if not d.is_dir() or not RUN_ID.fullmatch(d.name):
+                log.warning("run store: skipping %s: not a run directory", d)
+                continue
             try:
                 info = RunInfo.model_validate_json((d / META).read_text())
                 request = json.loads((d / "request.json").read_text())
-            except (OSError, ValueError):
+            except (OSError, ValueError) as exc:
+                log.warning("run store: skipping %s: %s", d, str(exc).splitlines()[0][:200])
                 continue
+            if info.id != d.name:
+                log.warning("run store: %s names run %r; the run is %r, its directory's name",
+                            d / META, info.id[:80], d.name)
+                info = info.model_copy(update={"id": d.name})
             out.append((info, request))
         return out
 

@@ -10,7 +10,7 @@ from protocol import ErrorCode, Hello, ProtocolError
 from protocol.session import HELLO_LIMIT
 
 from ..coupling import error_frame, serve_client
-from ..deps import websocket_token_ok
+from ..deps import websocket_subprotocol, websocket_token_ok
 from ..transports import WebSocketDoor
 
 router = APIRouter(tags=["coupling"])
@@ -21,7 +21,7 @@ async def couple(ws: WebSocket, run_id: str) -> None:
     if not websocket_token_ok(ws):
         await ws.close(code=1008, reason="missing or wrong API token")
         return
-    await ws.accept()
+    await ws.accept(subprotocol=websocket_subprotocol(ws))
     manager = ws.app.state.manager
     transport = WebSocketDoor(ws, min(HELLO_LIMIT, manager.settings.max_frame))
     seq = 0

@@ -29,9 +29,9 @@ def scene(**overrides) -> dict:
 
 
 class LiveServer:
-    def __init__(self, app, settings: Settings) -> None:
+    def __init__(self, app, settings: Settings, log_level: str = "warning") -> None:
         self.app, self.settings = app, settings
-        config = uvicorn.Config(app, host="127.0.0.1", port=0, log_level="warning",
+        config = uvicorn.Config(app, host="127.0.0.1", port=0, log_level=log_level,
                                 ws_max_size=settings.max_frame + 16, lifespan="on",
                                 ws_per_message_deflate=False)  # as `wavesph serve`
         self.server = uvicorn.Server(config)
@@ -80,8 +80,8 @@ class LiveServer:
 
 
 @contextmanager
-def live_server(tmp_path: Path, engine_factory=None, **settings):
+def live_server(tmp_path: Path, engine_factory=None, log_level: str = "warning", **settings):
     s = Settings(runs_dir=tmp_path / "runs", tcp_port=0, port=0, **settings)
     app = create_app(s) if engine_factory is None else create_app(s, engine_factory)
-    with LiveServer(app, s) as srv:
+    with LiveServer(app, s, log_level) as srv:
         yield srv

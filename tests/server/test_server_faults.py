@@ -178,3 +178,84 @@ def test_openapi_lists_the_error_answers_and_the_body(srv):
     assert post["requestBody"]["content"]["application/json"]["schema"]["$ref"].endswith("/RunRequest")
     assert {"404"} <= set(paths["/runs/{run_id}"]["get"]["responses"])
     assert {"404", "409"} <= set(paths["/runs/{run_id}/resume"]["post"]["responses"])
+
+
+# 4. the run store trusts its directory names and stays inside itself -----------------------------
+def test_store_skips_bad_entries_and_never_writes_outside_itself(tmp_path, factory, caplog):
+    import logging
+    import shutil
+
+    with live_server(tmp_path, factory) as srv:
+        a, b = srv.create(), srv.create()
+        for run in (a, b):
+            srv.wait_state(run["id"], "waiting_for_client")
+    runs = tmp_path / "runs"
+    moved = runs / "moved-run"
+    shutil.move(runs / a["id"], moved)  # meta.json still names the old id
+    meta = json.loads((runs / b["id"] / "meta.json").read_text())
+    (runs / b["id"] / "meta.json").write_text(json.dumps({**meta, "id": "../escaped"}))
+    (runs / "garbage").mkdir()
+    (runs / "garbage" / "meta.json").write_text("{not json")
+    (runs / "stray.txt").write_text("not a run")
+    caplog.set_level(logging.WARNING, logger="wavesph.server")
+    with live_server(tmp_path, factory) as srv:
+        listed = {r["id"]: r for r in srv.http.get("/runs").json()}
+        assert set(listed) == {"moved-run", b["id"]}
+        assert listed["moved-run"]["status"] == listed[b["id"]]["status"]
+        assert srv.http.get("/runs/moved-run/scene").status_code == 200
+        for run in srv.manager.runs.values():  # a record rewritten goes to its own directory
+            srv.manager.save(run)
+    assert not (tmp_path / "escaped").exists() and not (runs.parent / "escaped").exists()
+    assert json.loads((moved / "meta.json").read_text())["id"] == "moved-run"
+    assert json.loads((runs / b["id"] / "meta.json").read_text())["id"] == b["id"]
+    logged = caplog.text
+    assert "garbage" in logged and "stray.txt" in logged and "moved-run" in logged
+
+
+# 6. the API token: never in a log line; a header or a subprotocol work too ---------------------
+def test_websocket_token_is_redacted_in_logs_and_accepted_as_header_or_subprotocol(tmp_path, factory):
+    import logging
+
+    from websockets.sync.client import connect
+
+    from coupling_client import WsClient, bye, handshake, run_windows
+
+    token = "s3cret-token-0123456789"
+    lines: list[str] = []
+
+    class Keep(logging.Handler):
+        def emit(self, record: logging.LogRecord) -> None:
+            lines.append(record.getMessage())
+
+    keep = Keep()
+    loggers = [logging.getLogger(n) for n in ("uvicorn.access", "uvicorn.error")]
+    try:
+        with live_server(tmp_path, factory, log_level="info", token=token) as srv:
+            for lg in loggers:  # after uvicorn configured its logging
+                lg.addHandler(keep)
+            runs = [srv.create() for _ in range(3)]
+            for run in runs:
+                srv.wait_state(run["id"], "waiting_for_client")
+            base = f"ws://127.0.0.1:{srv.port}/runs"
+            # 1. ?token= (documented): works, and the log shows it redacted
+            c = WsClient(f"{base}/{runs[0]['id']}/couple?token={token}")
+            welcome, nodes = handshake(c, runs[0]["id"])
+            run_windows(c, welcome, nodes, 1)
+            bye(c)
+            # 2. a subprotocol beside "wavesph", which the server selects
+            with connect(f"{base}/{runs[1]['id']}/couple",
+                         subprotocols=["wavesph", f"wavesph.token.{token}"]) as ws:
+                assert ws.subprotocol == "wavesph"
+            # 3. the Authorization header
+            with connect(f"{base}/{runs[2]['id']}/couple",
+                         additional_headers={"Authorization": f"Bearer {token}"}):
+                pass
+            # a wrong token in any form is refused
+            with pytest.raises(Exception, match="403"):
+                connect(f"{base}/{runs[2]['id']}/couple?token=wrong-token-0123456789")
+    finally:
+        for lg in loggers:
+            lg.removeHandler(keep)
+    text = "\n".join(lines)
+    assert "token=***" in text  # the access line was logged, redacted
+    assert token not in text and "wrong-token" not in text
