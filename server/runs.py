@@ -137,6 +137,8 @@ class RunManager:
             run.info.queue_position = None
         log.info("run %s: %s", run.info.id, run.info.status)
         self.save(run)
+        if state in TERMINAL and (run.info.id in self.active or run.info.id in self.waiting):
+            self._release(run)  # a run that says it ended holds no slot (its engine may still close)
 
     def _queue_positions(self) -> None:
         for i, rid in enumerate(self.queue):
@@ -184,6 +186,8 @@ class RunManager:
     def _schedule(self) -> None:
         """Start every queued run that has room, in queue order: a coupled run needs a waiting
         place, any other run a stepping slot (so one kind never waits behind the other)."""
+        if self.stopping:
+            return
         for rid in list(self.queue):
             run = self.runs[rid]
             if _waits_for_client(run.request):
