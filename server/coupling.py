@@ -37,6 +37,36 @@ def error_frame(code: ErrorCode, text: str, seq: int = 0) -> bytes:
     return encode_frame(Error(int(code), text[:4000]), seq)
 
 
+async def claim_run(manager: RunManager, run_id: str, transport: DoorTransport) -> Run | None:
+    """The run a client's HELLO names, reserved for it at once and attached (a stepping slot
+    taken) when it is built and a slot is free; the client waits for WELCOME meanwhile. None if
+    the client left while waiting; ProtocolError (BUSY, CANCELLED, OUT_OF_ORDER) to refuse it."""
+    try:
+        run = manager.reserve(run_id)
+    except ValueError as exc:
+        raise ProtocolError(ErrorCode.BUSY, str(exc)) from None
+    attach = asyncio.ensure_future(manager.attach(run))
+    recv = asyncio.ensure_future(transport.recv())
+    try:
+        await asyncio.wait({attach, recv}, return_when=asyncio.FIRST_COMPLETED)
+        if recv.done():
+            if recv.result() is None:  # the client left; a ProtocolError passes through
+                return None
+            raise ProtocolError(ErrorCode.OUT_OF_ORDER, "a frame after HELLO, before WELCOME: "
+                                                        "wait for WELCOME")
+        try:
+            attach.result()
+        except ValueError as exc:
+            code = ErrorCode.CANCELLED if run.info.state == "cancelled" else ErrorCode.BUSY
+            raise ProtocolError(code, str(exc)) from None
+        return run
+    finally:
+        for task in (attach, recv):
+            task.cancel()
+        if not run.attached.is_set():
+            manager.unreserve(run)
+
+
 def welcome_for(run: Run, engine: CouplingEngine, idle_timeout: float) -> tuple[Welcome, Nodes]:
     s, nodes = engine.summary, engine.nodes()
     welcome = Welcome(int(Capability.GOBACK), bytes.fromhex(run.info.scene_hash), g=s.g, depth=s.depth,

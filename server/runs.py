@@ -103,6 +103,7 @@ class RunManager:
         self.executor = ThreadPoolExecutor(max_workers=settings.max_runs, thread_name_prefix="sph")
         self.builder = ThreadPoolExecutor(max_workers=1, thread_name_prefix="sph-build")
         self.stopping = False
+        self._changed = asyncio.Event()
         self._load_existing()
 
     # ------------------------------------------------------------------ records
@@ -137,6 +138,7 @@ class RunManager:
             run.info.queue_position = None
         log.info("run %s: %s", run.info.id, run.info.status)
         self.save(run)
+        self._pulse()
         if state in TERMINAL and (run.info.id in self.active or run.info.id in self.waiting):
             self._release(run)  # a run that says it ended holds no slot (its engine may still close)
 
@@ -208,6 +210,7 @@ class RunManager:
         self.active.discard(run.info.id)
         self.waiting.discard(run.info.id)
         self._schedule()
+        self._pulse()
 
     def cancel(self, run: Run) -> None:
         if run.terminal:
@@ -229,6 +232,7 @@ class RunManager:
 
     async def shutdown(self) -> None:
         self.stopping = True
+        self._pulse()
         for run in list(self.runs.values()):
             if not run.terminal:
                 run.cancel_flag.set()
@@ -316,14 +320,19 @@ class RunManager:
             if run.request.source is not None:  # standalone, driven by a built-in theory client
                 if self.source_driver is None:
                     raise RuntimeError("this server has no driver for built-in wave sources")
-                self.attach(run.info.id)
+                run.client_attached = True  # it took its stepping slot when it left the queue
+                run.attached.set()
                 run.task_client = asyncio.get_running_loop().create_task(self.source_driver(self, run))
-            woke = await _first_of(run.attached, run.cancelled, self.settings.client_wait_timeout)
+            while True:
+                woke = await _first_of(run.attached, run.cancelled, self.settings.client_wait_timeout)
+                if woke is None and run.client_attached:
+                    continue  # its client is connected (reserved it) and waits for a slot
+                break
             if woke is None:
                 self._set_state(run, FAILED, f"no client connected within "
                                              f"{self.settings.client_wait_timeout:g} s")
-            elif woke is run.cancelled and not run.client_attached:
-                self._set_state(run, *self.cancel_reason)
+            elif woke is run.cancelled and not run.attached.is_set():
+                self._set_state(run, *self.cancel_reason)  # a reserving client is told by its door
             else:
                 await run.session_done.wait()  # the door sets the final state
         except Exception as exc:  # noqa: BLE001
@@ -335,26 +344,46 @@ class RunManager:
                 await loop.run_in_executor(self.builder, run.engine.close)
             self._release(run)
 
-    def attach(self, run_id: str) -> Run:
-        """Give a connecting client its run and a stepping slot; ValueError says why not (sent as
-        ERROR BUSY)."""
+    # ------------------------------------------------------------------ coupling clients
+    def reserve(self, run_id: str) -> Run:
+        """A client's HELLO names a coupled run: the run is its own from now on (another HELLO
+        naming it is refused), even while it is queued or every stepping slot is busy; the door
+        then waits in ``attach``. ValueError says why not (sent as ERROR BUSY)."""
         run = self.runs.get(run_id)
         if run is None:
             raise ValueError(f"no run {run_id!r} on this server")
-        if run.client_attached or run.info.state != WAITING:
-            why = "already has a coupling client" if run.client_attached else f"is {run.info.status}"
-            raise ValueError(f"run {run_id} {why}")
-        if run_id not in self.active:  # a coupled run takes its stepping slot now
-            if len(self.active) >= self.settings.max_runs:
-                raise ValueError(f"run {run_id} is waiting for a client, but all "
-                                 f"{self.settings.max_runs} stepping slots of this server are "
-                                 f"in use: retry later (the run keeps waiting)")
-            self.waiting.discard(run_id)
-            self.active.add(run_id)
-            self._schedule()  # its waiting place is free for the next queued coupled run
+        if run.client_attached:
+            raise ValueError(f"run {run_id} already has a coupling client")
+        if run.info.state not in (QUEUED, WAITING) or not _waits_for_client(run.request):
+            raise ValueError(f"run {run_id} is {run.info.status}: it takes no coupling client")
         run.client_attached = True
-        run.attached.set()
         return run
+
+    def unreserve(self, run: Run) -> None:
+        """The reserving client left before its session began."""
+        if not run.attached.is_set():
+            run.client_attached = False
+
+    async def attach(self, run: Run) -> None:
+        """Wait until the reserved run is built and a stepping slot is free, then take the slot.
+        ValueError if the run ended meanwhile (cancelled, failed)."""
+        while True:
+            if self.stopping:
+                raise ValueError("the server is stopping")
+            if run.terminal:
+                raise ValueError(f"run {run.info.id} is {run.info.status}")
+            if run.info.state == WAITING and len(self.active) < self.settings.max_runs:
+                self.waiting.discard(run.info.id)
+                self.active.add(run.info.id)
+                run.attached.set()
+                self._schedule()  # its waiting place is free for the next queued coupled run
+                return
+            await self._changed.wait()
+
+    def _pulse(self) -> None:
+        """Wake every door waiting in ``attach``: a state or a slot changed."""
+        self._changed.set()
+        self._changed = asyncio.Event()
 
 
 def _waits_for_client(request: RunRequest) -> bool:

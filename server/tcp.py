@@ -8,7 +8,7 @@ import logging
 from protocol import ErrorCode, Hello, ProtocolError
 from protocol.session import HELLO_LIMIT
 
-from .coupling import error_frame, serve_client
+from .coupling import claim_run, error_frame, serve_client
 from .runs import RunManager
 from .transports import TcpDoor
 
@@ -38,10 +38,9 @@ async def _handle(manager: RunManager, transport: TcpDoor) -> None:
             raise ProtocolError(ErrorCode.OUT_OF_ORDER, f"{msg.TYPE.name} before HELLO")
         if not msg.run_id:
             raise ProtocolError(ErrorCode.BUSY, "HELLO.run_id is empty: the TCP port needs the run id")
-        try:
-            run = manager.attach(msg.run_id)
-        except ValueError as exc:
-            raise ProtocolError(ErrorCode.BUSY, str(exc)) from None
+        run = await claim_run(manager, msg.run_id, transport)
+        if run is None:
+            return await transport.close()
     except ProtocolError as exc:
         await _refuse(transport, exc.code, exc.text, seq)
         return

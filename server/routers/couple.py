@@ -9,7 +9,7 @@ from fastapi import APIRouter, WebSocket
 from protocol import ErrorCode, Hello, ProtocolError
 from protocol.session import HELLO_LIMIT
 
-from ..coupling import error_frame, serve_client
+from ..coupling import claim_run, error_frame, serve_client
 from ..deps import websocket_subprotocol, websocket_token_ok
 from ..transports import WebSocketDoor
 
@@ -34,10 +34,9 @@ async def couple(ws: WebSocket, run_id: str) -> None:
             raise ProtocolError(ErrorCode.OUT_OF_ORDER, f"{msg.TYPE.name} before HELLO")
         if msg.run_id not in ("", run_id):
             raise ProtocolError(ErrorCode.BUSY, f"HELLO.run_id {msg.run_id!r} differs from the URL's {run_id!r}")
-        try:
-            run = manager.attach(run_id)
-        except ValueError as exc:
-            raise ProtocolError(ErrorCode.BUSY, str(exc)) from None
+        run = await claim_run(manager, run_id, transport)
+        if run is None:
+            return await transport.close()
     except ProtocolError as exc:
         await _refuse(transport, exc.code, exc.text, seq)
         return

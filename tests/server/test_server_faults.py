@@ -259,3 +259,49 @@ def test_websocket_token_is_redacted_in_logs_and_accepted_as_header_or_subprotoc
     text = "\n".join(lines)
     assert "token=***" in text  # the access line was logged, redacted
     assert token not in text and "wrong-token" not in text
+
+
+# 7. a client may come before its run is started: it reserves the run and waits ----------------
+def test_client_of_a_queued_run_reserves_it_and_waits_for_welcome(tmp_path, factory):
+    from protocol import ErrorCode, GetNodes, Hello, Nodes, RemoteError, Welcome
+
+    from coupling_client import TcpClient, bye, run_windows
+
+    with live_server(tmp_path, factory, max_waiting=1) as srv:
+        first = srv.create()
+        srv.wait_state(first["id"], "waiting_for_client")
+        queued, other = srv.create(), srv.create()
+        assert srv.http.get(f"/runs/{queued['id']}").json()["state"] == "queued"
+        owner = TcpClient(srv.tcp_port)
+        owner.request(Hello(1, bytes(32), queued["id"], "owner"))
+        intruder = TcpClient(srv.tcp_port)
+        intruder.request(Hello(1, bytes(32), queued["id"], "intruder"))
+        with pytest.raises(RemoteError) as exc:
+            intruder.session.reply(*intruder.recv(), expect=Welcome)
+        assert exc.value.code == ErrorCode.BUSY and "already has a coupling client" in exc.value.text
+        # a client that leaves while waiting frees the run for the next one
+        leaver = TcpClient(srv.tcp_port)
+        leaver.request(Hello(1, bytes(32), other["id"], "leaver"))
+        leaver.close()
+        # the first run ends: the queued one is built and its waiting client gets WELCOME
+        assert srv.http.delete(f"/runs/{first['id']}").json()["state"] == "cancelled"
+        welcome = owner.session.reply(*owner.recv(), expect=Welcome)
+        nodes = owner.request(GetNodes(), expect=Nodes)
+        run_windows(owner, welcome, nodes, 1)
+        bye(owner)
+        assert srv.wait_state(queued["id"], "finished")["client"] == "owner"
+        srv.wait_state(other["id"], "waiting_for_client")
+        late = TcpClient(srv.tcp_port)
+        late.request(Hello(1, bytes(32), other["id"], "late"))
+        late.session.reply(*late.recv(), expect=Welcome)
+        # cancelling a reserved, still queued run tells its waiting client
+        filler = srv.create()  # takes the one waiting place
+        srv.wait_state(filler["id"], "waiting_for_client")
+        third = srv.create()
+        assert srv.http.get(f"/runs/{third['id']}").json()["state"] == "queued"
+        waiter = TcpClient(srv.tcp_port)
+        waiter.request(Hello(1, bytes(32), third["id"], "waiter"))
+        srv.http.delete(f"/runs/{third['id']}")
+        with pytest.raises(RemoteError) as exc:
+            waiter.session.reply(*waiter.recv(), expect=Welcome)
+        assert exc.value.code == ErrorCode.CANCELLED

@@ -10,7 +10,7 @@ import pytest
 from fastapi.testclient import TestClient
 from pydantic import ValidationError
 
-from protocol import ErrorCode, Hello, RemoteError, Welcome
+from protocol import ErrorCode, GetNodes, Hello, Nodes, RemoteError, Welcome
 from server.main import create_app
 from server.settings import Settings
 
@@ -67,18 +67,21 @@ def test_concurrency_cap_queues_runs(tmp_path, factory):
         c = TcpClient(srv.tcp_port)
         welcome, nodes = handshake(c, first["id"])
         srv.wait_state(second["id"], "waiting_for_client")
-        # while the first steps, the second's client is told to retry, and the run keeps waiting
+        # while the first steps, the second's client waits for WELCOME (the run is its own)
         c2 = TcpClient(srv.tcp_port)
         c2.request(Hello(1, bytes(32), second["id"], "pytest"))
+        c3 = TcpClient(srv.tcp_port)  # another holder of the id cannot take it
+        c3.request(Hello(1, bytes(32), second["id"], "intruder"))
         with pytest.raises(RemoteError) as exc:
-            c2.session.reply(*c2.recv(), expect=Welcome)
-        assert exc.value.code == ErrorCode.BUSY and "stepping slots" in exc.value.text
+            c3.session.reply(*c3.recv(), expect=Welcome)
+        assert exc.value.code == ErrorCode.BUSY and "already has a coupling client" in exc.value.text
+        assert srv.http.get(f"/runs/{second['id']}").json()["state"] == "waiting_for_client"
         # finishing the first run frees its slot for the second
         run_windows(c, welcome, nodes, 1)
         bye(c)
         srv.wait_state(first["id"], "finished")
-        c2 = TcpClient(srv.tcp_port)
-        welcome, nodes = handshake(c2, second["id"])
+        welcome = c2.session.reply(*c2.recv(), expect=Welcome)
+        nodes = c2.request(GetNodes(), expect=Nodes)
         run_windows(c2, welcome, nodes, 1)
         bye(c2)
         srv.wait_state(second["id"], "finished")
