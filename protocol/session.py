@@ -139,6 +139,9 @@ class SphSession:
             if not isinstance(msg, Hello):
                 raise ProtocolError(ErrorCode.OUT_OF_ORDER, f"{msg.TYPE.name} before HELLO")
             return self._hello(msg)
+        if isinstance(msg, Hello):
+            raise ProtocolError(ErrorCode.OUT_OF_ORDER, "a second HELLO: this session is open "
+                                                        "already (one HELLO per connection)")
         if isinstance(msg, GetNodes):
             return Reply(self._frame(self.nodes))
         if isinstance(msg, Set):

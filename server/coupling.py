@@ -19,6 +19,7 @@ from protocol.session import Measure, PeerError, Reply, Restore, SetWindow, Solv
 
 from .engine import CouplingEngine, Measurement
 from .runs import FAILED, FINISHED, RUNNING, UNSTABLE, Run, RunManager
+from .store import save_sealed
 from .transports import DoorTransport, PeerGone
 
 log = logging.getLogger("wavesph.server")
@@ -228,7 +229,8 @@ async def _save_state(manager: RunManager, run: Run) -> None:
     if save is None:
         return
     try:
-        await asyncio.get_running_loop().run_in_executor(manager.executor, save, run.state_file)
+        await asyncio.get_running_loop().run_in_executor(manager.executor, save_sealed, save,
+                                                         run.state_file)
     except Exception:  # noqa: BLE001 -- the run's data are in gauges.csv; only resuming is lost
         log.exception("run %s: could not save the engine state", run.info.id)
 

@@ -29,7 +29,7 @@ from protocol.session import set_payload_size
 from .engine import CouplingEngine, EngineFactory
 from .schemas import RunInfo, RunRequest, canonical_scene
 from .settings import Settings
-from .store import GaugeWriter, RunStore
+from .store import GaugeWriter, RunStore, has_seal, is_sealed, read_gauges
 
 log = logging.getLogger("wavesph.server")
 
@@ -118,8 +118,44 @@ class RunManager:
                 continue
             run = Run(info, req, self.store.run_dir(info.id))
             self.runs[info.id] = run
+            self._catch_up_with_gauges(run)
             if not run.terminal:
                 self._set_state(run, FAILED, "server stopped before the run ended")
+            if run.info.resumable and not self.state_intact(run):
+                self.save(run)
+
+    def _catch_up_with_gauges(self, run: Run) -> None:
+        """meta.json is rewritten at most every meta_interval, gauges.csv row by row: after a
+        crash, the gauge rows say how far a coupled run got."""
+        path = run.dir / "gauges.csv"
+        if not _windowed(run.request) or not path.exists():
+            return
+        try:
+            _, rows = read_gauges(path)
+        except (OSError, ValueError) as exc:
+            log.warning("run %s: gauges.csv unreadable (%s); its record is kept as it was",
+                        run.info.id, exc)
+            return
+        if len(rows) != run.info.windows and rows:
+            last = rows[-1]
+            run.info.windows, run.info.t = len(rows), float(last["t"])
+            run.info.steps = int(sum(r["steps"] or 0 for r in rows))
+            run.info.last_gauges = {k: v for k, v in last.items() if k not in ("t", "steps")}
+            log.warning("run %s: meta.json lagged gauges.csv; now %d windows to t = %g s",
+                        run.info.id, run.info.windows, run.info.t)
+
+    def state_intact(self, run: Run) -> bool:
+        """The saved state matches its seal; if not, the run is no longer resumable (says why).
+        Reads the whole state file: call it off the event loop for a live server."""
+        if is_sealed(run.state_file):
+            return True
+        if run.info.resumable:
+            run.info.resumable = False
+            run.info.reason = f"{run.info.reason or run.info.state}; its saved state is damaged"
+            if run.info.state in (FAILED, UNSTABLE):
+                run.info.status = f"{run.info.state}: {run.info.reason}"
+            log.warning("run %s: state.pkl does not match its seal: not resumable", run.info.id)
+        return False
 
     def save(self, run: Run, force: bool = True) -> None:
         now = time.monotonic()
@@ -132,7 +168,7 @@ class RunManager:
         run.info.reason = reason
         run.info.status = f"{state}: {reason}" if reason and state in (FAILED, UNSTABLE) else state
         run.info.resumable = (state in (FAILED, CANCELLED) and _windowed(run.request)
-                              and run.state_file.exists())
+                              and has_seal(run.state_file))
         if state in TERMINAL:
             run.info.ended = time.time()
             run.info.queue_position = None
@@ -172,6 +208,8 @@ class RunManager:
 
     def resume(self, run: Run) -> None:
         """Queue a failed or cancelled coupled run again, from its saved state."""
+        if run.info.resumable and not has_seal(run.state_file):
+            run.info.resumable = False
         if not run.info.resumable:
             raise ValueError(f"run {run.info.id} is {run.info.status}: only a failed or cancelled "
                              f"coupled run with a saved state can be resumed")

@@ -42,8 +42,11 @@ class Settings(BaseModel):
     @model_validator(mode="after")
     def _token_off_loopback(self) -> "Settings":
         if not self.loopback_only and not self.token:
+            public = [f"{name} {h!r}" for name, h in (("host", self.host),
+                                                     ("tcp_host", self.tcp_host or self.host))
+                      if not _is_loopback(h)]
             raise ValueError("token: an API token (>= 16 characters) is required when binding "
-                             f"{self.host!r}, which is not a loopback address")
+                             f"{' and '.join(public)}, not a loopback address")
         return self
 
     @classmethod

@@ -6,18 +6,20 @@
         meta.json      RunInfo: status, progress, speed, stability, last gauges (atomic rewrite)
         gauges.csv     coupled runs: one row per solved window, flushed at once
         state.pkl      coupled runs: the engine state at a window boundary (to resume the run)
+        state.pkl.sha256  its seal: a state that does not match it is not resumed
         sph/           standalone runs: sph_core's own outputs (probes.csv, meta.json, snapshots/)
 """
 
 from __future__ import annotations
 
 import csv
+import hashlib
 import json
 import logging
 import os
 import re
 from pathlib import Path
-from typing import Any
+from typing import Any, Callable
 
 from sph_core.output import write_json_atomic
 
@@ -71,6 +73,39 @@ class RunStore:
                 info = info.model_copy(update={"id": d.name})
             out.append((info, request))
         return out
+
+
+def _seal_path(path: Path) -> Path:
+    return path.with_name(path.name + ".sha256")
+
+
+def _sha256(path: Path) -> str:
+    h = hashlib.sha256()
+    with open(path, "rb") as f:
+        for block in iter(lambda: f.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
+
+
+def save_sealed(save: Callable[[Path], None], path: Path) -> None:
+    """``save(path)``, then its SHA-256 beside it: a state is trusted only if it matches (a crash
+    between the two leaves a state without a valid seal, which is not resumed)."""
+    _seal_path(path).unlink(missing_ok=True)
+    save(path)
+    _seal_path(path).write_text(_sha256(path) + "\n")
+
+
+def has_seal(path: Path) -> bool:
+    """``path`` and its seal exist (cheap; ``is_sealed`` reads the file)."""
+    return path.exists() and _seal_path(path).exists()
+
+
+def is_sealed(path: Path) -> bool:
+    """``path`` matches its seal: not damaged, not cut short, not from another save."""
+    try:
+        return _seal_path(path).read_text().strip() == _sha256(path)
+    except OSError:
+        return False
 
 
 class GaugeWriter:

@@ -122,6 +122,8 @@ async def resume_run(run: RunDep, manager: Manager) -> RunInfo:
     """Queue a coupled run that failed or was cancelled again, from its last saved window
     boundary (`resumable` in its record); a client then couples from WELCOME's t_start."""
     try:
+        if not await asyncio.to_thread(manager.state_intact, run):
+            manager.save(run)
         manager.resume(run)
     except QueueFull as exc:
         raise _queue_full(exc) from None

@@ -305,3 +305,79 @@ def test_client_of_a_queued_run_reserves_it_and_waits_for_welcome(tmp_path, fact
         with pytest.raises(RemoteError) as exc:
             waiter.session.reply(*waiter.recv(), expect=Welcome)
         assert exc.value.code == ErrorCode.CANCELLED
+
+
+# 9. messages that said the wrong thing ------------------------------------------------------------
+def test_second_hello_is_named_as_such(srv):
+    from protocol import ErrorCode, Hello, RemoteError, Result
+
+    from coupling_client import TcpClient, handshake
+
+    run = srv.create()
+    srv.wait_state(run["id"], "waiting_for_client")
+    c = TcpClient(srv.tcp_port)
+    handshake(c, run["id"])
+    c.request(Hello(1, bytes(32), run["id"], "again"))
+    with pytest.raises(RemoteError) as exc:
+        c.session.reply(*c.recv(), expect=Result)
+    assert exc.value.code == ErrorCode.OUT_OF_ORDER and "second HELLO" in exc.value.text
+    assert "server only" not in exc.value.text
+
+
+def test_public_tcp_host_without_token_names_the_tcp_host(tmp_path):
+    from pydantic import ValidationError
+
+    from server.settings import Settings
+
+    with pytest.raises(ValidationError) as exc:
+        Settings.from_env({"WAVESPH_TCP_HOST": "0.0.0.0", "WAVESPH_RUNS_DIR": str(tmp_path)})
+    text = str(exc.value)
+    assert "tcp_host '0.0.0.0'" in text and "127.0.0.1" not in text
+
+
+def test_meta_catches_up_with_gauges_after_a_crash(tmp_path, factory):
+    import shutil
+
+    from coupling_client import TcpClient, handshake, run_windows
+
+    with live_server(tmp_path, factory, meta_interval=1000.0) as srv:
+        run = srv.create()
+        srv.wait_state(run["id"], "waiting_for_client")
+        c = TcpClient(srv.tcp_port)
+        welcome, nodes = handshake(c, run["id"])
+        run_windows(c, welcome, nodes, 5)
+        # the disk as a kill -9 would leave it now: gauges.csv has 5 rows, meta.json fewer
+        crashed = tmp_path / "crashed" / "runs"
+        shutil.copytree(tmp_path / "runs", crashed)
+        assert json.loads((crashed / run["id"] / "meta.json").read_text())["windows"] < 5
+        c.close()
+    with live_server(tmp_path / "crashed", factory) as srv:
+        info = srv.http.get(f"/runs/{run['id']}").json()
+        assert info["windows"] == 5 and info["t"] == pytest.approx(0.25)
+        assert info["status"] == "failed: server stopped before the run ended"
+        assert info["last_gauges"]["g_mid_eta"] is not None
+
+
+def test_damaged_saved_state_is_not_resumable(tmp_path, factory):
+    from coupling_client import TcpClient, handshake, run_windows
+
+    with live_server(tmp_path, factory) as srv:
+        run = srv.create()
+        srv.wait_state(run["id"], "waiting_for_client")
+        c = TcpClient(srv.tcp_port)
+        welcome, nodes = handshake(c, run["id"])
+        run_windows(c, welcome, nodes, 2)
+        c.close()
+        assert srv.wait_state(run["id"], "failed")["resumable"]
+        state = tmp_path / "runs" / run["id"] / "state.pkl"
+        good = state.read_bytes()
+        state.write_bytes(good[:-3] + b"xyz")  # damaged under a live server: resume refuses
+        r = srv.http.post(f"/runs/{run['id']}/resume")
+        assert r.status_code == 409 and "resumed" in r.json()["detail"]
+        assert not srv.http.get(f"/runs/{run['id']}").json()["resumable"]
+    # and after a restart the record says so
+    with live_server(tmp_path, factory) as srv:
+        info = srv.http.get(f"/runs/{run['id']}").json()
+        assert not info["resumable"] and "saved state is damaged" in info["status"]
+        r = srv.http.post(f"/runs/{run['id']}/resume")
+        assert r.status_code == 409
