@@ -93,7 +93,7 @@ async def serve_client(manager: RunManager, run: Run, transport: DoorTransport,
     timeout = settings.hello_timeout
     window: SetWindow | None = None
     at_boundary = True          # engine state is a window boundary (safe to save for resuming)
-    saved_at = time.monotonic()
+    saved_at, saved_t = time.monotonic(), engine.t
     end: _SessionEnd
 
     def sync_limits() -> None:
@@ -129,9 +129,10 @@ async def serve_client(manager: RunManager, run: Run, transport: DoorTransport,
                 run.gauges.row(engine.t, measured.steps, values)
                 _progress(manager, run, engine, values, connected, solve_time)
                 await transport.send(reply)
-                if time.monotonic() - saved_at >= settings.checkpoint_every:
-                    await _save_state(manager, run)
-                    saved_at = time.monotonic()
+                if (time.monotonic() - saved_at >= settings.checkpoint_every
+                        or engine.t - saved_t >= settings.checkpoint_every_t * (1 - 1e-9)):
+                    await _save_state(manager, run)  # by wall time and by simulated progress
+                    saved_at, saved_t = time.monotonic(), engine.t
             elif isinstance(action, Measure):
                 measured = await loop.run_in_executor(manager.executor, engine.measure)
                 await transport.send(session.result(action, _result(measured)))

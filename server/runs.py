@@ -108,7 +108,10 @@ class RunManager:
 
     # ------------------------------------------------------------------ records
     def _load_existing(self) -> None:
-        """Runs left on disk by an earlier server: listed with their data; unfinished ones failed."""
+        """Runs left on disk by an earlier server: listed with their data. Runs that had not
+        started (queued, or waiting for their client) are queued again; runs that were stepping
+        are failed (a coupled one resumable from its last saved state)."""
+        requeue: list[Run] = []
         for info, request in self.store.load_all():
             try:
                 req = RunRequest.model_validate(request)
@@ -119,10 +122,26 @@ class RunManager:
             run = Run(info, req, self.store.run_dir(info.id))
             self.runs[info.id] = run
             self._catch_up_with_gauges(run)
-            if not run.terminal:
+            if run.info.state in (QUEUED, WAITING):  # nothing stepped yet: queue it again
+                requeue.append(run)
+            elif not run.terminal:
                 self._set_state(run, FAILED, "server stopped before the run ended")
             if run.info.resumable and not self.state_intact(run):
                 self.save(run)
+        for run in sorted(requeue, key=lambda r: r.info.created):
+            if run.info.resumed:  # queued to resume: from its saved state
+                if not is_sealed(run.state_file):
+                    self._set_state(run, FAILED, "server stopped before the run was resumed, "
+                                                 "and its saved state is damaged")
+                    continue
+                run.resume_from = run.state_file
+            run.info.ended = None
+            self.queue.append(run.info.id)
+            self._set_state(run, QUEUED)
+            log.info("run %s: queued again (it had not started when the server stopped)",
+                     run.info.id)
+        if self.queue:
+            self._schedule()
 
     def _catch_up_with_gauges(self, run: Run) -> None:
         """meta.json is rewritten at most every meta_interval, gauges.csv row by row: after a
@@ -279,7 +298,7 @@ class RunManager:
         if tasks:
             await asyncio.wait(tasks, timeout=10)
         for run in self.runs.values():
-            if not run.terminal:
+            if not run.terminal and run.info.state != QUEUED:  # queued ones run after a restart
                 self._set_state(run, FAILED, "server stopped before the run ended")
         self.executor.shutdown(wait=False, cancel_futures=True)
         self.builder.shutdown(wait=False, cancel_futures=True)
@@ -370,7 +389,10 @@ class RunManager:
                 self._set_state(run, FAILED, f"no client connected within "
                                              f"{self.settings.client_wait_timeout:g} s")
             elif woke is run.cancelled and not run.attached.is_set():
-                self._set_state(run, *self.cancel_reason)  # a reserving client is told by its door
+                if self.stopping:  # nothing stepped: queued again when the server restarts
+                    self._set_state(run, QUEUED)
+                else:
+                    self._set_state(run, *self.cancel_reason)  # a reserving client: its door says
             else:
                 await run.session_done.wait()  # the door sets the final state
         except Exception as exc:  # noqa: BLE001

@@ -34,6 +34,8 @@ class Settings(BaseModel):
     meta_interval: float = Field(0.5, ge=0, description="[s] least time between meta.json rewrites")
     checkpoint_every: float = Field(60.0, gt=0, description="[s] wall time between saved states of "
                                                             "a coupled run (for resuming it)")
+    checkpoint_every_t: float = Field(1.0, gt=0, description="[s] simulated time between saved "
+                                                             "states (whichever comes first)")
 
     @property
     def loopback_only(self) -> bool:

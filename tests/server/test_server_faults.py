@@ -381,3 +381,55 @@ def test_damaged_saved_state_is_not_resumable(tmp_path, factory):
         assert not info["resumable"] and "saved state is damaged" in info["status"]
         r = srv.http.post(f"/runs/{run['id']}/resume")
         assert r.status_code == 409
+
+
+# 10. resumable early, and queued runs survive a server stop ------------------------------------
+def test_state_is_saved_by_simulated_progress_too(tmp_path, factory):
+    import shutil
+
+    from coupling_client import TcpClient, bye, handshake, run_windows
+
+    with live_server(tmp_path, factory, checkpoint_every=1000.0, checkpoint_every_t=0.1) as srv:
+        run = srv.create()
+        srv.wait_state(run["id"], "waiting_for_client")
+        c = TcpClient(srv.tcp_port)
+        welcome, nodes = handshake(c, run["id"])
+        run_windows(c, welcome, nodes, 3)  # to t = 0.15: a state saved at t = 0.1
+        crashed = tmp_path / "crashed" / "runs"  # the disk as a kill -9 leaves it now
+        shutil.copytree(tmp_path / "runs", crashed)
+        c.close()
+    with live_server(tmp_path / "crashed", factory) as srv:
+        info = srv.http.get(f"/runs/{run['id']}").json()
+        assert info["resumable"] and info["windows"] == 3
+        assert srv.http.post(f"/runs/{run['id']}/resume").status_code == 202
+        srv.wait_state(run["id"], "waiting_for_client")
+        c = TcpClient(srv.tcp_port)
+        welcome, nodes = handshake(c, run["id"])
+        assert welcome.t_start == pytest.approx(0.1)
+        run_windows(c, welcome, nodes, 1, t0=0.1)
+        bye(c)
+        assert srv.wait_state(run["id"], "finished")["windows"] == 3  # rows after t = 0.1 redone
+
+
+def test_runs_not_started_are_queued_again_after_a_stop_or_a_crash(tmp_path, factory):
+    import shutil
+
+    from coupling_client import TcpClient, bye, handshake, run_windows
+
+    with live_server(tmp_path, factory, max_waiting=1) as srv:
+        waiting, queued = srv.create(), srv.create()
+        srv.wait_state(waiting["id"], "waiting_for_client")
+        assert srv.http.get(f"/runs/{queued['id']}").json()["state"] == "queued"
+        crashed = tmp_path / "crashed" / "runs"
+        shutil.copytree(tmp_path / "runs", crashed)
+    for root in (tmp_path, tmp_path / "crashed"):  # after a clean stop, and after a kill -9
+        with live_server(root, factory, max_waiting=1) as srv:
+            srv.wait_state(waiting["id"], "waiting_for_client")
+            info = srv.http.get(f"/runs/{queued['id']}").json()
+            assert info["state"] == "queued" and info["queue_position"] == 1
+            c = TcpClient(srv.tcp_port)
+            welcome, nodes = handshake(c, waiting["id"])
+            run_windows(c, welcome, nodes, 1)
+            bye(c)
+            srv.wait_state(waiting["id"], "finished")
+            srv.wait_state(queued["id"], "waiting_for_client")
