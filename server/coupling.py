@@ -12,8 +12,8 @@ import logging
 import time
 import numpy as np
 
-from protocol import (Capability, ErrorCode, Nodes, ProtocolError, Result, SphSession, Welcome,
-                      encode_frame)
+from protocol import (Capability, ErrorCode, GaugeKind, Gauges, Nodes, ProtocolError, Result,
+                      SphSession, Welcome, encode_frame)
 from protocol.messages import Error, Hello, Message
 from protocol.session import Measure, PeerError, Reply, Restore, SetWindow, SolveWindow
 
@@ -24,7 +24,7 @@ from .transports import DoorTransport, PeerGone
 
 log = logging.getLogger("wavesph.server")
 
-SERVER_NAME = "wavesph-server 0.1 (protocol 1)"
+SERVER_NAME = "wavesph-server 0.1 (protocol 1.1)"
 
 
 class _SessionEnd(Exception):
@@ -68,14 +68,20 @@ async def claim_run(manager: RunManager, run_id: str, transport: DoorTransport) 
             manager.unreserve(run)
 
 
-def welcome_for(run: Run, engine: CouplingEngine, idle_timeout: float) -> tuple[Welcome, Nodes]:
+def welcome_for(run: Run, engine: CouplingEngine,
+                idle_timeout: float) -> tuple[Welcome, Nodes, Gauges]:
+    """WELCOME (the scene summary), NODES and, for 1.1 clients, GAUGES of a run's engine."""
     s, nodes = engine.summary, engine.nodes()
     welcome = Welcome(int(Capability.GOBACK), bytes.fromhex(run.info.scene_hash), g=s.g, depth=s.depth,
                       still_water_level=s.still_water_level, z_ref=s.z_ref, t_start=s.t_start,
                       t_end=s.t_end, dt_sph=s.dt_sph, window_max=run.request.coupling.window_max,
                       idle_timeout=idle_timeout, n_nodes=nodes.x.size, n_gauges=nodes.gauge_x.size,
                       max_payload=0, run_id=run.info.id, server=SERVER_NAME)
-    return welcome, Nodes(nodes.x, nodes.z, nodes.side, nodes.gauge_x)
+    n = nodes.gauge_x.size
+    gauges = Gauges(nodes.gauge_names or [f"g{j}" for j in range(n)],
+                    nodes.gauge_kind if nodes.gauge_kind is not None
+                    else np.full(n, GaugeKind.PROBE, np.uint32), np.array(nodes.eta_gauge, np.uint32))
+    return welcome, Nodes(nodes.x, nodes.z, nodes.side, nodes.gauge_x), gauges
 
 
 async def serve_client(manager: RunManager, run: Run, transport: DoorTransport,
@@ -84,8 +90,8 @@ async def serve_client(manager: RunManager, run: Run, transport: DoorTransport,
     settings, engine = manager.settings, run.engine
     assert engine is not None and run.gauges is not None
     loop = asyncio.get_running_loop()
-    welcome, nodes = welcome_for(run, engine, settings.idle_timeout)
-    session = SphSession(welcome, nodes)
+    welcome, nodes, gauges = welcome_for(run, engine, settings.idle_timeout)
+    session = SphSession(welcome, nodes, gauges)
     names = engine.nodes().gauge_names or [f"g{j}" for j in range(nodes.gauge_x.size)]
     pending = list(first)
     connected = time.perf_counter()

@@ -41,6 +41,8 @@ class EngineNodes:
     side: np.ndarray           # 0 inlet, 1 outlet
     gauge_x: np.ndarray
     gauge_names: list[str] = field(default_factory=list)
+    gauge_kind: np.ndarray | None = None   # protocol.GaugeKind per gauge; None: all probes
+    eta_gauge: tuple[int, int] = (0xFFFFFFFF, 0xFFFFFFFF)  # per side: the gauge its absorber reads
 
 
 @dataclass(frozen=True)

@@ -2,8 +2,9 @@
 
 Three caps, so that runs whose client never comes cannot block the server:
 - ``max_runs`` stepping slots: a standalone run holds one while it steps, a coupled run from the
-  moment its client attaches (HELLO accepted) to the end of the session. A coupled run that waits
-  for its client holds none; a client arriving when every slot is busy is refused (BUSY, retry).
+  moment its client attaches to the end of the session. A coupled run that waits for its client
+  holds none; a client's HELLO reserves its run (``reserve``) and waits in ``attach`` while the
+  run is queued or every slot is busy.
 - ``max_waiting`` coupled runs built (engine in memory) and waiting for their client;
 - ``max_queued`` runs in the queue; one more is refused (HTTP 429 with Retry-After).
 
