@@ -59,7 +59,7 @@ sys.path.insert(0, str(ROOT))
 
 from protocol import (Bye, ClientSession, FrameDecoder, GetNodes, Hello, Nodes, Result, Set,  # noqa: E402
                       Solve, Welcome, decode_frame)
-from server.engine import BoundaryNodes, Measurement, SceneSummary  # noqa: E402
+from server.engine import EngineNodes, Measurement, SceneSummary  # noqa: E402
 from server.flume_engine import FlumeEngine  # noqa: E402
 from server.main import create_app  # noqa: E402
 from server.schemas import RunRequest  # noqa: E402
@@ -132,14 +132,14 @@ class NullEngine:
 
     def __init__(self, n_nodes: int, t_end: float) -> None:
         self.summary = SceneSummary(9.81, DEPTH, DEPTH, -0.5 * DEPTH, 0.0, t_end, 1e-3)
-        self._nodes = BoundaryNodes(np.zeros(n_nodes), np.linspace(-DEPTH, 0, n_nodes),
+        self._nodes = EngineNodes(np.zeros(n_nodes), np.linspace(-DEPTH, 0, n_nodes),
                                     np.zeros(n_nodes, np.uint32), np.array([1.0, 2.0]), ["a", "b"])
         self.t, self.steps, self.n_particles = 0.0, 0, 1
         self._m = Measurement(np.zeros(2), np.ones(2, bool), np.zeros(2), np.zeros(2), 1)
         self._t1 = 0.0
         self.solve_s: list[float] = []
 
-    def nodes(self) -> BoundaryNodes: return self._nodes
+    def nodes(self) -> EngineNodes: return self._nodes
     def set_window(self, t0, t1, u, w, eta) -> None: self._t1 = t1
     def solve_window(self) -> Measurement:
         self.t, self.steps = self._t1, self.steps + 1

@@ -16,7 +16,8 @@ class InProcessServer:
     ``settings``: overrides of `server.settings.Settings` (e.g. max_runs); ``engine_factory``:
     the SPH side of coupled runs (default the server's, an sph_core Simulation with open ends)."""
 
-    def __init__(self, runs_dir: Path, engine_factory: Any = None, **settings: Any) -> None:
+    def __init__(self, runs_dir: Path, engine_factory: Any = None, log_level: str = "warning",
+                 **settings: Any) -> None:
         import uvicorn
 
         from server.main import create_app
@@ -26,7 +27,7 @@ class InProcessServer:
         self.app = (create_app(self.settings) if engine_factory is None
                     else create_app(self.settings, engine_factory))
         self.server = uvicorn.Server(uvicorn.Config(  # socket options as `wavesph serve`
-            self.app, host="127.0.0.1", port=0, log_level="warning", lifespan="on",
+            self.app, host="127.0.0.1", port=0, log_level=log_level, lifespan="on",
             ws_max_size=self.settings.max_frame + 16, ws_per_message_deflate=False))
         self.thread = threading.Thread(target=self.server.run, name="wavesph-server", daemon=True)
 

@@ -28,11 +28,11 @@ import hashlib
 from .client import ClientSession, RemoteError
 from .errors import ErrorCode, ProtocolError
 from .framing import FrameDecoder, decode_frame, encode_frame
-from .messages import (Bye, Error, Get, GetNodes, GoBack, Hello, Message, Nodes, Result, Set, Solve,
-                       Welcome)
+from .messages import (Bye, Error, Gauges, Get, GetGauges, GetNodes, GoBack, Hello, Message, Nodes,
+                       Result, Set, Solve, Welcome)
 from .session import SphSession
 from .wire import (HEADER_SIZE, MAGIC, MAX_COUNT, MAX_PAYLOAD, MAX_TEXT, NO_SCENE_HASH, VERSION,
-                   Capability, MessageType, Side)
+                   NO_GAUGE, Capability, GaugeKind, MessageType, Side)
 
 
 def scene_hash(canonical_scene: bytes) -> bytes:
@@ -41,7 +41,8 @@ def scene_hash(canonical_scene: bytes) -> bytes:
 
 
 __all__ = [
-    "Bye", "Capability", "ClientSession", "Error", "ErrorCode", "FrameDecoder", "Get", "GetNodes",
+    "Bye", "Capability", "ClientSession", "Error", "ErrorCode", "FrameDecoder", "GaugeKind", "Gauges",
+    "Get", "GetGauges", "GetNodes", "NO_GAUGE",
     "GoBack", "HEADER_SIZE", "Hello", "MAGIC", "MAX_COUNT", "MAX_PAYLOAD", "MAX_TEXT", "Message",
     "MessageType", "NO_SCENE_HASH", "Nodes", "ProtocolError", "RemoteError", "Result", "Set", "Side",
     "Solve", "SphSession", "VERSION", "Welcome", "decode_frame", "encode_frame", "scene_hash",

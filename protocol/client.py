@@ -14,7 +14,7 @@ from typing import TypeVar
 
 from .errors import ErrorCode, ProtocolError
 from .framing import encode_frame
-from .messages import Bye, Error, Message, Nodes, Result, Welcome
+from .messages import Bye, Error, Gauges, Message, Nodes, Result, Welcome
 
 M = TypeVar("M", bound=Message)
 
@@ -49,6 +49,10 @@ class ClientSession:
             self.welcome = msg
         elif self.welcome is not None and isinstance(msg, (Nodes, Result)):
             _check_lengths(msg, self.welcome)
+        elif self.welcome is not None and isinstance(msg, Gauges):
+            if not len(msg.names) == msg.kind.size == self.welcome.n_gauges:
+                raise ProtocolError(ErrorCode.SHAPE_MISMATCH, f"GAUGES has {len(msg.names)} names "
+                                    f"and {msg.kind.size} kinds, WELCOME said {self.welcome.n_gauges}")
         return msg
 
 

@@ -87,6 +87,10 @@ class _Reader:
         n = self._count(name, 4)
         return np.frombuffer(self._take(4 * n, name), dtype="<u4").astype(np.uint32)
 
+    def text_array(self, name: str) -> list[str]:
+        n = self._count(name, 4)  # every text takes its 4-byte length at least
+        return [self.text(f"{name}[{i}]") for i in range(n)]
+
     def end(self) -> None:
         left = len(self.buf) - self.pos
         if left:
@@ -144,15 +148,23 @@ class _Writer:
             raise _bad(ErrorCode.BAD_VALUE, f"{self.what}.{name}", "values are not u32")
         self._array(name, arr, "<u4")
 
+    def text_array(self, name: str, value: list[str]) -> None:
+        if len(value) > MAX_COUNT:
+            raise _bad(ErrorCode.BAD_VALUE, f"{self.what}.{name}", f"{len(value)} texts > {MAX_COUNT}")
+        self.parts.append(_U32.pack(len(value)))
+        for i, text in enumerate(value):
+            self.text(f"{name}[{i}]", text)
+
     def bytes(self) -> bytes:
         return b"".join(self.parts)
 
 
-# Field codecs, in wire order: (attribute, kind). Kinds: u32, f64, text, hash, f64[], u32[].
+# Field codecs, in wire order: (attribute, kind). Kinds: u32, f64, text, hash, f64[], u32[],
+# text[] (1.1: a u32 count, then that many texts).
 _READ = {"u32": _Reader.u32, "f64": _Reader.f64, "text": _Reader.text, "hash": _Reader.hash,
-         "f64[]": _Reader.f64_array, "u32[]": _Reader.u32_array}
+         "f64[]": _Reader.f64_array, "u32[]": _Reader.u32_array, "text[]": _Reader.text_array}
 _WRITE = {"u32": _Writer.u32, "f64": _Writer.f64, "text": _Writer.text, "hash": _Writer.hash,
-          "f64[]": _Writer.f64_array, "u32[]": _Writer.u32_array}
+          "f64[]": _Writer.f64_array, "u32[]": _Writer.u32_array, "text[]": _Writer.text_array}
 
 
 class Message:
@@ -337,6 +349,31 @@ class Bye(Message):
     reason: str = ""
 
 
+@dataclass(eq=False)
+class GetGauges(Message):
+    """Client -> server (1.1, GAUGE_INFO in force): ask what each gauge is."""
+
+    TYPE = MessageType.GETGAUGES
+
+
+@dataclass(eq=False)
+class Gauges(Message):
+    """Server -> client (1.1): per gauge, in RESULT order, its name and kind (GaugeKind); per
+    side (Side order: inlet, outlet), the gauge whose elevation the SPH side's own absorber at
+    that end measures, NO_GAUGE if the end is not open or does not absorb."""
+
+    TYPE = MessageType.GAUGES
+    LAYOUT = (("names", "text[]"), ("kind", "u32[]"), ("eta_gauge", "u32[]"))
+    names: list[str] = field(default_factory=list)
+    kind: np.ndarray = field(default_factory=lambda: np.zeros(0, np.uint32))
+    eta_gauge: np.ndarray = field(default_factory=lambda: np.zeros(0, np.uint32))
+
+    def __post_init__(self) -> None:
+        self.names = list(self.names)
+        self.kind, self.eta_gauge = _u32s(self.kind), _u32s(self.eta_gauge)
+
+
 MESSAGE_CLASSES: dict[MessageType, type[Message]] = {
-    cls.TYPE: cls for cls in (Hello, Welcome, GetNodes, Nodes, Set, Solve, Get, Result, GoBack, Error, Bye)
+    cls.TYPE: cls for cls in (Hello, Welcome, GetNodes, Nodes, Set, Solve, Get, Result, GoBack, Error,
+                              Bye, GetGauges, Gauges)
 }

@@ -23,8 +23,8 @@ import numpy as np
 
 from .errors import ErrorCode, ProtocolError
 from .framing import encode_frame
-from .messages import (Bye, Error, Get, GetNodes, GoBack, Hello, Message, Nodes, Result, Set, Solve,
-                       Welcome)
+from .messages import (Bye, Error, Gauges, Get, GetGauges, GetNodes, GoBack, Hello, Message, Nodes,
+                       Result, Set, Solve, Welcome)
 from .wire import MAX_TEXT, NO_SCENE_HASH, Capability
 
 TIME_RTOL = 1e-9  # relative tolerance when matching window times to the SPH clock
@@ -93,13 +93,20 @@ class SphSession:
     ``welcome`` is the server's offer (capabilities it supports, scene summary); the
     capabilities actually sent are the intersection with the client's, and ``max_payload`` is
     set to the largest frame the client may send for this scene (a SET). ``nodes`` is the reply
-    to GETNODES; its lengths must agree with ``welcome``.
+    to GETNODES; its lengths must agree with ``welcome``. ``gauges`` (1.1) is the reply to
+    GETGAUGES: given, the GAUGE_INFO capability is offered; a 1.0 client does not ask for it and
+    is served as before.
     """
 
-    def __init__(self, welcome: Welcome, nodes: Nodes) -> None:
+    def __init__(self, welcome: Welcome, nodes: Nodes, gauges: Gauges | None = None) -> None:
         if not (nodes.x.size == nodes.z.size == nodes.side.size == welcome.n_nodes
                 and nodes.gauge_x.size == welcome.n_gauges):
             raise ValueError("nodes: array lengths disagree with welcome.n_nodes / n_gauges")
+        if gauges is not None:
+            if not len(gauges.names) == gauges.kind.size == welcome.n_gauges:
+                raise ValueError("gauges: names / kind lengths disagree with welcome.n_gauges")
+            welcome = replace(welcome, capabilities=welcome.capabilities | Capability.GAUGE_INFO)
+        self.gauges = gauges
         # after HELLO the client may send nothing larger than a SET for this scene
         self.client_limit = max(set_payload_size(welcome.n_nodes), 4 + 4 + MAX_TEXT)
         self.offer = replace(welcome, max_payload=self.client_limit)
@@ -139,8 +146,16 @@ class SphSession:
             if not isinstance(msg, Hello):
                 raise ProtocolError(ErrorCode.OUT_OF_ORDER, f"{msg.TYPE.name} before HELLO")
             return self._hello(msg)
+        if isinstance(msg, Hello):
+            raise ProtocolError(ErrorCode.OUT_OF_ORDER, "a second HELLO: this session is open "
+                                                        "already (one HELLO per connection)")
         if isinstance(msg, GetNodes):
             return Reply(self._frame(self.nodes))
+        if isinstance(msg, GetGauges):
+            if not self.capabilities & Capability.GAUGE_INFO or self.gauges is None:
+                raise ProtocolError(ErrorCode.OUT_OF_ORDER, "GETGAUGES without the GAUGE_INFO "
+                                                            "capability (protocol 1.1)")
+            return Reply(self._frame(self.gauges))
         if isinstance(msg, Set):
             return self._set(msg)
         if isinstance(msg, Solve):
@@ -221,11 +236,6 @@ class SphSession:
         else:
             code, text = ErrorCode.INTERNAL, f"{type(exc).__name__}: {exc}"
         return self._frame(Error(int(code), _clip(text)))
-
-    def bye_frame(self, reason: str) -> bytes:
-        """Server-initiated BYE (run finished or server stopping)."""
-        self.state = State.CLOSED
-        return self._frame(Bye(_clip(reason)))
 
     def _frame(self, msg: Message) -> bytes:
         return encode_frame(msg, self._reply_seq)

@@ -35,12 +35,15 @@ class MessageType(IntEnum):
     GOBACK = 9
     ERROR = 10
     BYE = 11
+    GETGAUGES = 12   # 1.1, with the GAUGE_INFO capability
+    GAUGES = 13      # 1.1, with the GAUGE_INFO capability
 
 
 class Capability(IntEnum):
     """Bits of the u32 capability mask in HELLO/WELCOME. Unknown bits are ignored."""
 
     GOBACK = 1 << 0       # client may send GOBACK (implicit / iterated coupling)
+    GAUGE_INFO = 1 << 1   # protocol 1.1: GETGAUGES -> GAUGES (names, kinds, the SPH-side eta gauges)
 
 
 class Side(IntEnum):
@@ -48,3 +51,13 @@ class Side(IntEnum):
 
     INLET = 0
     OUTLET = 1
+
+
+class GaugeKind(IntEnum):
+    """What a gauge is (u32 in GAUGES)."""
+
+    BOUNDARY = 0   # an open end's own gauge (a few h inside its face)
+    PROBE = 1      # an elevation probe of the scene
+
+
+NO_GAUGE = 0xFFFFFFFF  # GAUGES.eta_gauge of an end that is not open, or does not absorb

@@ -1,7 +1,6 @@
 """The coupling door logic shared by the WebSocket and TCP endpoints.
 
-A transport gives ``recv()`` (a list of (seq, message), or None when the peer closed) and
-``send(bytes)``; ``serve_client`` runs the protocol session (protocol.SphSession) against the
+A transport (transports.DoorTransport) gives ``recv()`` and ``send(bytes)``; ``serve_client`` runs the protocol session (protocol.SphSession) against the
 run's engine. Engine calls go to the worker pool; every read has a timeout; the run's state
 says how the session ended, and the gauge rows of every solved window are on disk already.
 """
@@ -11,30 +10,21 @@ from __future__ import annotations
 import asyncio
 import logging
 import time
-from typing import Protocol
-
 import numpy as np
 
-from protocol import (Capability, ErrorCode, Nodes, ProtocolError, Result, SphSession, Welcome,
-                      encode_frame)
+from protocol import (Capability, ErrorCode, GaugeKind, Gauges, Nodes, ProtocolError, Result,
+                      SphSession, Welcome, encode_frame)
 from protocol.messages import Error, Hello, Message
 from protocol.session import Measure, PeerError, Reply, Restore, SetWindow, SolveWindow
 
 from .engine import CouplingEngine, Measurement
 from .runs import FAILED, FINISHED, RUNNING, UNSTABLE, Run, RunManager
-from .transports import PeerGone
+from .store import save_sealed
+from .transports import DoorTransport, PeerGone
 
 log = logging.getLogger("wavesph.server")
 
-SERVER_NAME = "wavesph-server 0.1 (protocol 1)"
-
-
-class Transport(Protocol):
-    max_payload: int
-
-    async def recv(self) -> list[tuple[int, Message]] | None: ...
-    async def send(self, data: bytes) -> None: ...
-    async def close(self) -> None: ...
+SERVER_NAME = "wavesph-server 0.1 (protocol 1.1)"
 
 
 class _SessionEnd(Exception):
@@ -48,24 +38,60 @@ def error_frame(code: ErrorCode, text: str, seq: int = 0) -> bytes:
     return encode_frame(Error(int(code), text[:4000]), seq)
 
 
-def welcome_for(run: Run, engine: CouplingEngine, idle_timeout: float) -> tuple[Welcome, Nodes]:
+async def claim_run(manager: RunManager, run_id: str, transport: DoorTransport) -> Run | None:
+    """The run a client's HELLO names, reserved for it at once and attached (a stepping slot
+    taken) when it is built and a slot is free; the client waits for WELCOME meanwhile. None if
+    the client left while waiting; ProtocolError (BUSY, CANCELLED, OUT_OF_ORDER) to refuse it."""
+    try:
+        run = manager.reserve(run_id)
+    except ValueError as exc:
+        raise ProtocolError(ErrorCode.BUSY, str(exc)) from None
+    attach = asyncio.ensure_future(manager.attach(run))
+    recv = asyncio.ensure_future(transport.recv())
+    try:
+        await asyncio.wait({attach, recv}, return_when=asyncio.FIRST_COMPLETED)
+        if recv.done():
+            if recv.result() is None:  # the client left; a ProtocolError passes through
+                return None
+            raise ProtocolError(ErrorCode.OUT_OF_ORDER, "a frame after HELLO, before WELCOME: "
+                                                        "wait for WELCOME")
+        try:
+            attach.result()
+        except ValueError as exc:
+            code = ErrorCode.CANCELLED if run.info.state == "cancelled" else ErrorCode.BUSY
+            raise ProtocolError(code, str(exc)) from None
+        return run
+    finally:
+        for task in (attach, recv):
+            task.cancel()
+        if not run.attached.is_set():
+            manager.unreserve(run)
+
+
+def welcome_for(run: Run, engine: CouplingEngine,
+                idle_timeout: float) -> tuple[Welcome, Nodes, Gauges]:
+    """WELCOME (the scene summary), NODES and, for 1.1 clients, GAUGES of a run's engine."""
     s, nodes = engine.summary, engine.nodes()
     welcome = Welcome(int(Capability.GOBACK), bytes.fromhex(run.info.scene_hash), g=s.g, depth=s.depth,
                       still_water_level=s.still_water_level, z_ref=s.z_ref, t_start=s.t_start,
                       t_end=s.t_end, dt_sph=s.dt_sph, window_max=run.request.coupling.window_max,
                       idle_timeout=idle_timeout, n_nodes=nodes.x.size, n_gauges=nodes.gauge_x.size,
                       max_payload=0, run_id=run.info.id, server=SERVER_NAME)
-    return welcome, Nodes(nodes.x, nodes.z, nodes.side, nodes.gauge_x)
+    n = nodes.gauge_x.size
+    gauges = Gauges(nodes.gauge_names or [f"g{j}" for j in range(n)],
+                    nodes.gauge_kind if nodes.gauge_kind is not None
+                    else np.full(n, GaugeKind.PROBE, np.uint32), np.array(nodes.eta_gauge, np.uint32))
+    return welcome, Nodes(nodes.x, nodes.z, nodes.side, nodes.gauge_x), gauges
 
 
-async def serve_client(manager: RunManager, run: Run, transport: Transport,
+async def serve_client(manager: RunManager, run: Run, transport: DoorTransport,
                        first: list[tuple[int, Message]]) -> None:
     """Run one client's session on ``run`` (already attached); sets the run's final state."""
     settings, engine = manager.settings, run.engine
     assert engine is not None and run.gauges is not None
     loop = asyncio.get_running_loop()
-    welcome, nodes = welcome_for(run, engine, settings.idle_timeout)
-    session = SphSession(welcome, nodes)
+    welcome, nodes, gauges = welcome_for(run, engine, settings.idle_timeout)
+    session = SphSession(welcome, nodes, gauges)
     names = engine.nodes().gauge_names or [f"g{j}" for j in range(nodes.gauge_x.size)]
     pending = list(first)
     connected = time.perf_counter()
@@ -73,7 +99,7 @@ async def serve_client(manager: RunManager, run: Run, transport: Transport,
     timeout = settings.hello_timeout
     window: SetWindow | None = None
     at_boundary = True          # engine state is a window boundary (safe to save for resuming)
-    saved_at = time.monotonic()
+    saved_at, saved_t = time.monotonic(), engine.t
     end: _SessionEnd
 
     def sync_limits() -> None:
@@ -109,9 +135,10 @@ async def serve_client(manager: RunManager, run: Run, transport: Transport,
                 run.gauges.row(engine.t, measured.steps, values)
                 _progress(manager, run, engine, values, connected, solve_time)
                 await transport.send(reply)
-                if time.monotonic() - saved_at >= settings.checkpoint_every:
-                    await _save_state(manager, run)
-                    saved_at = time.monotonic()
+                if (time.monotonic() - saved_at >= settings.checkpoint_every
+                        or engine.t - saved_t >= settings.checkpoint_every_t * (1 - 1e-9)):
+                    await _save_state(manager, run)  # by wall time and by simulated progress
+                    saved_at, saved_t = time.monotonic(), engine.t
             elif isinstance(action, Measure):
                 measured = await loop.run_in_executor(manager.executor, engine.measure)
                 await transport.send(session.result(action, _result(measured)))
@@ -175,7 +202,7 @@ class _Cancel(Exception):
     pass
 
 
-async def _recv(transport: Transport, timeout: float, run: Run) -> list[tuple[int, Message]]:
+async def _recv(transport: DoorTransport, timeout: float, run: Run) -> list[tuple[int, Message]]:
     """Next frames, or _Gone / TimeoutError / _Cancel; ProtocolError passes through."""
     recv = asyncio.ensure_future(transport.recv())
     cancel = asyncio.ensure_future(run.cancelled.wait())
@@ -209,7 +236,8 @@ async def _save_state(manager: RunManager, run: Run) -> None:
     if save is None:
         return
     try:
-        await asyncio.get_running_loop().run_in_executor(manager.executor, save, run.state_file)
+        await asyncio.get_running_loop().run_in_executor(manager.executor, save_sealed, save,
+                                                         run.state_file)
     except Exception:  # noqa: BLE001 -- the run's data are in gauges.csv; only resuming is lost
         log.exception("run %s: could not save the engine state", run.info.id)
 

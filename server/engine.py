@@ -33,7 +33,7 @@ class SceneSummary:
 
 
 @dataclass(frozen=True)
-class BoundaryNodes:
+class EngineNodes:
     """Boundary nodes (z up from still water) and gauges, in the order of every array."""
 
     x: np.ndarray
@@ -41,6 +41,8 @@ class BoundaryNodes:
     side: np.ndarray           # 0 inlet, 1 outlet
     gauge_x: np.ndarray
     gauge_names: list[str] = field(default_factory=list)
+    gauge_kind: np.ndarray | None = None   # protocol.GaugeKind per gauge; None: all probes
+    eta_gauge: tuple[int, int] = (0xFFFFFFFF, 0xFFFFFFFF)  # per side: the gauge its absorber reads
 
 
 @dataclass(frozen=True)
@@ -60,7 +62,7 @@ class CouplingEngine(Protocol):
     steps: int                 # SPH steps since the start
     n_particles: int
 
-    def nodes(self) -> BoundaryNodes: ...
+    def nodes(self) -> EngineNodes: ...
     def set_window(self, t0: float, t1: float, u: np.ndarray, w: np.ndarray, eta: np.ndarray) -> None:
         """Boundary values at t1; the values in force at t0 are those of the previous window."""
     def solve_window(self) -> Measurement:

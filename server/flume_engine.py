@@ -21,13 +21,13 @@ from pathlib import Path
 
 import numpy as np
 
-from protocol import ErrorCode, ProtocolError
+from protocol import NO_GAUGE, ErrorCode, GaugeKind, ProtocolError
 from sph_core.boundary_data import BoundaryDataError, BoundarySample
 from sph_core.open_ends import SIDES
 from sph_core.scene import PointProbe, Scene
 from sph_core.simulation import Simulation
 
-from .engine import BoundaryNodes, Measurement, SceneSummary
+from .engine import EngineNodes, Measurement, SceneSummary
 from .schemas import RunRequest
 
 REF = "_ref"  # suffix of the point probes the engine adds at z_ref
@@ -76,8 +76,14 @@ class FlumeEngine:
             xs.append(np.full(nd.size, nd.x_face))
             zs.append(nd.z - swl)
             side_ids.append(np.full(nd.size, SIDES.index(s), dtype=np.uint32))
-        self._nodes = BoundaryNodes(np.concatenate(xs), np.concatenate(zs), np.concatenate(side_ids),
-                                    np.array(gauge_x), list(self.gauge_names))
+        boundary = [n.endswith("_boundary") for n in self.gauge_names]
+        absorbs = {o.side: o.absorb for o in scene.open_boundaries}
+        eta_gauge = tuple(self.gauge_names.index(f"{s}_boundary") if absorbs.get(s) else NO_GAUGE
+                          for s in SIDES)
+        self._nodes = EngineNodes(np.concatenate(xs), np.concatenate(zs), np.concatenate(side_ids),
+                                  np.array(gauge_x), list(self.gauge_names),
+                                  np.where(boundary, GaugeKind.BOUNDARY, GaugeKind.PROBE).astype(np.uint32),
+                                  eta_gauge)
         self.summary = SceneSummary(g=scene.constants.g, depth=depth, still_water_level=swl,
                                     z_ref=z_ref, t_start=f.t, t_end=scene.t_end, dt_sph=f.dt)
         self._window: tuple[float, float, dict[str, BoundarySample]] | None = None
@@ -98,7 +104,7 @@ class FlumeEngine:
         return self.flume.n_particles
 
     # -- contract --------------------------------------------------------------------------
-    def nodes(self) -> BoundaryNodes:
+    def nodes(self) -> EngineNodes:
         return self._nodes
 
     def set_window(self, t0: float, t1: float, u: np.ndarray, w: np.ndarray, eta: np.ndarray) -> None:

@@ -5,14 +5,21 @@ from __future__ import annotations
 import logging
 from contextlib import asynccontextmanager
 
-from fastapi import FastAPI
+from fastapi import FastAPI, Request
+from fastapi.exceptions import RequestValidationError
+from fastapi.openapi.utils import get_openapi
+from fastapi.responses import JSONResponse
 
+from .deps import redact_tokens_in_server_logs
 from .engine import EngineFactory
 from .flume_engine import flume_engine
 from .routers import couple, runs
 from .runs import RunManager
+from .schemas import RunRequest
 from .settings import Settings
 from .tcp import start_tcp_server
+from .theory_client import serve_theory
+from .validation import clean_errors
 
 log = logging.getLogger("wavesph.server")
 
@@ -25,7 +32,8 @@ def create_app(settings: Settings | None = None,
 
     @asynccontextmanager
     async def lifespan(app: FastAPI):
-        manager = RunManager(settings, engine_factory)
+        redact_tokens_in_server_logs()  # after uvicorn configured its logging
+        manager = RunManager(settings, engine_factory, serve_theory)
         app.state.manager = manager
         tcp = None
         if settings.tcp_port is not None:
@@ -44,4 +52,22 @@ def create_app(settings: Settings | None = None,
                               "(protocol/PROTOCOL.md).")
     app.include_router(runs.router)
     app.include_router(couple.router)
+
+    @app.exception_handler(RequestValidationError)
+    async def unprocessable(request: Request, exc: RequestValidationError) -> JSONResponse:
+        """FastAPI's 422 without the input (it may be huge, or a NaN JSON cannot carry)."""
+        return JSONResponse({"detail": clean_errors(list(exc.errors()))}, status_code=422)
+
+    def openapi() -> dict:
+        if app.openapi_schema is None:  # POST /runs reads its body itself: add RunRequest's schema
+            schema = get_openapi(title=app.title, version=app.version, description=app.description,
+                                 routes=app.routes)
+            body = RunRequest.model_json_schema(ref_template="#/components/schemas/{model}")
+            models = schema.setdefault("components", {}).setdefault("schemas", {})
+            models.update(body.pop("$defs", {}))
+            models["RunRequest"] = body
+            app.openapi_schema = schema
+        return app.openapi_schema
+
+    app.openapi = openapi  # type: ignore[method-assign]
     return app

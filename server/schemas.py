@@ -14,7 +14,9 @@ from sph_core.scene import Scene
 from .theory_source import TheorySource
 
 
-class CouplingOptions(BaseModel):
+class RunCouplingOptions(BaseModel):
+    """The `coupling` part of POST /runs (the client's own options are wave_client's)."""
+
     model_config = ConfigDict(extra="forbid")
 
     window_max: float = Field(0.05, gt=0, description="longest coupling window the client may use [s]")
@@ -31,7 +33,7 @@ class RunRequest(BaseModel):
     mode: Literal["coupled", "standalone"] = Field(
         "coupled", description="coupled: wait for a client on /runs/{id}/couple or the TCP port; "
                                "standalone: run the scene as it is (open ends: driven by `source`)")
-    coupling: CouplingOptions = CouplingOptions()
+    coupling: RunCouplingOptions = RunCouplingOptions()
     source: TheorySource | None = Field(None, description="built-in wave theory driving the open "
                                                           "ends of a standalone run")
 
@@ -69,15 +71,19 @@ def canonical_scene(scene: Scene) -> bytes:
     return json.dumps(scene.model_dump(mode="json"), sort_keys=True, separators=(",", ":")).encode()
 
 
-def estimate_particles(scene: Scene) -> int:
-    """Upper estimate of fluid + wall particles, without building them (for the cap)."""
+def estimate_particles(scene: Scene) -> float:
+    """Upper estimate of fluid + wall particles, without building them (for the cap); math.inf
+    when it overflows a float (a 1e308 m tank, a dp of 5e-324 m): never raises."""
     dp, t = scene.dp, scene.tank
-    fluid = sum((b.x1 - b.x0) * (b.z1 - b.z0) for b in scene.water_blocks) / dp**2
+    # (a / dp) / dp, not a / dp**2: dp**2 underflows to 0 for a tiny dp; float * and / give inf
+    # on overflow where ** and ceil would raise
+    fluid = sum((b.x1 - b.x0) * (b.z1 - b.z0) / dp / dp for b in scene.water_blocks)
     layers = wall_layers(scene)
-    walls = layers * (2 * (t.z1 - t.z0) + (t.x1 - t.x0)) / dp + 4 * layers**2
+    walls = layers * (2 * (t.z1 - t.z0) + (t.x1 - t.x0)) / dp + 4 * layers * layers
     for bed in scene.beds:
         length = sum(math.dist(a, b) for a, b in zip(bed.points, bed.points[1:]))
         walls += layers * length / dp
     for s in scene.structures:
         walls += layers * 2 * ((s.x1 - s.x0) + (s.z1 - s.z0)) / dp
-    return int(math.ceil(fluid + walls))
+    n = fluid + walls
+    return float(math.ceil(n)) if math.isfinite(n) else math.inf

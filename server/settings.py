@@ -18,8 +18,14 @@ class Settings(BaseModel):
     tcp_port: int | None = Field(8766, ge=0, le=65535, description="TCP coupling port; None disables it")
     runs_dir: Path = Field(Path("runs"), description="one sub-directory per run")
     token: str | None = Field(None, min_length=16, description="API token (required off loopback)")
-    max_runs: int = Field(2, ge=1, description="runs stepping or holding a coupling slot at once")
+    max_runs: int = Field(2, ge=1, description="runs stepping at once (a coupled run from its "
+                                               "client's HELLO on)")
+    max_waiting: int = Field(4, ge=1, description="coupled runs built and waiting for their client "
+                                                  "(each holds its particles in memory)")
+    max_queued: int = Field(32, ge=0, description="runs in the queue; beyond: HTTP 429")
     max_particles: int = Field(2_000_000, ge=1, description="particle-count cap per run")
+    max_probes: int = Field(1000, ge=0, description="probes of one scene")
+    max_body: int = Field(1024 * 1024, ge=1024, description="largest POST /runs body [bytes]")
     max_frame: int = Field(16 * 1024 * 1024, ge=4104, le=16 * 1024 * 1024,
                            description="largest coupling frame payload [bytes]")
     hello_timeout: float = Field(30.0, gt=0, description="[s] for the first frame after connect")
@@ -28,6 +34,8 @@ class Settings(BaseModel):
     meta_interval: float = Field(0.5, ge=0, description="[s] least time between meta.json rewrites")
     checkpoint_every: float = Field(60.0, gt=0, description="[s] wall time between saved states of "
                                                             "a coupled run (for resuming it)")
+    checkpoint_every_t: float = Field(1.0, gt=0, description="[s] simulated time between saved "
+                                                             "states (whichever comes first)")
 
     @property
     def loopback_only(self) -> bool:
@@ -36,8 +44,11 @@ class Settings(BaseModel):
     @model_validator(mode="after")
     def _token_off_loopback(self) -> "Settings":
         if not self.loopback_only and not self.token:
+            public = [f"{name} {h!r}" for name, h in (("host", self.host),
+                                                     ("tcp_host", self.tcp_host or self.host))
+                      if not _is_loopback(h)]
             raise ValueError("token: an API token (>= 16 characters) is required when binding "
-                             f"{self.host!r}, which is not a loopback address")
+                             f"{' and '.join(public)}, not a loopback address")
         return self
 
     @classmethod

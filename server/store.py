@@ -6,26 +6,29 @@
         meta.json      RunInfo: status, progress, speed, stability, last gauges (atomic rewrite)
         gauges.csv     coupled runs: one row per solved window, flushed at once
         state.pkl      coupled runs: the engine state at a window boundary (to resume the run)
+        state.pkl.sha256  its seal: a state that does not match it is not resumed
         sph/           standalone runs: sph_core's own outputs (probes.csv, meta.json, snapshots/)
 """
 
 from __future__ import annotations
 
 import csv
+import hashlib
 import json
+import logging
 import os
+import re
 from pathlib import Path
-from typing import Any
+from typing import Any, Callable
+
+from sph_core.output import write_json_atomic
 
 from .schemas import RunInfo
 
 META = "meta.json"
+RUN_ID = re.compile(r"[A-Za-z0-9_-]{1,64}")  # a run's directory name: never a path
 
-
-def write_json_atomic(path: Path, data: Any) -> None:
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(json.dumps(data, indent=2, default=str))
-    os.replace(tmp, path)
+log = logging.getLogger("wavesph.server")
 
 
 class RunStore:
@@ -33,27 +36,76 @@ class RunStore:
         self.root = Path(root)
         self.root.mkdir(parents=True, exist_ok=True)
 
+    def run_dir(self, run_id: str) -> Path:
+        """The run's directory, inside the store whatever the id says (ValueError if not a name)."""
+        if not RUN_ID.fullmatch(run_id):
+            raise ValueError(f"run id {run_id[:80]!r} is not a plain name ({RUN_ID.pattern})")
+        return self.root / run_id
+
     def create(self, run_id: str, request: dict[str, Any], scene_bytes: bytes) -> Path:
-        d = self.root / run_id
+        d = self.run_dir(run_id)
         d.mkdir()
         write_json_atomic(d / "request.json", request)
         (d / "scene.json").write_bytes(scene_bytes)
         return d
 
     def save(self, info: RunInfo) -> None:
-        write_json_atomic(self.root / info.id / META, info.model_dump(mode="json"))
+        write_json_atomic(self.run_dir(info.id) / META, info.model_dump(mode="json"))
 
     def load_all(self) -> list[tuple[RunInfo, dict[str, Any]]]:
-        """Every run found on disk with its request; unreadable directories are skipped."""
+        """Every run found on disk with its request. The directory's name is the run's id (a
+        directory moved or copied keeps working); an entry that cannot be read is skipped with
+        a log line, never stops the server."""
         out = []
         for d in sorted(self.root.iterdir()):
+            if not d.is_dir() or not RUN_ID.fullmatch(d.name):
+                log.warning("run store: skipping %s: not a run directory", d)
+                continue
             try:
                 info = RunInfo.model_validate_json((d / META).read_text())
                 request = json.loads((d / "request.json").read_text())
-            except (OSError, ValueError):
+            except (OSError, ValueError) as exc:
+                log.warning("run store: skipping %s: %s", d, str(exc).splitlines()[0][:200])
                 continue
+            if info.id != d.name:
+                log.warning("run store: %s names run %r; the run is %r, its directory's name",
+                            d / META, info.id[:80], d.name)
+                info = info.model_copy(update={"id": d.name})
             out.append((info, request))
         return out
+
+
+def _seal_path(path: Path) -> Path:
+    return path.with_name(path.name + ".sha256")
+
+
+def _sha256(path: Path) -> str:
+    h = hashlib.sha256()
+    with open(path, "rb") as f:
+        for block in iter(lambda: f.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
+
+
+def save_sealed(save: Callable[[Path], None], path: Path) -> None:
+    """``save(path)``, then its SHA-256 beside it: a state is trusted only if it matches (a crash
+    between the two leaves a state without a valid seal, which is not resumed)."""
+    _seal_path(path).unlink(missing_ok=True)
+    save(path)
+    _seal_path(path).write_text(_sha256(path) + "\n")
+
+
+def has_seal(path: Path) -> bool:
+    """``path`` and its seal exist (cheap; ``is_sealed`` reads the file)."""
+    return path.exists() and _seal_path(path).exists()
+
+
+def is_sealed(path: Path) -> bool:
+    """``path`` matches its seal: not damaged, not cut short, not from another save."""
+    try:
+        return _seal_path(path).read_text().strip() == _sha256(path)
+    except OSError:
+        return False
 
 
 class GaugeWriter:

@@ -8,16 +8,16 @@ import logging
 from protocol import ErrorCode, Hello, ProtocolError
 from protocol.session import HELLO_LIMIT
 
-from .coupling import error_frame, serve_client
+from .coupling import claim_run, error_frame, serve_client
 from .runs import RunManager
-from .transports import TcpTransport
+from .transports import TcpDoor
 
 log = logging.getLogger("wavesph.server")
 
 
 async def start_tcp_server(manager: RunManager, host: str, port: int) -> asyncio.base_events.Server:
     async def handle(reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> None:
-        transport = TcpTransport(reader, writer, min(HELLO_LIMIT, manager.settings.max_frame))
+        transport = TcpDoor(reader, writer, min(HELLO_LIMIT, manager.settings.max_frame))
         try:
             await _handle(manager, transport)
         except Exception:  # noqa: BLE001 -- one bad connection never stops the port
@@ -27,7 +27,7 @@ async def start_tcp_server(manager: RunManager, host: str, port: int) -> asyncio
     return await asyncio.start_server(handle, host, port)
 
 
-async def _handle(manager: RunManager, transport: TcpTransport) -> None:
+async def _handle(manager: RunManager, transport: TcpDoor) -> None:
     seq = 0
     try:
         frames = await asyncio.wait_for(transport.recv(), manager.settings.hello_timeout)
@@ -38,10 +38,9 @@ async def _handle(manager: RunManager, transport: TcpTransport) -> None:
             raise ProtocolError(ErrorCode.OUT_OF_ORDER, f"{msg.TYPE.name} before HELLO")
         if not msg.run_id:
             raise ProtocolError(ErrorCode.BUSY, "HELLO.run_id is empty: the TCP port needs the run id")
-        try:
-            run = manager.attach(msg.run_id)
-        except ValueError as exc:
-            raise ProtocolError(ErrorCode.BUSY, str(exc)) from None
+        run = await claim_run(manager, msg.run_id, transport)
+        if run is None:
+            return await transport.close()
     except ProtocolError as exc:
         await _refuse(transport, exc.code, exc.text, seq)
         return
@@ -52,7 +51,7 @@ async def _handle(manager: RunManager, transport: TcpTransport) -> None:
     await serve_client(manager, run, transport, frames)
 
 
-async def _refuse(transport: TcpTransport, code: ErrorCode, text: str, seq: int) -> None:
+async def _refuse(transport: TcpDoor, code: ErrorCode, text: str, seq: int) -> None:
     try:
         await asyncio.wait_for(transport.send(error_frame(code, text, seq)), 5.0)
     except Exception:  # noqa: BLE001

@@ -1,10 +1,12 @@
-"""The two coupling transports: plain TCP (length-prefixed frames) and WebSocket (one frame per
-binary message). Both give the coupling door the same recv/send/close."""
+"""What the coupling door reads and writes frames through (``DoorTransport``), and its two
+socket forms: plain TCP (length-prefixed frames) and WebSocket (one frame per binary message).
+The built-in theory source (theory_client.py) is a third, in memory."""
 
 from __future__ import annotations
 
 import asyncio
 import socket
+from typing import Protocol
 
 from fastapi import WebSocket, WebSocketDisconnect
 
@@ -14,11 +16,21 @@ from protocol.messages import Message
 READ_CHUNK = 1 << 16
 
 
+class DoorTransport(Protocol):
+    """``recv()`` gives a list of (seq, message), or None when the peer closed."""
+
+    max_payload: int
+
+    async def recv(self) -> list[tuple[int, Message]] | None: ...
+    async def send(self, data: bytes) -> None: ...
+    async def close(self) -> None: ...
+
+
 class PeerGone(Exception):
     """The connection broke while sending: the client vanished."""
 
 
-class TcpTransport:
+class TcpDoor:
     def __init__(self, reader: asyncio.StreamReader, writer: asyncio.StreamWriter,
                  max_payload: int) -> None:
         self.reader, self.writer = reader, writer
@@ -63,7 +75,7 @@ class TcpTransport:
             pass
 
 
-class WebSocketTransport:
+class WebSocketDoor:
     def __init__(self, ws: WebSocket, max_payload: int) -> None:
         self.ws = ws
         self.max_payload = max_payload

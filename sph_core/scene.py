@@ -9,6 +9,7 @@ Rectangles are given by their corners (x0, x1, z0, z1) in metres. Unknown keys a
 from __future__ import annotations
 
 import math
+from collections import Counter
 import tomllib
 from pathlib import Path
 from typing import Annotated, Literal, Union
@@ -199,8 +200,7 @@ class Scene(_Model):
                 raise ValueError(f"water_blocks.{i}: must lie inside the tank")
             if min(b.x1 - b.x0, b.z1 - b.z0) < self.dp:
                 raise ValueError(f"water_blocks.{i}: must be at least dp wide and high")
-        names = [p.name for p in self.probes]
-        dup = {n for n in names if names.count(n) > 1}
+        dup = {n for n, k in Counter(p.name for p in self.probes).items() if k > 1}  # O(n)
         if dup:
             raise ValueError(f"probes: duplicate names {sorted(dup)}")
         for i, p in enumerate(self.probes):

@@ -61,6 +61,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                    help="SHA-256 (hex) of the scene the model was set up for; refused if it differs")
     p.add_argument("--timeout", type=float, default=120.0,
                    help="longest wait for a server reply [s] (one SPH window)")
+    p.add_argument("--queue-timeout", type=float, default=3600.0,
+                   help="longest wait for the run to start [s] (it may be queued on the server; "
+                        "it is reserved for this client meanwhile)")
     p.add_argument("--output", default=None, help="CSV file for the gauge series (must not exist)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
 
@@ -131,7 +134,8 @@ def main(args: argparse.Namespace) -> int:
         if args.url.startswith("tcp://") and not args.run_id:
             raise ValueError("--run-id is required with a tcp:// url (the HELLO names the run)")
         report = couple(args.url, factory, options, run_id=args.run_id, scene_hash=scene_hash,
-                        timeout=args.timeout, log_path=args.output, progress=not args.no_progress)
+                        timeout=args.timeout, queue_timeout=args.queue_timeout,
+                        log_path=args.output, progress=not args.no_progress)
     except ValueError as exc:
         print(f"wavesph couple: {exc}", file=sys.stderr)
         return 2

@@ -9,9 +9,9 @@ from fastapi import APIRouter, WebSocket
 from protocol import ErrorCode, Hello, ProtocolError
 from protocol.session import HELLO_LIMIT
 
-from ..coupling import error_frame, serve_client
-from ..deps import websocket_token_ok
-from ..transports import WebSocketTransport
+from ..coupling import claim_run, error_frame, serve_client
+from ..deps import websocket_subprotocol, websocket_token_ok
+from ..transports import WebSocketDoor
 
 router = APIRouter(tags=["coupling"])
 
@@ -21,9 +21,9 @@ async def couple(ws: WebSocket, run_id: str) -> None:
     if not websocket_token_ok(ws):
         await ws.close(code=1008, reason="missing or wrong API token")
         return
-    await ws.accept()
+    await ws.accept(subprotocol=websocket_subprotocol(ws))
     manager = ws.app.state.manager
-    transport = WebSocketTransport(ws, min(HELLO_LIMIT, manager.settings.max_frame))
+    transport = WebSocketDoor(ws, min(HELLO_LIMIT, manager.settings.max_frame))
     seq = 0
     try:
         frames = await asyncio.wait_for(transport.recv(), manager.settings.hello_timeout)
@@ -34,10 +34,9 @@ async def couple(ws: WebSocket, run_id: str) -> None:
             raise ProtocolError(ErrorCode.OUT_OF_ORDER, f"{msg.TYPE.name} before HELLO")
         if msg.run_id not in ("", run_id):
             raise ProtocolError(ErrorCode.BUSY, f"HELLO.run_id {msg.run_id!r} differs from the URL's {run_id!r}")
-        try:
-            run = manager.attach(run_id)
-        except ValueError as exc:
-            raise ProtocolError(ErrorCode.BUSY, str(exc)) from None
+        run = await claim_run(manager, run_id, transport)
+        if run is None:
+            return await transport.close()
     except ProtocolError as exc:
         await _refuse(transport, exc.code, exc.text, seq)
         return
@@ -47,7 +46,7 @@ async def couple(ws: WebSocket, run_id: str) -> None:
     await serve_client(manager, run, transport, frames)
 
 
-async def _refuse(transport: WebSocketTransport, code: ErrorCode, text: str, seq: int) -> None:
+async def _refuse(transport: WebSocketDoor, code: ErrorCode, text: str, seq: int) -> None:
     try:
         await transport.send(error_frame(code, text, seq))
     except Exception:  # noqa: BLE001 -- the peer may already be gone

@@ -6,41 +6,74 @@ import asyncio
 import json
 from typing import Literal
 
-from fastapi import APIRouter, HTTPException, Query, Response
+from fastapi import APIRouter, HTTPException, Query, Request, Response
 from fastapi.responses import FileResponse, StreamingResponse
 
 from ..deps import Auth, Manager, RunDep
-from ..runs import TERMINAL
-from ..schemas import RunInfo, RunRequest, estimate_particles
+from ..runs import TERMINAL, QueueFull
+from ..schemas import RunInfo
 from ..store import read_gauges
-from ..theory_source import source_errors
+from ..validation import BodyNotJson, RequestInvalid, parse_run_request
 
-router = APIRouter(prefix="/runs", tags=["runs"], dependencies=[Auth])
+router = APIRouter(prefix="/runs", tags=["runs"], dependencies=[Auth], responses={
+    401: {"description": "missing or wrong API token (Authorization: Bearer <token>)"}})
 
 EVENT_POLL_S = 0.25
+RETRY_AFTER_S = 30  # what a refused POST is told to wait: about one short run
 
 
-def _unprocessable(loc: list[str], msg: str) -> HTTPException:
-    """A 422 shaped like FastAPI's own validation errors, naming the field."""
-    return HTTPException(422, [{"loc": loc, "msg": msg, "type": "value_error"}])
+def _queue_full(exc: QueueFull) -> HTTPException:
+    return HTTPException(429, str(exc), headers={"Retry-After": str(RETRY_AFTER_S)})
 
 
-@router.post("", status_code=201, response_model=RunInfo)
-async def create_run(body: RunRequest, manager: Manager) -> RunInfo:
-    """Create a run from a scene. Coupled runs wait for a client on `/runs/{id}/couple` (WebSocket)
-    or the TCP coupling port; standalone runs start stepping when a slot is free."""
-    n = estimate_particles(body.scene)
-    cap = manager.settings.max_particles
-    if n > cap:
-        raise _unprocessable(["body", "scene", "dp"],
-                             f"the scene needs about {n:.3g} particles, the server's cap is {cap:.3g}: "
-                             f"increase dp or shrink the tank and water blocks")
-    if body.mode == "coupled" and not body.scene.open_boundaries:
-        raise _unprocessable(["body", "scene", "open_boundaries"],
-                             "a coupled run needs at least one open end for the client to drive")
-    for loc, msg in source_errors(body.scene, body.mode, body.source, body.coupling.window_max):
-        raise _unprocessable(["body", *loc], msg)
-    return manager.submit(body).info
+def _detail(description: str) -> dict:
+    return {"description": description, "content": {"application/json": {"schema": {
+        "type": "object", "properties": {"detail": {}}}}}}
+
+
+NOT_FOUND = {404: _detail("no such run")}
+
+
+async def _read_body(request: Request, limit: int) -> bytes:
+    """The body, refused (413) as soon as it exceeds ``limit`` bytes, declared or streamed."""
+    declared = request.headers.get("content-length")
+    if declared is not None and declared.isdigit() and int(declared) > limit:
+        raise HTTPException(413, f"the body has {declared} bytes, the server's max_body is {limit}")
+    chunks, size = [], 0
+    async for chunk in request.stream():
+        size += len(chunk)
+        if size > limit:
+            raise HTTPException(413, f"the body exceeds the server's max_body of {limit} bytes")
+        chunks.append(chunk)
+    return b"".join(chunks)
+
+
+@router.post("", status_code=201, response_model=RunInfo, openapi_extra={"requestBody": {
+    "required": True, "content": {"application/json": {"schema": {"$ref": "#/components/schemas/RunRequest"}}}}},
+             responses={400: _detail("the body is not JSON"),
+                        413: _detail("the body exceeds max_body"),
+                        422: _detail("a field, or a rule across fields, is not met: `detail` lists "
+                                     "loc, msg, type (never the input); numbers must be finite; "
+                                     "the scene within max_particles and max_probes; "
+                                     "mode 'coupled' needs open_boundaries; 'source' only for a "
+                                     "standalone run with open_boundaries (and required there); "
+                                     "coupling.z_ref in the water column; windows at most 1e7"),
+                        429: _detail("the queue is full (max_queued); see Retry-After")})
+async def create_run(request: Request, manager: Manager) -> RunInfo:
+    """Create a run from a scene (body: RunRequest). Coupled runs wait for a client on
+    `/runs/{id}/couple` (WebSocket) or the TCP coupling port; standalone runs start stepping when
+    a slot is free. Everything the run needs is checked before the 201."""
+    raw = await _read_body(request, manager.settings.max_body)
+    try:  # parsing and validation off the event loop: a big scene never stalls other requests
+        body = await asyncio.to_thread(parse_run_request, raw, manager.settings)
+    except BodyNotJson as exc:
+        raise HTTPException(400, str(exc)) from None
+    except RequestInvalid as exc:
+        raise HTTPException(422, exc.errors) from None
+    try:
+        return manager.submit(body).info
+    except QueueFull as exc:
+        raise _queue_full(exc) from None
 
 
 @router.get("", response_model=list[RunInfo])
@@ -49,18 +82,18 @@ async def list_runs(manager: Manager) -> list[RunInfo]:
     return sorted((r.info for r in manager.runs.values()), key=lambda i: i.created)
 
 
-@router.get("/{run_id}", response_model=RunInfo)
+@router.get("/{run_id}", response_model=RunInfo, responses=NOT_FOUND)
 async def get_run(run: RunDep) -> RunInfo:
     return run.info
 
 
-@router.get("/{run_id}/scene")
+@router.get("/{run_id}/scene", responses=NOT_FOUND)
 async def get_scene(run: RunDep) -> Response:
     """The canonical scene bytes: the protocol's scene hash is their SHA-256."""
     return Response(run.scene_bytes, media_type="application/json")
 
 
-@router.get("/{run_id}/gauges")
+@router.get("/{run_id}/gauges", responses={404: _detail("no such run, or no gauge data yet")})
 async def get_gauges(run: RunDep, format: Literal["csv", "json"] = Query("csv")) -> Response:
     """Gauge series as CSV (dry gauges written `dry`) or JSON (`null` where dry)."""
     path = run.dir / (run.info.gauges_file or "gauges.csv")
@@ -72,7 +105,7 @@ async def get_gauges(run: RunDep, format: Literal["csv", "json"] = Query("csv"))
     return Response(json.dumps({"columns": columns, "rows": rows}), media_type="application/json")
 
 
-@router.delete("/{run_id}", response_model=RunInfo)
+@router.delete("/{run_id}", response_model=RunInfo, responses=NOT_FOUND)
 async def cancel_run(run: RunDep, manager: Manager) -> RunInfo:
     """Cancel a queued, waiting or running run; its data so far stays on disk."""
     manager.cancel(run)
@@ -83,18 +116,23 @@ async def cancel_run(run: RunDep, manager: Manager) -> RunInfo:
     return run.info
 
 
-@router.post("/{run_id}/resume", status_code=202, response_model=RunInfo)
+@router.post("/{run_id}/resume", status_code=202, response_model=RunInfo, responses={
+    **NOT_FOUND, 409: _detail("the run is not resumable"), 429: _detail("the queue is full")})
 async def resume_run(run: RunDep, manager: Manager) -> RunInfo:
     """Queue a coupled run that failed or was cancelled again, from its last saved window
     boundary (`resumable` in its record); a client then couples from WELCOME's t_start."""
     try:
+        if not await asyncio.to_thread(manager.state_intact, run):
+            manager.save(run)
         manager.resume(run)
+    except QueueFull as exc:
+        raise _queue_full(exc) from None
     except ValueError as exc:
         raise HTTPException(409, str(exc)) from None
     return run.info
 
 
-@router.get("/{run_id}/events")
+@router.get("/{run_id}/events", responses=NOT_FOUND)
 async def run_events(run: RunDep) -> StreamingResponse:
     """Server-Sent Events: a `progress` event with the run record whenever it changes; the
     stream ends after the event that shows a final state."""

@@ -63,6 +63,6 @@ class LiveServer(InProcessServer):
 
 
 @contextmanager
-def live_server(tmp_path: Path, engine_factory=None, **settings):
-    with LiveServer(tmp_path / "runs", engine_factory, **settings) as srv:
+def live_server(tmp_path: Path, engine_factory=None, log_level: str = "warning", **settings):
+    with LiveServer(tmp_path / "runs", engine_factory, log_level, **settings) as srv:
         yield srv

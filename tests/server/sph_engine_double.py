@@ -17,7 +17,7 @@ import time
 
 import numpy as np
 
-from server.engine import BoundaryNodes, Measurement, SceneSummary
+from server.engine import EngineNodes, Measurement, SceneSummary
 from server.schemas import RunRequest
 from sph_core.simulation import UnstableError
 
@@ -34,7 +34,7 @@ class EngineDouble:
                                     else -depth / 2, t_start=0.0, t_end=scene.t_end, dt_sph=dt_sph)
         n = max(int(round(depth / scene.dp)), 2)
         gauges = [p for p in scene.probes if p.kind == "elevation"]
-        self._nodes = BoundaryNodes(np.full(n, scene.tank.x0), np.linspace(-depth, 0.0, n),
+        self._nodes = EngineNodes(np.full(n, scene.tank.x0), np.linspace(-depth, 0.0, n),
                                     np.zeros(n, np.uint32), np.array([p.x for p in gauges]),
                                     [p.name for p in gauges])
         self.t, self.steps, self.n_particles = 0.0, 0, 1000
@@ -45,7 +45,7 @@ class EngineDouble:
         self._saved = None
         self.closed = False
 
-    def nodes(self) -> BoundaryNodes:
+    def nodes(self) -> EngineNodes:
         return self._nodes
 
     def set_window(self, t0, t1, u, w, eta) -> None:

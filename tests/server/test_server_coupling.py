@@ -295,3 +295,28 @@ def test_a_run_whose_client_vanished_resumes_from_its_last_window(srv, engines):
     np.testing.assert_allclose(eta[:50], 0.03 + (0.1 - 0.03) * np.arange(1, 51) / 50)
     rows = srv.http.get(f"/runs/{run['id']}/gauges", params={"format": "json"}).json()["rows"]
     assert [r["t"] for r in rows] == pytest.approx([0.05, 0.1, 0.15, 0.2, 0.25])
+
+
+@pytest.mark.parametrize("door", ["tcp", "ws"])
+def test_gauge_info_for_a_1_1_client_and_none_for_a_1_0_one(srv, door):
+    from protocol import Capability, Gauges, GetGauges, GetNodes, Nodes, Welcome
+
+    run = srv.create()
+    srv.wait_state(run["id"], "waiting_for_client")
+    c = _clients(srv, run["id"])[door]()
+    caps = Capability.GOBACK | Capability.GAUGE_INFO
+    welcome = c.request(Hello(caps, bytes(32), run["id"], "pytest 1.1"), expect=Welcome)
+    assert welcome.capabilities == caps
+    nodes = c.request(GetNodes(), expect=Nodes)
+    gauges = c.request(GetGauges(), expect=Gauges)
+    assert gauges.names == ["g_mid", "dry_g"] and len(gauges.names) == nodes.gauge_x.size
+    run_windows(c, welcome, nodes, 1)
+    bye(c)
+    # a 1.0 client: the capability is not granted, everything else as before
+    run2 = srv.create()
+    srv.wait_state(run2["id"], "waiting_for_client")
+    c = _clients(srv, run2["id"])[door]()
+    welcome, nodes = handshake(c, run2["id"])
+    assert welcome.capabilities == Capability.GOBACK
+    run_windows(c, welcome, nodes, 1)
+    bye(c)

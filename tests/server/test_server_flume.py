@@ -122,3 +122,19 @@ def test_resumed_flume_continues_exactly(tmp_path):
         assert res.steps == m.steps
         np.testing.assert_allclose(res.eta, np.where(m.wet, m.eta, 0.0), rtol=1e-12, atol=1e-15)
     engine.close()
+
+
+def test_flume_gauge_metadata_names_the_ends_own_gauges():
+    """Protocol 1.1 GAUGES: which gauge is which, and the gauge each end's absorber reads."""
+    from protocol import NO_GAUGE, GaugeKind
+
+    scene = {**FLUME, "open_boundaries": [{"side": "left", "absorb": True},
+                                          {"side": "right", "elevation": "extrapolated", "absorb": False}]}
+    engine = FlumeEngine(RunRequest.model_validate({"scene": scene, "mode": "coupled"}), None)
+    try:
+        nodes = engine.nodes()
+        assert nodes.gauge_names == ["left_boundary", "right_boundary", "g1"]
+        assert nodes.gauge_kind.tolist() == [GaugeKind.BOUNDARY, GaugeKind.BOUNDARY, GaugeKind.PROBE]
+        assert nodes.eta_gauge == (0, NO_GAUGE)  # the right end does not absorb
+    finally:
+        engine.close()

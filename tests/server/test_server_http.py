@@ -10,6 +10,7 @@ import pytest
 from fastapi.testclient import TestClient
 from pydantic import ValidationError
 
+from protocol import ErrorCode, GetNodes, Hello, Nodes, RemoteError, Welcome
 from server.main import create_app
 from server.settings import Settings
 
@@ -53,7 +54,8 @@ def test_mode_and_open_boundaries_must_agree(srv):
 
 
 def test_concurrency_cap_queues_runs(tmp_path, factory):
-    with live_server(tmp_path, factory, max_runs=1) as srv:
+    # issue 15: a coupled run waiting for its client holds a waiting place, not a stepping slot
+    with live_server(tmp_path, factory, max_runs=1, max_waiting=1) as srv:
         first, second = srv.create(), srv.create()
         srv.wait_state(first["id"], "waiting_for_client")
         info = srv.http.get(f"/runs/{second['id']}").json()
@@ -61,14 +63,28 @@ def test_concurrency_cap_queues_runs(tmp_path, factory):
         third = srv.create()
         assert srv.http.get(f"/runs/{third['id']}").json()["queue_position"] == 2
         assert srv.http.delete(f"/runs/{third['id']}").json()["status"] == "cancelled"
-        # finishing the first run frees its slot for the second
+        # the first run's client takes the one stepping slot; its waiting place goes to the second
         c = TcpClient(srv.tcp_port)
         welcome, nodes = handshake(c, first["id"])
+        srv.wait_state(second["id"], "waiting_for_client")
+        # while the first steps, the second's client waits for WELCOME (the run is its own)
+        c2 = TcpClient(srv.tcp_port)
+        c2.request(Hello(1, bytes(32), second["id"], "pytest"))
+        c3 = TcpClient(srv.tcp_port)  # another holder of the id cannot take it
+        c3.request(Hello(1, bytes(32), second["id"], "intruder"))
+        with pytest.raises(RemoteError) as exc:
+            c3.session.reply(*c3.recv(), expect=Welcome)
+        assert exc.value.code == ErrorCode.BUSY and "already has a coupling client" in exc.value.text
+        assert srv.http.get(f"/runs/{second['id']}").json()["state"] == "waiting_for_client"
+        # finishing the first run frees its slot for the second
         run_windows(c, welcome, nodes, 1)
         bye(c)
         srv.wait_state(first["id"], "finished")
-        srv.wait_state(second["id"], "waiting_for_client")
-        assert srv.http.delete(f"/runs/{second['id']}").json()["status"] == "cancelled"
+        welcome = c2.session.reply(*c2.recv(), expect=Welcome)
+        nodes = c2.request(GetNodes(), expect=Nodes)
+        run_windows(c2, welcome, nodes, 1)
+        bye(c2)
+        srv.wait_state(second["id"], "finished")
 
 
 def test_standalone_run_with_sph_core(srv):

@@ -28,3 +28,31 @@ def test_wave_client_couples_an_airy_wave(srv, engines, door):
     np.testing.assert_allclose([r["g_mid_eta"] for r in rows], expected, rtol=1e-9, atol=1e-12)
     np.testing.assert_allclose(report.t, t1)
     assert engines[0].steps == 300
+
+
+def test_wavesph_couple_waits_while_its_run_is_queued(tmp_path, factory, capsys, monkeypatch):
+    """Issue 15: `wavesph couple` on a queued run waits (saying so) and then couples."""
+    import argparse
+    import threading
+
+    from server_harness import live_server
+    from wave_client import couple_cli
+    from wave_client.coupling import runner
+
+    monkeypatch.setattr(runner, "WAIT_NOTE_EVERY", 0.2)
+    with live_server(tmp_path, factory, max_waiting=1) as srv:
+        blocker = srv.create()
+        srv.wait_state(blocker["id"], "waiting_for_client")
+        run = srv.create(t_end=0.1)
+        assert srv.http.get(f"/runs/{run['id']}").json()["state"] == "queued"
+        parser = argparse.ArgumentParser()
+        couple_cli.add_arguments(parser)
+        args = parser.parse_args(["--url", f"ws://127.0.0.1:{srv.port}/runs/{run['id']}/couple",
+                                  "--model", "linear", "--H", "0.02", "--T", "1.0",
+                                  "--window", "0.05", "--timeout", "20", "--queue-timeout", "30"])
+        # the run starts only when the blocker ends, a second or so after the client came
+        threading.Timer(1.0, lambda: srv.http.delete(f"/runs/{blocker['id']}")).start()
+        assert couple_cli.main(args) == 0
+        assert srv.wait_state(run["id"], "finished")["windows"] == 2
+    err = capsys.readouterr().err
+    assert "the run is not started yet" in err

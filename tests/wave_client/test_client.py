@@ -17,8 +17,8 @@ import time
 import numpy as np
 import pytest
 
-from protocol import (ErrorCode, FrameDecoder, Nodes, ProtocolError, Result, SphSession, Welcome,
-                      decode_frame)
+from protocol import (Bye, ErrorCode, FrameDecoder, Nodes, ProtocolError, Result, SphSession, Welcome,
+                      decode_frame, encode_frame)
 from protocol.session import PeerError, Reply, SetWindow, SolveWindow, set_payload_size
 from wave_client.coupling import (CouplingCore, CouplingError, CouplingOptions, CouplingTimeout,
                                   GaugeLog, ServerEnded, ServerError, parse_url, run_coupling)
@@ -105,7 +105,8 @@ class FakeSph:
                     if len(self.sets) == 2 and self.behaviour == "hangup":
                         return
                     if len(self.sets) == 2 and self.behaviour == "bye":
-                        await send(session.bye_frame("run cancelled by its owner"))
+                        # a BYE out of turn (a v1 server sends BYE only to answer one)
+                        await send(encode_frame(Bye("run cancelled by its owner"), seq))
                         return
                     await send(session.result(action, self.measure(action.t1, self.sets[-1])))
                 elif isinstance(action, PeerError):

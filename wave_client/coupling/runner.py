@@ -15,6 +15,7 @@ to the CSV log and flushed as it arrives, so a failed run keeps what it measured
 from __future__ import annotations
 
 import asyncio
+import sys
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -27,6 +28,8 @@ from protocol import ErrorCode, ProtocolError, RemoteError, Welcome
 from wave_client.coupling.core import (CouplingCore, CouplingError, CouplingOptions, ModelSource,
                                        ServerEnded, WindowRecord)
 from wave_client.coupling.transport import TransportClosed, open_transport, parse_url
+
+WAIT_NOTE_EVERY = 10.0  # [s] between "still waiting for the run to start" lines
 
 
 class CouplingTimeout(CouplingError):
@@ -108,14 +111,18 @@ class GaugeLog:
 async def run_coupling(url: str, model: ModelSource, options: CouplingOptions | None = None, *,
                        run_id: str | None = None, scene_hash: bytes | None = None,
                        timeout: float = 120.0, connect_timeout: float = 10.0,
+                       queue_timeout: float = 3600.0,
                        log_path: str | Path | None = None, progress: bool = True) -> CouplingReport:
     """Couple ``model`` to the SPH server at ``url`` until t_end; see the module docstring.
 
     ``timeout`` bounds every wait for a reply [s] (a RESULT takes as long as SPH needs for one
-    window); ``run_id`` defaults to the one in a ws:// url (required by the server on tcp://).
+    window); WELCOME comes when the server has started the run and has a stepping slot for it
+    (the run is reserved for this client meanwhile), so it is awaited up to ``queue_timeout``
+    [s], with a line on stderr every 10 s when ``progress``. ``run_id`` defaults to the one in a
+    ws:// url (required by the server on tcp://).
     """
-    if not timeout > 0 or not connect_timeout > 0:
-        raise ValueError("timeout and connect_timeout must be > 0 s")
+    if not timeout > 0 or not connect_timeout > 0 or not queue_timeout > 0:
+        raise ValueError("timeout, connect_timeout and queue_timeout must be > 0 s")
     _, _, _, url_run = parse_url(url)
     core = CouplingCore(model, options, run_id=run_id if run_id is not None else url_run,
                         **({} if scene_hash is None else {"scene_hash": scene_hash}))
@@ -135,7 +142,11 @@ async def run_coupling(url: str, model: ModelSource, options: CouplingOptions | 
     stage = "handshake"
     try:
         await transport.send([core.hello()])
-        await transport.send([core.on_welcome(*await transport.recv(timeout))])
+        stage, waited = f"waiting for the run to start (up to {queue_timeout:g} s)", timeout
+        timeout = queue_timeout
+        welcome = await _await_welcome(transport, queue_timeout, progress)
+        stage, timeout = "handshake", waited
+        await transport.send([core.on_welcome(*welcome)])
         core.on_nodes(*await transport.recv(timeout))
         report.welcome, report.gauges = core.welcome, core.gauges
         if log is not None:
@@ -189,6 +200,24 @@ async def run_coupling(url: str, model: ModelSource, options: CouplingOptions | 
             log.close()
         await _close_quietly(transport)
     return report
+
+
+async def _await_welcome(transport, limit: float, progress: bool):
+    """The server's answer to HELLO, which waits while the run is queued or every stepping slot
+    of the server is busy: up to ``limit`` s, saying so every WAIT_NOTE_EVERY s."""
+    loop = asyncio.get_running_loop()
+    start = loop.time()
+    while True:
+        left = limit - (loop.time() - start)
+        if left <= 0:
+            raise TimeoutError
+        try:
+            return await transport.recv(min(left, WAIT_NOTE_EVERY))
+        except TimeoutError:
+            if progress and loop.time() - start < limit:
+                print(f"wavesph couple: the run is not started yet (queued, or the server's "
+                      f"stepping slots are busy); reserved for us, waiting "
+                      f"{loop.time() - start:.0f} s", file=sys.stderr, flush=True)
 
 
 def _keep(report: CouplingReport, err: CouplingError) -> CouplingError:
