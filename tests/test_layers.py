@@ -24,25 +24,15 @@ SCRIPTS = ("bench", "examples")  # scripts: their names are checked, their own `
 # name -> the files that may define it, and why. A name defined in one more place, or no longer
 # defined twice, fails the test: update this list with the code.
 ALLOWED: dict[str, tuple[set[str], str]] = {
-    # pending renames on the server side (issue 10, server worktree): remove when merged
-    "BoundaryNodes": ({"sph_core/boundary_data.py", "server/engine.py"}, "server rename pending"),
-    "CouplingOptions": ({"wave_client/coupling/core.py", "server/schemas.py"}, "server rename pending"),
-    "Transport": ({"wave_client/coupling/transport.py", "server/coupling.py"}, "server rename pending"),
-    "TcpTransport": ({"wave_client/coupling/transport.py", "server/transports.py"},
-                     "server rename pending"),
-    "WebSocketTransport": ({"wave_client/coupling/transport.py", "server/transports.py"},
-                           "server rename pending"),
-    "write_json_atomic": ({"sph_core/output.py", "server/store.py"}, "server rename pending"),
-    "couple": ({"wave_client/coupling/runner.py", "server/routers/couple.py"}, "server rename pending"),
-    "get_run": ({"server/deps.py", "server/routers/runs.py"}, "server rename pending"),
-    "module runs": ({"server/runs.py", "server/routers/runs.py"}, "server rename pending"),
-    # pending in the solver rewrite (issue 10, core worktree): remove when merged
     # deliberate
+    "module runs": ({"server/runs.py", "server/routers/runs.py"},
+                    "the run manager and its HTTP routes: each routers module is named for its URL"),
     "module couple": ({"wavesph_cli/couple.py", "server/routers/couple.py"},
                       "`wavesph couple` and the /runs/{id}/couple endpoint: each named for its "
                       "command or URL"),
-    "log": ({"server/coupling.py", "server/main.py", "server/runs.py", "server/tcp.py",
-             "server/theory_source.py"}, "the logging convention: one `log` per module"),
+    "log": ({"server/coupling.py", "server/main.py", "server/runs.py", "server/store.py",
+             "server/tcp.py", "server/theory_client.py"},
+            "the logging convention: one `log` per module"),
     "router": ({"server/routers/couple.py", "server/routers/runs.py"},
                "the FastAPI convention: one `router` per routers module"),
 }

@@ -17,7 +17,7 @@ router = APIRouter(tags=["coupling"])
 
 
 @router.websocket("/runs/{run_id}/couple")
-async def couple(ws: WebSocket, run_id: str) -> None:
+async def couple_websocket(ws: WebSocket, run_id: str) -> None:
     if not websocket_token_ok(ws):
         await ws.close(code=1008, reason="missing or wrong API token")
         return

@@ -83,7 +83,7 @@ async def list_runs(manager: Manager) -> list[RunInfo]:
 
 
 @router.get("/{run_id}", response_model=RunInfo, responses=NOT_FOUND)
-async def get_run(run: RunDep) -> RunInfo:
+async def read_run(run: RunDep) -> RunInfo:
     return run.info
 
 

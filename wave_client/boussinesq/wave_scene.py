@@ -86,12 +86,12 @@ class Solver(_Strict):
     max_iter: int = Field(default=20, ge=1, description="corrector iteration cap")
 
 
-class Gauges(_Strict):
+class WaveGauges(_Strict):
     x: list[float] = Field(min_length=1, description="gauge positions [m]")
     names: list[str] | None = Field(default=None, description="column names (default eta_<x>m)")
 
     @model_validator(mode="after")
-    def _names(self) -> "Gauges":
+    def _names(self) -> "WaveGauges":
         if self.names is not None and len(self.names) != len(self.x):
             raise ValueError(f"names ({len(self.names)}) and x ({len(self.x)}) differ in length")
         return self
@@ -121,7 +121,7 @@ class WaveScene(_Strict):
     sponge: Sponge = Sponge()
     filter: Filter = Filter()
     solver: Solver = Solver()
-    gauges: Gauges
+    gauges: WaveGauges
     output: WaveOutput = WaveOutput()
     coupling: Coupling = Coupling()
 
