@@ -36,7 +36,7 @@ def test_wavesph_couple_waits_while_its_run_is_queued(tmp_path, factory, capsys,
     import threading
 
     from server_harness import live_server
-    from wave_client import couple_cli
+    from wavesph_cli import couple as couple_cli
     from wave_client.coupling import runner
 
     monkeypatch.setattr(runner, "WAIT_NOTE_EVERY", 0.2)
