@@ -149,6 +149,9 @@ class SphSession:
         if isinstance(msg, Hello):
             raise ProtocolError(ErrorCode.OUT_OF_ORDER, "a second HELLO: this session is open "
                                                         "already (one HELLO per connection)")
+        if isinstance(msg, (GetNodes, GetGauges)) and self.state is State.WINDOW_SET:
+            raise ProtocolError(ErrorCode.OUT_OF_ORDER, f"{msg.TYPE.name} after SET: ask between "
+                                                        "windows (state READY)")
         if isinstance(msg, GetNodes):
             return Reply(self._frame(self.nodes))
         if isinstance(msg, GetGauges):

@@ -12,8 +12,8 @@ import logging
 import time
 import numpy as np
 
-from protocol import (Capability, ErrorCode, GaugeKind, Gauges, Nodes, ProtocolError, Result,
-                      SphSession, Welcome, encode_frame)
+from protocol import (NO_SCENE_HASH, Capability, ErrorCode, GaugeKind, Gauges, Nodes, ProtocolError,
+                      Result, SphSession, Welcome, encode_frame)
 from protocol.messages import Error, Hello, Message
 from protocol.session import Measure, PeerError, Reply, Restore, SetWindow, SolveWindow
 
@@ -38,10 +38,18 @@ def error_frame(code: ErrorCode, text: str, seq: int = 0) -> bytes:
     return encode_frame(Error(int(code), text[:4000]), seq)
 
 
-async def claim_run(manager: RunManager, run_id: str, transport: DoorTransport) -> Run | None:
+async def claim_run(manager: RunManager, run_id: str, hello: Hello,
+                    transport: DoorTransport) -> Run | None:
     """The run a client's HELLO names, reserved for it at once and attached (a stepping slot
     taken) when it is built and a slot is free; the client waits for WELCOME meanwhile. None if
-    the client left while waiting; ProtocolError (BUSY, CANCELLED, OUT_OF_ORDER) to refuse it."""
+    the client left while waiting; ProtocolError (BUSY, CANCELLED, OUT_OF_ORDER,
+    SCENE_MISMATCH) to refuse it. A refused client leaves the run as it was."""
+    known = manager.runs.get(run_id)
+    if known is not None and hello.scene_hash not in (NO_SCENE_HASH, bytes.fromhex(known.info.scene_hash)):
+        raise ProtocolError(ErrorCode.SCENE_MISMATCH,
+                            f"client expects scene {hello.scene_hash.hex()[:16]}..., run {run_id} "
+                            f"has {known.info.scene_hash[:16]}... (GET /runs/{run_id}/scene); "
+                            f"the run keeps waiting for its client")
     try:
         run = manager.reserve(run_id)
     except ValueError as exc:

@@ -186,7 +186,9 @@ class RunManager:
     def _set_state(self, run: Run, state: str, reason: str | None = None) -> None:
         run.info.state = state
         run.info.reason = reason
-        run.info.status = f"{state}: {reason}" if reason and state in (FAILED, UNSTABLE) else state
+        run.info.status = state
+        if reason and state in (FAILED, UNSTABLE):  # "unstable at step ...", not "unstable: unstable at"
+            run.info.status = reason if reason.startswith(state) else f"{state}: {reason}"
         run.info.resumable = (state in (FAILED, CANCELLED) and _windowed(run.request)
                               and has_seal(run.state_file))
         if state in TERMINAL:

@@ -9,8 +9,8 @@ Rectangles are given by their corners (x0, x1, z0, z1) in metres. Unknown keys a
 from __future__ import annotations
 
 import math
-from collections import Counter
 import tomllib
+from collections import Counter
 from pathlib import Path
 from typing import Annotated, Literal, Union
 

@@ -67,3 +67,15 @@ def test_a_server_without_gauge_info_does_not_offer_it():
 def test_gauges_must_match_welcome():
     with pytest.raises(ValueError, match="gauges"):
         SphSession(WELCOME, NODES, Gauges(["a"], [0], [0, 0]))
+
+
+def test_getnodes_and_getgauges_after_set_are_out_of_order():
+    from protocol import GetNodes, Set
+
+    for seq, msg in ((3, GetNodes()), (3, GetGauges())):
+        s = SphSession(WELCOME, NODES, GAUGES)
+        _hello(s, Capability.GOBACK | Capability.GAUGE_INFO)
+        s.receive(2, Set(0.0, 0.05, np.zeros(2), np.zeros(2), np.zeros(2)))
+        with pytest.raises(ProtocolError) as exc:
+            s.receive(seq, msg)
+        assert exc.value.code is ErrorCode.OUT_OF_ORDER and "after SET" in exc.value.text
