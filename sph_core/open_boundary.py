@@ -17,7 +17,7 @@ interpolated linearly in time and linearly in z between the nodes):
     surface z_s,b = swl + eta_b(t)  (elevation imposed)  or  swl + eta_meas,b  (extrapolated)
     active (interacts as fluid) iff z_i < z_s,b;  rho_i = rho0 (1 + rho0 g (z_s,b - z_i)/B)^(1/7)
     (hydrostatic below the imposed or measured surface; Tait EOS, same form as the initial state),
-    or, at an end with ghost extrapolation (OB_GHOST; seed 002's outlet), after the sort:
+    or, at an end with ghost extrapolation (OpenEnds.ghost; seed 002's outlet), after the sort:
     p_i = p_g + (x_i - x_g) dp/dx_g from the fluid at the ghost node x_g = 2 x_f - x_i mirrored
     into the fluid (first-order consistent interpolation, Tafuni et al. 2018), rho_i = EOS^-1(p_i).
     The outlet extrapolates by default (scene.OUTLET_PRESSURE, with the measured reflection: half
