@@ -9,7 +9,8 @@ warm-up; particles counts all active particles (fluid + wall), as the DualSPHysi
 anchors do. Also measures the one-off numba compile time, cold (empty cache) and cached.
 
 Output: one JSON object per line.
-    python bench/sph_throughput.py [--steps 400] [--dps 0.01 0.005] [--integrator kdk] [--diagnostics]
+    python bench/sph_throughput.py [--steps 400] [--dps 0.01 0.005] [--integrator kdk]
+        [--cells-per-support 2] [--diagnostics]
 """
 
 from __future__ import annotations
@@ -71,20 +72,21 @@ def time_components(sim, repeats: int) -> dict:
     return {"sort": t_sort, "wall": t_wall, "fluid": t_fluid, "kick": t_kick}
 
 
-def run_size(dp: float, steps: int, integrator: str, diagnostics: bool) -> dict:
+def run_size(dp: float, steps: int, integrator: str, diagnostics: bool,
+             cells_per_support: int | None) -> dict:
     import numba
 
     from cases.dambreak import dambreak_scene
     from sph_core.simulation import Simulation
 
     scene = dambreak_scene(a=1.0, dp=dp, t_end=1.0, integrator=integrator)
-    sim = Simulation(scene)
+    sim = Simulation(scene, **({"cells_per_support": cells_per_support} if cells_per_support else {}))
     sim.advance_steps(20)                     # warm-up (compiled already, touches memory)
     sim.wall_time = 0.0
     s0 = sim.steps
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     sim.advance_steps(steps)
-    wall = time.perf_counter() - t0
+    wall, cpu = time.perf_counter() - t0, time.process_time() - c0
     n = sim.n_particles
     parts = time_components(sim, repeats=20)
     kick_calls = 2 if integrator == "kdk" else 2   # kdk: drift+kick; pc: predict+correct
@@ -96,9 +98,10 @@ def run_size(dp: float, steps: int, integrator: str, diagnostics: bool) -> dict:
     total = sum(per_step.values())
     out = {
         "bench": "sph_throughput", "case": "dambreak_2d_1x2m_tank4m", "dp": dp,
-        "integrator": integrator, "particles": n, "fluid_particles": sim.n_fluid,
+        "integrator": integrator, "neighbours": "cell_lists",
+        "cell_side_over_h": round(sim.grid.cs / sim.h, 3), "particles": n, "fluid_particles": sim.n_fluid,
         "steps": sim.steps - s0, "passes_per_step": sim.passes_per_step,
-        "wall_s": round(wall, 3),
+        "wall_s": round(wall, 3), "cpu_s": round(cpu, 3),
         "particle_steps_per_s": round(n * (sim.steps - s0) / wall),
         "particle_passes_per_s": round(n * (sim.steps - s0) * sim.passes_per_step / wall),
         "threads": numba.get_num_threads(), "threading_layer": numba.threading_layer(),
@@ -119,13 +122,16 @@ def main() -> None:
     ap.add_argument("--steps", type=int, default=400)
     ap.add_argument("--dps", type=float, nargs="+", default=[0.01, 0.005])
     ap.add_argument("--integrator", choices=["kdk", "symplectic_pc"], default="kdk")
+    ap.add_argument("--cells-per-support", type=int, default=None,
+                    help="neighbour cells of side 2h / this (default: the Simulation's)")
     ap.add_argument("--diagnostics", action="store_true", help="print numba parallel diagnostics")
     ap.add_argument("--no-compile", action="store_true", help="skip the compile-time measurement")
     args = ap.parse_args()
     if not args.no_compile:
         print(json.dumps(compile_times(args.integrator)), flush=True)
     for dp in args.dps:
-        print(json.dumps(run_size(dp, args.steps, args.integrator, args.diagnostics)), flush=True)
+        print(json.dumps(run_size(dp, args.steps, args.integrator, args.diagnostics,
+                                  args.cells_per_support)), flush=True)
 
 
 if __name__ == "__main__":

@@ -1,8 +1,12 @@
-"""Cell-list neighbour search: cells of side 2h (the kernel support), counting sort, reorder.
+"""Cell-list neighbour search: square cells of side 2h / reach, counting sort, reorder.
 
 After ``sort_by_cell`` the particles of cell c are the contiguous slots
-``cell_start[c] : cell_start[c + 1]`` (cell index c = cz * ncx + cx), so the 3 x 3 block around a
-particle is three contiguous runs of slots. Inactive particles go to an extra bin at the end.
+``start[c] : start[c + 1]`` (cell index c = cz * ncx + cx), so the (2 reach + 1)^2 block of cells
+that covers a particle's support 2h is 2 reach + 1 contiguous runs of slots (``block_of``).
+Inactive particles go to an extra bin at the end.
+reach = 1 (cells of 2h, 3 x 3 block) tests 36 h^2 of area for a support of 4 pi h^2 (35 % hits);
+reach = 2 (cells of h, 5 x 5) tests 25 h^2 (50 % hits): fewer distance tests per neighbour, the
+default (bench/sph_throughput.py --cells-per-support measures it).
 """
 
 from __future__ import annotations
@@ -25,13 +29,18 @@ class CellGrid:
     cs: float
     ncx: int
     ncz: int
+    reach: int = 1  # cells per support radius: the search block is (2 reach + 1)^2 cells
 
     @classmethod
-    def covering(cls, x0: float, x1: float, z0: float, z1: float, cs: float) -> "CellGrid":
-        """A grid over the box with one spare cell on every side."""
+    def covering(cls, x0: float, x1: float, z0: float, z1: float, support: float,
+                 reach: int = 1) -> "CellGrid":
+        """A grid of cells of side support / reach over the box, one spare cell on every side."""
+        if reach < 1:
+            raise ValueError(f"reach: must be >= 1 cell per support, got {reach}")
+        cs = support / reach
         ncx = int(math.ceil((x1 - x0) / cs)) + 3
         ncz = int(math.ceil((z1 - z0) / cs)) + 3
-        return cls(x0 - cs, z0 - cs, cs, ncx, ncz)
+        return cls(x0 - cs, z0 - cs, cs, ncx, ncz, reach)
 
     @property
     def ncell(self) -> int:
@@ -41,7 +50,26 @@ class CellGrid:
         """Empty cell lists on this grid for ``capacity`` particle slots."""
         return Cells(np.zeros(self.ncell + 2, dtype=np.int64), np.zeros(self.ncell + 1, dtype=np.int64),
                      np.zeros(capacity, dtype=np.int64), self.ncx, self.ncz, float(self.xmin),
-                     float(self.zmin), 1.0 / self.cs)
+                     float(self.zmin), 1.0 / self.cs, self.reach)
+
+
+@njit(cache=True, inline="always")
+def block_of(c, cells):
+    """(cxl, cxh, czl, czh): the block of cells within reach of cell c, clipped to the grid; its
+    particles are the slots start[zz * ncx + cxl] : start[zz * ncx + cxh + 1], zz in czl..czh."""
+    ncx = cells.ncx
+    r = cells.reach
+    cz = c // ncx
+    cx = c - cz * ncx
+    return max(cx - r, 0), min(cx + r, ncx - 1), max(cz - r, 0), min(cz + r, cells.ncz - 1)
+
+
+@njit(cache=True, inline="always")
+def cell_at(x, z, cells):
+    """Cell index of the point (x, z), clamped to the grid."""
+    cx = min(max(int((x - cells.xmin) * cells.inv_cs), 0), cells.ncx - 1)
+    cz = min(max(int((z - cells.zmin) * cells.inv_cs), 0), cells.ncz - 1)
+    return cz * cells.ncx + cx
 
 
 @njit(parallel=True, cache=True)

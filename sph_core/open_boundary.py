@@ -17,7 +17,7 @@ interpolated linearly in time and linearly in z between the nodes):
     surface z_s,b = swl + eta_b(t)  (elevation imposed)  or  swl + eta_meas,b  (extrapolated)
     active (interacts as fluid) iff z_i < z_s,b;  rho_i = rho0 (1 + rho0 g (z_s,b - z_i)/B)^(1/7)
     (hydrostatic below the imposed or measured surface; Tait EOS, same form as the initial state),
-    or, at an end with ghost extrapolation (OB_GHOST; seed 002's outlet), after the sort:
+    or, at an end with ghost extrapolation (OpenEnds.ghost; seed 002's outlet), after the sort:
     p_i = p_g + (x_i - x_g) dp/dx_g from the fluid at the ghost node x_g = 2 x_f - x_i mirrored
     into the fluid (first-order consistent interpolation, Tafuni et al. 2018), rho_i = EOS^-1(p_i).
     The outlet extrapolates by default (scene.OUTLET_PRESSURE, with the measured reflection: half
@@ -47,6 +47,7 @@ from numba import njit, prange
 
 from .eos import density, pressure
 from .kernels import f_of_q, w_of_q
+from .neighbours import block_of, cell_at
 from .particles import FLUID, INACTIVE, INLET, OUTLET
 
 # idle buffer particles: above the boundary's surface, kept in place but not interacting.
@@ -250,18 +251,14 @@ def ghost_pressure(ps, cells, xg, zg, prm):
     kind = ps.kind
     cell_start = cells.start
     ncx = cells.ncx
-    ncz = cells.ncz
     h = prm.h
     aw = prm.alpha_w
     af = prm.alpha_f
     s2 = 4.0 * h * h
-    cx = min(max(int((xg - cells.xmin) * cells.inv_cs), 0), ncx - 1)
-    cz = min(max(int((zg - cells.zmin) * cells.inv_cs), 0), ncz - 1)
-    cxl = max(cx - 1, 0)
-    cxh = min(cx + 1, ncx - 1)
+    cxl, cxh, czl, czh = block_of(cell_at(xg, zg, cells), cells)
     a00 = a01 = a02 = a10 = a11 = a12 = a20 = a21 = a22 = 0.0
     b0 = b1 = b2 = 0.0
-    for zz in range(max(cz - 1, 0), min(cz + 2, ncz)):
+    for zz in range(czl, czh + 1):
         row = zz * ncx
         for j in range(cell_start[row + cxl], cell_start[row + cxh + 1]):
             if kind[j] != FLUID:
@@ -360,21 +357,17 @@ def surface_z(ps, cells, xp, z_lo, z_hi, dz, prm):
     kind = ps.kind
     cell_start = cells.start
     ncx = cells.ncx
-    ncz = cells.ncz
     h = prm.h
     aw = prm.alpha_w
     level = 0.5 * prm.rho0
     s2 = 4.0 * h * h
     nz = int((z_hi - z_lo) / dz) + 1
-    cx = min(max(int((xp - cells.xmin) * cells.inv_cs), 0), ncx - 1)
-    cxl = max(cx - 1, 0)
-    cxh = min(cx + 1, ncx - 1)
     prev = 0.0
     for k in range(nz - 1, -1, -1):
         zk = z_lo + k * dz
-        cz = min(max(int((zk - cells.zmin) * cells.inv_cs), 0), ncz - 1)
+        cxl, cxh, czl, czh = block_of(cell_at(xp, zk, cells), cells)
         s = 0.0
-        for zz in range(max(cz - 1, 0), min(cz + 2, ncz)):
+        for zz in range(czl, czh + 1):
             row = zz * ncx
             for j in range(cell_start[row + cxl], cell_start[row + cxh + 1]):
                 kj = kind[j]

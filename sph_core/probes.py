@@ -20,26 +20,21 @@ import numpy as np
 from numba import njit, prange
 
 from .kernels import w_of_q
-from .particles import FLUID, M, P, RHO, VX, VZ, X, Z
+from .neighbours import block_of, cell_at
+from .particles import FLUID
 
 
 @njit(cache=True)
-def _cell_range(xp, zp, xmin, zmin, inv_cs, ncx, ncz):
-    cx = int((xp - xmin) * inv_cs)
-    cz = int((zp - zmin) * inv_cs)
-    cx = min(max(cx, 0), ncx - 1)
-    cz = min(max(cz, 0), ncz - 1)
-    return max(cx - 1, 0), min(cx + 1, ncx - 1), max(cz - 1, 0), min(cz + 1, ncz - 1)
-
-
-@njit(cache=True)
-def interpolate_points(f, kind, cell_start, xs, zs, h, alpha_w, xmin, zmin, inv_cs, ncx, ncz, out):
+def interpolate_points(ps, cells, xs, zs, h, alpha_w, out):
     """out[k] = (u, w, p, sum V W) at point k (Shepard-normalised; zeros where sum V W = 0)."""
-    x = f[X]
-    z = f[Z]
+    x = ps.x
+    z = ps.z
+    kind = ps.kind
+    cell_start = cells.start
+    ncx = cells.ncx
     s2 = 4.0 * h * h
     for k in range(xs.size):
-        cxl, cxh, czl, czh = _cell_range(xs[k], zs[k], xmin, zmin, inv_cs, ncx, ncz)
+        cxl, cxh, czl, czh = block_of(cell_at(xs[k], zs[k], cells), cells)
         su = 0.0
         sw_ = 0.0
         sp = 0.0
@@ -52,11 +47,11 @@ def interpolate_points(f, kind, cell_start, xs, zs, h, alpha_w, xmin, zmin, inv_
                     dz = zs[k] - z[j]
                     r2 = dx * dx + dz * dz
                     if r2 < s2:
-                        vw = f[M, j] / f[RHO, j] * w_of_q(math.sqrt(r2) / h, alpha_w)
+                        vw = ps.m[j] / ps.rho[j] * w_of_q(math.sqrt(r2) / h, alpha_w)
                         sv += vw
-                        su += f[VX, j] * vw
-                        sw_ += f[VZ, j] * vw
-                        sp += f[P, j] * vw
+                        su += ps.vx[j] * vw
+                        sw_ += ps.vz[j] * vw
+                        sp += ps.p[j] * vw
         if sv > 0.0:
             out[k, 0] = su / sv
             out[k, 1] = sw_ / sv
@@ -69,13 +64,16 @@ def interpolate_points(f, kind, cell_start, xs, zs, h, alpha_w, xmin, zmin, inv_
 
 
 @njit(cache=True)
-def line_mass_density(f, kind, cell_start, xp, zs, h, alpha_w, xmin, zmin, inv_cs, ncx, ncz, out):
+def line_mass_density(ps, cells, xp, zs, h, alpha_w, out):
     """out[k] = sum_j m_j W at (xp, zs[k]) over fluid particles (seed 004, eq. 23)."""
-    x = f[X]
-    z = f[Z]
+    x = ps.x
+    z = ps.z
+    kind = ps.kind
+    cell_start = cells.start
+    ncx = cells.ncx
     s2 = 4.0 * h * h
     for k in range(zs.size):
-        cxl, cxh, czl, czh = _cell_range(xp, zs[k], xmin, zmin, inv_cs, ncx, ncz)
+        cxl, cxh, czl, czh = block_of(cell_at(xp, zs[k], cells), cells)
         s = 0.0
         for zz in range(czl, czh + 1):
             row = zz * ncx
@@ -85,7 +83,7 @@ def line_mass_density(f, kind, cell_start, xp, zs, h, alpha_w, xmin, zmin, inv_c
                     dz = zs[k] - z[j]
                     r2 = dx * dx + dz * dz
                     if r2 < s2:
-                        s += f[M, j] * w_of_q(math.sqrt(r2) / h, alpha_w)
+                        s += ps.m[j] * w_of_q(math.sqrt(r2) / h, alpha_w)
         out[k] = s
 
 
@@ -102,22 +100,22 @@ def surface_from_line(zs: np.ndarray, rho_f: np.ndarray, level: float) -> float 
 
 
 @njit(parallel=True, cache=True)
-def fluid_neighbour_counts(f, kind, cell, cell_start, n, h, ncx, ncz, counts):
+def fluid_neighbour_counts(ps, n, cells, h, counts):
     """counts[i] = number of fluid neighbours within 2h of fluid particle i (-1 for others)."""
-    x = f[X]
-    z = f[Z]
+    x = ps.x
+    z = ps.z
+    kind = ps.kind
+    cell = ps.cell
+    cell_start = cells.start
+    ncx = cells.ncx
     s2 = 4.0 * h * h
     for i in prange(n):
         if kind[i] != FLUID:
             counts[i] = -1
         else:
-            c = cell[i]
-            cz = c // ncx
-            cx = c - cz * ncx
-            cxl = cx - 1 if cx > 0 else 0
-            cxh = cx + 1 if cx < ncx - 1 else ncx - 1
+            cxl, cxh, czl, czh = block_of(cell[i], cells)
             k = 0
-            for zz in range(max(cz - 1, 0), min(cz + 2, ncz)):
+            for zz in range(czl, czh + 1):
                 row = zz * ncx
                 for j in range(cell_start[row + cxl], cell_start[row + cxh + 1]):
                     if j != i and kind[j] == FLUID:

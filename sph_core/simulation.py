@@ -39,6 +39,8 @@ from .scene import ElevationProbe, FrontProbe, PointProbe, Scene
 from .state import Params
 
 STEPS_PER_CALL = 200  # steps per jitted call between progress callbacks
+# cells per kernel support radius 2h (neighbours.py): 2 = cells of side h, a 5 x 5 search block
+CELLS_PER_SUPPORT = 2
 
 
 class UnstableError(RuntimeError):
@@ -55,11 +57,12 @@ class Simulation:
     """WCSPH run of one scene; see the module docstring for the contract.
 
     ``sources`` (side -> BoundaryData) and ``window`` [s] apply to scenes with open ends;
-    ``spare`` is the spare particle capacity (default 0.1, 0.3 with open ends: inflow)."""
+    ``spare`` is the spare particle capacity (default 0.1, 0.3 with open ends: inflow);
+    ``cells_per_support`` sets the neighbour cells' side, 2h / cells_per_support."""
 
     def __init__(self, scene: Scene, run_dir: str | Path | None = None,
                  spare: float | None = None, sources: Mapping[str, BoundaryData] | None = None,
-                 window: float = 0.02) -> None:
+                 window: float = 0.02, cells_per_support: int = CELLS_PER_SUPPORT) -> None:
         self.scene = scene
         c = scene.constants
         layout = build_layout(scene)
@@ -83,7 +86,8 @@ class Simulation:
         self.open.attach(ps, scene, self.b, layout.n_layers * dp)
         t = scene.tank
         wall = layout.n_layers * dp
-        self.grid = CellGrid.covering(t.x0 - wall, t.x1 + wall, t.z0 - wall, t.z1, 2.0 * h)
+        self.grid = CellGrid.covering(t.x0 - wall, t.x1 + wall, t.z0 - wall, t.z1, 2.0 * h,
+                                      reach=cells_per_support)
         self.cells = self.grid.lists(ps.capacity)
         aw = wendland_alpha(h)
         # a fluid particle whose centre passes the first dummy layer (dp/2 behind the wall face)
@@ -183,31 +187,26 @@ class Simulation:
 
     def probe_values(self) -> dict[str, float | None]:
         """Configured probes at the current state [SI]; None marks a dry probe."""
-        g = self.grid
-        f, kind = self.particles.f, self.particles.kind
+        ps = self.particles
         aw = self.prm.alpha_w
-        cell_start = self.cells.start
         out: dict[str, float | None] = {}
         if self._points:
-            interpolate_points(f, kind, cell_start, self._px, self._pz, self.h, aw, g.xmin,
-                               g.zmin, 1.0 / g.cs, g.ncx, g.ncz, self._pout)
+            interpolate_points(ps.view, self.cells, self._px, self._pz, self.h, aw, self._pout)
             for k, p in enumerate(self._points):
                 wet = self._pout[k, 3] > 0.05
                 for j, suffix in enumerate(("u", "w", "p")):
                     out[f"{p.name}_{suffix}"] = float(self._pout[k, j]) if wet else None
         rho0 = self.scene.constants.rho0
         for p in self._elev:
-            line_mass_density(f, kind, cell_start, float(p.x), self._line_z, self.h, aw,
-                              g.xmin, g.zmin, 1.0 / g.cs, g.ncx, g.ncz, self._line_rho)
+            line_mass_density(ps.view, self.cells, float(p.x), self._line_z, self.h, aw,
+                              self._line_rho)
             zs = surface_from_line(self._line_z, self._line_rho, p.threshold * rho0)
             out[f"{p.name}_z_surface"] = zs
             swl = self.scene.still_water_level
             if swl is not None:
                 out[f"{p.name}_eta"] = None if zs is None else zs - swl
         if self._fronts:
-            ps = self.particles
-            fluid_neighbour_counts(f, kind, ps.cell, cell_start, ps.n, self.h, g.ncx,
-                                   g.ncz, self._counts)
+            fluid_neighbour_counts(ps.view, ps.n, self.cells, self.h, self._counts)
             counts = self._counts[: ps.n]
             x = ps.field(X)
             for p in self._fronts:

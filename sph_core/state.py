@@ -59,7 +59,8 @@ def particles_view(f: np.ndarray, kind: np.ndarray, ids: np.ndarray, cell: np.nd
 
 class Cells(NamedTuple):
     """Cell lists: the particles of cell c = cz * ncx + cx are slots start[c]:start[c + 1] (the
-    bin ncx * ncz holds inactive slots); cursor and order are the sort's scratch."""
+    bin ncx * ncz holds inactive slots); cursor and order are the sort's scratch. A particle's
+    neighbours are in the block neighbours.block_of(cell)."""
 
     start: np.ndarray
     cursor: np.ndarray
@@ -69,6 +70,7 @@ class Cells(NamedTuple):
     xmin: float
     zmin: float
     inv_cs: float
+    reach: int           # cells per support radius 2h: the search block is (2 reach + 1)^2
 
 
 class Params(NamedTuple):

@@ -36,6 +36,7 @@ from numba import njit, prange
 
 from .eos import density, pressure
 from .kernels import f_of_q, w_of_q
+from .neighbours import block_of
 from .particles import FLUID, INLET, OUTLET, WALL
 
 # status codes returned by the time loop (step.run)
@@ -80,7 +81,6 @@ def wall_pass(ps, n, cells, prm):
     cell = ps.cell
     cell_start = cells.start
     ncx = cells.ncx
-    ncz = cells.ncz
     h = prm.h
     inv_h = 1.0 / h
     s2 = 4.0 * h * h
@@ -100,12 +100,8 @@ def wall_pass(ps, n, cells, prm):
             sp = 0.0
             svx = 0.0
             svz = 0.0
-            c = cell[i]
-            cz = c // ncx
-            cx = c - cz * ncx
-            cxl = cx - 1 if cx > 0 else 0
-            cxh = cx + 1 if cx < ncx - 1 else ncx - 1
-            for zz in range(max(cz - 1, 0), min(cz + 2, ncz)):
+            cxl, cxh, czl, czh = block_of(cell[i], cells)
+            for zz in range(czl, czh + 1):
                 row = zz * ncx
                 for j in range(cell_start[row + cxl], cell_start[row + cxh + 1]):
                     # fluid and active open-boundary buffer particles (kinds 0, 2, 3)
@@ -155,7 +151,6 @@ def fluid_pass(ps, n, cells, prm):
     cell = ps.cell
     cell_start = cells.start
     ncx = cells.ncx
-    ncz = cells.ncz
     h = prm.h
     inv_h = 1.0 / h
     s2 = 4.0 * h * h
@@ -181,18 +176,15 @@ def fluid_pass(ps, n, cells, prm):
             vzi = vz[i]
             rhoi = rho[i]
             pi = p[i]
+            inv_rhoi = 1.0 / rhoi
             # hydrostatic density gradient factor rho_i g / c_i^2 (Fourtakas et al. 2019)
             khyd = rhoi * g / (c0 * c0 * (rhoi / rho0) ** (gam - 1.0))
             fx = 0.0
             fz = 0.0
             cont = 0.0
             diff = 0.0
-            c = cell[i]
-            cz = c // ncx
-            cx = c - cz * ncx
-            cxl = cx - 1 if cx > 0 else 0
-            cxh = cx + 1 if cx < ncx - 1 else ncx - 1
-            for zz in range(max(cz - 1, 0), min(cz + 2, ncz)):
+            cxl, cxh, czl, czh = block_of(cell[i], cells)
+            for zz in range(czl, czh + 1):
                 row = zz * ncx
                 for j in range(cell_start[row + cxl], cell_start[row + cxh + 1]):
                     kj = kind[j]
@@ -213,7 +205,8 @@ def fluid_pass(ps, n, cells, prm):
                     dvx = vxi - vx[j]
                     dvz = vzi - vz[j]
                     cont -= vol * fij * (dvx * dx + dvz * dz)
-                    pf = mj * (pi + p[j]) / (rhoi * rhoj)
+                    # m_j (p_i + p_j) / (rho_i rho_j), with the divisions shared per pair
+                    pf = vol * (pi + p[j]) * inv_rhoi
                     visc = kj != WALL or noslip
                     # height of i above j along gravity (z_i - z_j for g = (0, -g)); wall
                     # densities come from the Adami extrapolation, so they carry the hydrostatic
@@ -225,9 +218,10 @@ def fluid_pass(ps, n, cells, prm):
                         dvz = vzi - vwz[j]
                     if visc:
                         vr = dvx * dx + dvz * dz
+                        mden = mj / ((rhoi + rhoj) * (r2 + eta2))
                         if vr < 0.0:
-                            pf -= mj * av * vr / (0.5 * (rhoi + rhoj) * (r2 + eta2))
-                        lam = mj * nu4 * r2 / ((rhoi + rhoj) * (r2 + eta2))
+                            pf -= 2.0 * av * vr * mden
+                        lam = nu4 * r2 * mden
                         fx -= lam * fij * dvx
                         fz -= lam * fij * dvz
                     fx += pf * fij * dx
