@@ -45,7 +45,8 @@ class Tank(Rect):
     """The fluid domain: walls of dummy particles left (x0), right (x1) and below (z0).
 
     The walls reach up to z1, which is also the top of the computational domain: a particle above
-    z1 has left the domain and stops the run."""
+    z1 has left the domain and is excluded (Constants.exclude_limit), as one whose density left
+    the band."""
 
 
 class WaterBlock(Rect):
@@ -87,10 +88,11 @@ class Constants(_Model):
     # A drop thrown off the surface (splash, run-up on a staircase bed) keeps few neighbours: its
     # density leaves the band by continuity and, landing, it can be crushed against the wall
     # particles. Such particles are removed and logged, as DualSPHysics excludes particles
-    # leaving [700, 1300] kg/m^3; more than this share means a real blow-up: the run stops.
+    # leaving [700, 1300] kg/m^3 or the domain; more than this share means a real blow-up:
+    # the run stops.
     exclude_limit: float = Field(0.01, ge=0, le=1, description=(
-        "share of the initial fluid particles that may be excluded for density out of the band "
-        "before the run stops as unstable"))
+        "share of the initial fluid particles that may be excluded (density out of the band, or "
+        "left the tank over its top or through a wall) before the run stops as unstable"))
     integrator: Literal["kdk", "symplectic_pc"] = Field(
         "kdk", description="kdk: leapfrog, 1 force pass/step; symplectic_pc: DualSPHysics-style, 2 passes")
 

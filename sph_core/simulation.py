@@ -109,7 +109,7 @@ class Simulation:
         self.v_max = 0.0
         self.fluid_mass0 = self.fluid_mass()
         self.n_fluid0 = self.n_fluid
-        self.excluded: list[dict[str, float]] = []  # particles removed for density (_exclude)
+        self.excluded: list[dict[str, Any]] = []  # particles removed: density band, left the tank
         # probes
         self._points = [p for p in scene.probes if isinstance(p, PointProbe)]
         self._elev = [p for p in scene.probes if isinstance(p, ElevationProbe)]
@@ -370,16 +370,16 @@ class Simulation:
         return self.open.counts()
 
     def _exclude(self, bad: np.ndarray, ids: np.ndarray, x: np.ndarray, z: np.ndarray,
-                 rho: np.ndarray) -> bool:
+                 rho: np.ndarray, reason: str) -> bool:
         """Remove the fluid particles ``bad`` (indices into the fluid selection) from the run
-        and log them, if the scene's exclude_limit allows; False if it does not."""
+        and log them with ``reason``, if the scene's exclude_limit allows; False if it does not."""
         limit = self.scene.constants.exclude_limit * self.n_fluid0
         if bad.size == 0 or len(self.excluded) + bad.size > limit:
             return False
         slots = np.nonzero(self.particles.mask(FLUID))[0][bad]
         self.particles.kind[slots] = INACTIVE  # skipped by every pass, sorted to the end
         self.excluded += [{"id": int(ids[k]), "t": self.t, "step": self.steps, "x": float(x[k]),
-                           "z": float(z[k]), "rho": float(rho[k])} for k in bad]
+                           "z": float(z[k]), "rho": float(rho[k]), "reason": reason} for k in bad]
         if self.writer:
             self.writer.update_meta(**self._meta_fields())
         return True
@@ -396,13 +396,17 @@ class Simulation:
             lo, hi = self.scene.constants.density_band
             rho0 = self.scene.constants.rho0
             bad = np.nonzero((rho < lo * rho0) | (rho > hi * rho0))[0]
-            if self._exclude(bad, ids, x, z, rho):
+            if self._exclude(bad, ids, x, z, rho, "density out of band"):
                 return
             cause += f" [{lo}, {hi}] rho0 (after {len(self.excluded)} excluded)"
         elif status == wcsph.ST_LEFT_DOMAIN:
-            t = self.scene.tank
-            hd = 0.5 * self.scene.dp
-            bad = np.nonzero(~((x >= t.x0 - hd) & (x <= t.x1 + hd) & (z >= t.z0 - hd) & (z <= t.z1)))[0]
+            # a particle thrown over the top or through a wall is removed like one whose density
+            # left the band (same log, same exclude_limit): one splash must not end the run
+            q = self.prm
+            bad = np.nonzero(~((x >= q.fx0) & (x <= q.fx1) & (z >= q.fz0) & (z <= q.fz1)))[0]
+            if self._exclude(bad, ids, x, z, rho, "left the tank"):
+                return
+            cause += f" (after {len(self.excluded)} excluded)"
         else:
             v = np.hypot(ps.field(VX)[sel], ps.field(VZ)[sel])
             bad = np.nonzero(~(np.isfinite(v) & np.isfinite(rho)))[0]

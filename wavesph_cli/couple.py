@@ -2,7 +2,7 @@
 
     wavesph couple --url ws://127.0.0.1:8000/runs/r1/couple --model stokes --H 0.08 --T 2
     wavesph couple --url tcp://127.0.0.1:8766 --run-id r1 --model irregular --H 0.15 --T 2 \
-                   --output gauges.csv
+                   --out gauges.csv
 
 The still-water depth defaults to the scene's (sent by the server in WELCOME); --d is checked
 against it. Exit status: 0 done, 1 the coupled run failed (reason on stderr), 2 bad arguments.
@@ -61,7 +61,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                    help="SHA-256 (hex) of the scene the model was set up for; refused if it differs")
     p.add_argument("--timeout", type=float, default=120.0,
                    help="longest wait for a server reply [s] (one SPH window)")
-    p.add_argument("--output", default=None, help="CSV file for the gauge series (must not exist)")
+    p.add_argument("-o", "--out", dest="output", default=None,
+                   help="CSV file for the gauge series (must not exist)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
 
 
