@@ -38,8 +38,14 @@ def main(args: argparse.Namespace) -> int:
             data["t_end"] = args.t_end      # meta.json records the real end
         if args.dp is not None:
             data["dp"] = args.dp
+        length = data["t_end"] - data["t_start"]
         if args.snapshot_every is not None:
             data["output"] = {**data["output"], "snapshot_every": args.snapshot_every}
+        elif args.t_end is not None and data["output"]["snapshot_every"] > length:
+            # a shortened run keeps its first and last snapshot, and says so
+            data["output"] = {**data["output"], "snapshot_every": length}
+            print(f"wavesph run: snapshots every {length:g} s (the run is shorter than the "
+                  "scene's output.snapshot_every)", file=sys.stderr)
         scene = make_scene(data)             # the overrides are validated like the file
     except SceneError as exc:
         print(f"wavesph run: {exc}", file=sys.stderr)

@@ -51,10 +51,12 @@ def main(args: argparse.Namespace) -> int:
             field = ".".join(str(p) for p in err["loc"]) or "settings"
             print(f"wavesph serve: {field}: {err['msg'].removeprefix('Value error, ')}", file=sys.stderr)
         return 2
-    for what, port in (("--port", settings.port), ("--tcp-port", settings.tcp_port)):
-        busy = port_in_use(settings.host, port)
+    tcp_host = settings.tcp_host or settings.host
+    for what, host, port in (("--port", settings.host, settings.port),
+                             ("--tcp-port", tcp_host, settings.tcp_port)):
+        busy = port_in_use(host, port)
         if busy:
-            print(f"wavesph serve: {what} {port} on {settings.host} is not free ({busy}); "
+            print(f"wavesph serve: {what} {port} on {host} is not free ({busy}); "
                   f"choose another port", file=sys.stderr)
             return 1
     logging.basicConfig(level=logging.INFO, format="%(asctime)s %(name)s %(message)s")
