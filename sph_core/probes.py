@@ -19,8 +19,8 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from .kernels import w_of_q
-from .particles import FLUID, M, P, RHO, VX, VZ, X, Z
+from .kernels import f_of_q, w_of_q
+from .particles import FLUID, INLET, M, OUTLET, P, RHO, VX, VZ, X, Z
 
 
 @njit(cache=True)
@@ -126,3 +126,42 @@ def fluid_neighbour_counts(f, kind, cell, cell_start, n, h, ncx, ncz, counts):
                         if dx * dx + dz * dz < s2:
                             k += 1
             counts[i] = k
+
+
+@njit(cache=True)
+def wall_force(f, kind, cell_start, slots, xm, zm, h, alpha_f, xmin, zmin, inv_cs, ncx, ncz):
+    """(F_x, F_z, M_y) the fluid exerts on the wall particles ``slots``: minus the pressure pair
+    forces m_f m_s (p_f + p_s)/(rho_f rho_s) F_fs r_fs of wcsph.fluid_pass; M_y about (xm, zm)."""
+    x = f[X]
+    z = f[Z]
+    s2 = 4.0 * h * h
+    fx = 0.0
+    fz = 0.0
+    my = 0.0
+    for k in range(slots.size):
+        s = slots[k]
+        xs = x[s]
+        zs = z[s]
+        cxl, cxh, czl, czh = _cell_range(xs, zs, xmin, zmin, inv_cs, ncx, ncz)
+        p_s = f[P, s]
+        c_s = f[M, s] / f[RHO, s]  # m_s / rho_s
+        sx = 0.0
+        sz = 0.0
+        for zz in range(czl, czh + 1):
+            row = zz * ncx
+            for j in range(cell_start[row + cxl], cell_start[row + cxh + 1]):
+                kj = kind[j]
+                if kj == FLUID or kj == INLET or kj == OUTLET:
+                    dx = x[j] - xs
+                    dz = z[j] - zs
+                    r2 = dx * dx + dz * dz
+                    if r2 < s2:
+                        pf = c_s * f[M, j] * (f[P, j] + p_s) / f[RHO, j]
+                        fij = f_of_q(math.sqrt(r2) / h, alpha_f)
+                        # force on the fluid particle is +pf F r_fs; the wall gets the reaction
+                        sx -= pf * fij * dx
+                        sz -= pf * fij * dz
+        fx += sx
+        fz += sz
+        my += (zs - zm) * sx - (xs - xm) * sz
+    return fx, fz, my

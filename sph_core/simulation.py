@@ -30,6 +30,7 @@ from .eos import hydrostatic_density, tait_b
 from .geometry import build_layout
 from .kernels import wendland_alpha
 from .neighbours import CellGrid, compute_cells, counting_sort
+from .load_probes import LoadProbes
 from .open_ends import OpenBoundaries
 from .output import RunWriter
 from .particles import FLUID, INACTIVE, M, P, RHO, VX, VZ, WALL, X, Z, Checkpoint, ParticleSet
@@ -117,6 +118,7 @@ class Simulation:
         self._px = np.array([p.x for p in self._points], dtype=float)
         self._pz = np.array([p.z for p in self._points], dtype=float)
         self._pout = np.zeros((len(self._points), 4))
+        self.loads = LoadProbes(scene)  # force, pressure_line, overtopping
         nz = int(math.floor((t.z1 - t.z0) / (0.5 * dp)))
         self._line_z = t.z0 + (np.arange(nz) + 0.5) * 0.5 * dp
         self._line_rho = np.zeros(self._line_z.size)
@@ -179,7 +181,7 @@ class Simulation:
                 cols.append(f"{p.name}_eta")
         for p in self._fronts:
             cols.append(f"{p.name}_x")
-        return cols
+        return cols + self.loads.columns()
 
     def probe_values(self) -> dict[str, float | None]:
         """Configured probes at the current state [SI]; None marks a dry probe."""
@@ -213,6 +215,9 @@ class Simulation:
             for p in self._fronts:
                 sel = counts >= p.min_neighbours
                 out[f"{p.name}_x"] = float(x[sel].max()) if sel.any() else None
+        if self.loads:
+            out.update(self.loads.values(self.particles, self.cells, g, self.h, aw,
+                                         self.prm.alpha_f, self.t))
         return out
 
     # ---------------------------------------------------------------- outputs
@@ -442,6 +447,7 @@ class Simulation:
         else:
             self._rebuild_cells()
         self.open.set_state(c.open_state)
+        self.loads.reset_sides()
         self.status = "paused"
         o = self.scene.output
         self._k_probe = int(math.floor(self.t / o.probe_every + 1e-9)) + 1 if o.probe_every else 0
