@@ -256,6 +256,9 @@ class Simulation:
         fld["kind"] = ps.kind[: ps.n][sel].astype(np.int32)
         fld["id"] = ps.ids[: ps.n][sel].astype(np.int64)
         fld["speed"] = np.hypot(fld["vx"], fld["vz"])
+        fld["velocity"] = (fld["vx"], np.zeros_like(fld["vx"]), fld["vz"])  # a vector for glyphs
+        fld["mass"] = ps.field(M)[sel]
+        fld["h"] = np.full(fld["mass"].size, self.h)
         self.writer.snapshot(self.t, ps.field(X)[sel], ps.field(Z)[sel], fld)
 
     def _next_output_time(self, t_target: float) -> float:
