@@ -9,7 +9,7 @@ from fastapi import FastAPI
 
 from .engine import EngineFactory
 from .flume_engine import flume_engine
-from .routers import couple, runs
+from .routers import couple, pages, runs
 from .runs import RunManager
 from .settings import Settings
 from .tcp import start_tcp_server
@@ -44,4 +44,5 @@ def create_app(settings: Settings | None = None,
                               "(protocol/PROTOCOL.md).")
     app.include_router(runs.router)
     app.include_router(couple.router)
+    pages.install(app)  # the run monitor at /, offline /docs (server/routers/pages.py)
     return app
