@@ -46,7 +46,7 @@ def variant_scene(name: str, dp: float, t_end: float) -> dict:
     return d
 
 
-def run(name: str, dp: float, t_end: float, every: float) -> None:
+def run_variant(name: str, dp: float, t_end: float, every: float) -> None:
     scene = make_scene(variant_scene(name, dp, t_end))
     orig = geometry._polyline_distance
     if name == "gap_dp":  # shift the kept fluid: distance to the polyline >= dp instead of dp/2
@@ -86,7 +86,7 @@ def main() -> None:
     ap.add_argument("--variants", default="base,no_slip,gap_dp,flat")
     a = ap.parse_args()
     for name in a.variants.split(","):
-        run(name, a.dp, a.t_end, a.every)
+        run_variant(name, a.dp, a.t_end, a.every)
 
 
 if __name__ == "__main__":

@@ -33,11 +33,11 @@ def format_time(t: float) -> str:
     return f"{float(t):.12g}"
 
 
-def read_gauges(path: str | Path) -> dict[str, np.ndarray]:
+def load_gauges(path: str | Path) -> dict[str, np.ndarray]:
     """Any wavesph gauge CSV (a run's probes.csv, the server's gauges.csv, a coupling client's
     log, `wavesph waves` output) as {column: float array}: ``#`` lines are skipped, a dry gauge
     (``dry`` or an empty field) is NaN. Returns numpy arrays (pandas is not a dependency;
-    ``pandas.DataFrame(read_gauges(p))`` gives a frame)."""
+    ``pandas.DataFrame(load_gauges(p))`` gives a frame)."""
     with open(path, newline="") as fh:
         rows = list(csv.reader(line for line in fh if line.strip() and not line.startswith("#")))
     if not rows:

@@ -67,13 +67,21 @@ def main(args: argparse.Namespace) -> int:
                   f">= 4 particles, got {dp}", file=sys.stderr)
             return 2
         T_end = 3.3 if args.t_end is None else t_end * math.sqrt(2 * 9.81 / DAMBREAK_A)
-        return run_dambreak_demo(out, a=DAMBREAK_A, resolution=resolution, T_end=T_end,
-                                 make_plot=not args.no_plot)
+        try:
+            return run_dambreak_demo(out, a=DAMBREAK_A, resolution=resolution, T_end=T_end,
+                                     make_plot=not args.no_plot)
+        except KeyboardInterrupt:
+            print(f"\nwavesph demo: interrupted; partial results in {out}", file=sys.stderr)
+            return 130
     from cases.demo_flume import GAUGES, demo_figures, depth_for, plot_demo, run_demo
 
     out.mkdir(parents=True, exist_ok=True)
     tic = time.perf_counter()
-    info, report = run_demo(dp, t_end, args.transport, out)
+    try:
+        info, report = run_demo(dp, t_end, args.transport, out)
+    except KeyboardInterrupt:
+        print(f"\nwavesph demo: interrupted; partial results in {out}", file=sys.stderr)
+        return 130
     depth = depth_for(dp)
     wall = time.perf_counter() - tic
     run_dir = out / info["id"]

@@ -196,9 +196,9 @@ def test_demo_writes_run_and_figure(tmp_path):
 
 
 def test_outputs_follow_the_documented_convention(tmp_path):
-    """probes.csv: short times, read back by read_gauges (dry -> NaN); snapshots carry a
+    """probes.csv: short times, read back by load_gauges (dry -> NaN); snapshots carry a
     velocity vector, mass, h and kind (README "Outputs")."""
-    from sph_core.output import read_gauges
+    from sph_core.output import load_gauges
 
     scene = dambreak_scene(a=0.05, dp=0.005, t_end=0.03, probe_every=0.01, snapshot_every=0.03)
     sim = Simulation(scene, run_dir=tmp_path)
@@ -206,11 +206,11 @@ def test_outputs_follow_the_documented_convention(tmp_path):
     sim.close()
     text = (tmp_path / "probes.csv").read_text()
     assert [r.split(",")[0] for r in text.splitlines()[1:]] == ["0", "0.01", "0.02", "0.03"]
-    cols = read_gauges(tmp_path / "probes.csv")
+    cols = load_gauges(tmp_path / "probes.csv")
     assert list(cols) == ["t", "step", "front_x"]
     np.testing.assert_allclose(cols["front_x"], [r["front_x"] for r in sim.history], rtol=1e-11)
     (tmp_path / "g.csv").write_text("# a comment\nt,a\n0.5,dry\n1,2.5\n1.5,\n")
-    g = read_gauges(tmp_path / "g.csv")
+    g = load_gauges(tmp_path / "g.csv")
     assert np.isnan(g["a"][0]) and g["a"][1] == 2.5 and np.isnan(g["a"][2])
     vtu = sorted((tmp_path / "snapshots").glob("*.vtu"))[-1].read_bytes()
     for name in (b'Name="velocity" NumberOfComponents="3"', b'Name="mass"', b'Name="h"',

@@ -25,7 +25,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 from tqdm import tqdm
 
-from wave_client.progress import TQDM_INTERVAL
+from wave_client.progress_bars import TQDM_INTERVAL
 
 from . import stepping
 from .dispersion import BETA, G, nwogu_wavenumber

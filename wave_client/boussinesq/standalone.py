@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
-from wave_client.progress import TQDM_INTERVAL
+from wave_client.progress_bars import TQDM_INTERVAL
 
 from .wave_scene import WaveScene, build_model
 from .solver import BoussinesqUnstableError

@@ -23,7 +23,7 @@ from typing import TextIO
 import numpy as np
 from tqdm import tqdm
 
-from wave_client.progress import TQDM_INTERVAL
+from wave_client.progress_bars import TQDM_INTERVAL
 
 from protocol import ErrorCode, ProtocolError, RemoteError, Welcome
 from wave_client.coupling.core import (CouplingCore, CouplingError, CouplingOptions, ModelSource,
