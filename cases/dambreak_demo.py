@@ -19,7 +19,10 @@ from sph_core.simulation import Simulation
 from .dambreak import dambreak_scene, front_errors, martin_moyce_table
 
 
-def run_dambreak_demo(out: Path | None = None, a: float = 0.1, resolution: int = 40,
+DAMBREAK_A = 0.1  # column width [m] of the demo (height 2a)
+
+
+def run_dambreak_demo(out: Path | None = None, a: float = DAMBREAK_A, resolution: int = 40,
                       T_end: float = 3.3, make_plot: bool = True) -> int:
     """Run the dam break of column width ``a`` [m] (height 2a) at ``resolution`` particles
     across it to ``T_end`` in Martin & Moyce units T = t sqrt(2g/a); outputs in ``out`` (default

@@ -36,6 +36,7 @@ PERIOD = 1.4          # wave period [s]; L = 2.0 m at this depth (Stokes 2, Urse
 SLOPE = 0.1           # 1:10 beach
 X_TOE = 2.0           # beach toe [m]: one wavelength of flat bed after the inlet
 RAMP_PERIODS = 2.0    # start-up ramp of the wave [periods]
+FREEBOARD = 0.2       # tank top above the beach's top (d + 0.1 m) [m]
 GAUGES = {"flat": 1.0, "toe": X_TOE, "beach": X_TOE + 0.5 * DEPTH / SLOPE}  # x [m]
 
 
@@ -55,7 +56,10 @@ def demo_scene(dp: float, t_end: float) -> dict[str, Any]:
     d, x1 = depth_for(dp), tank_end(dp)
     return {
         "name": "wavesph-demo", "dp": dp, "t_end": t_end, "still_water_level": d,
-        "tank": {"x0": 0.0, "x1": x1, "z0": 0.0, "z1": d + 2 * HEIGHT + 4 * dp},
+        # freeboard: the walls reach FREEBOARD above the beach's top, room for run-up and
+        # splashes (the top at d + 2H + 4dp let a shoreline particle hit it at t = 2.4 s); a
+        # particle that still leaves is excluded and logged (Constants.exclude_limit)
+        "tank": {"x0": 0.0, "x1": x1, "z0": 0.0, "z1": round(d + 0.1 + FREEBOARD, 12)},
         "water_blocks": [{"x0": 0.0, "x1": X_TOE + d / SLOPE, "z0": 0.0, "z1": d}],
         "beds": [{"points": [[X_TOE, 0.0], [x1, SLOPE * (x1 - X_TOE)]]}],
         # c0 = 10 sqrt(g d) bounds orbital speeds x10; free slip: the theory is inviscid

@@ -13,7 +13,7 @@ from fastapi.responses import JSONResponse
 from .deps import redact_tokens_in_server_logs
 from .engine import EngineFactory
 from .flume_engine import flume_engine
-from .routers import couple, runs
+from .routers import couple, pages, runs
 from .runs import RunManager
 from .schemas import RunRequest
 from .settings import Settings
@@ -70,4 +70,5 @@ def create_app(settings: Settings | None = None,
         return app.openapi_schema
 
     app.openapi = openapi  # type: ignore[method-assign]
+    pages.install(app)  # the run monitor at /, offline /docs (server/routers/pages.py)
     return app

@@ -28,6 +28,30 @@ def package_versions() -> dict[str, str]:
     return out
 
 
+def format_time(t: float) -> str:
+    """A time [s] for a CSV: 12 significant digits, so 0.027999999999999997 reads 0.028."""
+    return f"{float(t):.12g}"
+
+
+def load_gauges(path: str | Path) -> dict[str, np.ndarray]:
+    """Any wavesph gauge CSV (a run's probes.csv, the server's gauges.csv, a coupling client's
+    log, `wavesph waves` output) as {column: float array}: ``#`` lines are skipped, a dry gauge
+    (``dry`` or an empty field) is NaN. Returns numpy arrays (pandas is not a dependency;
+    ``pandas.DataFrame(load_gauges(p))`` gives a frame)."""
+    with open(path, newline="") as fh:
+        rows = list(csv.reader(line for line in fh if line.strip() and not line.startswith("#")))
+    if not rows:
+        raise ValueError(f"{path}: no header row")
+    header, body = rows[0], rows[1:]
+    cols: dict[str, np.ndarray] = {}
+    for k, name in enumerate(header):
+        try:
+            cols[name] = np.array([np.nan if r[k] in ("", "dry") else float(r[k]) for r in body])
+        except ValueError as exc:
+            raise ValueError(f"{path}: column {name!r}: {exc}") from None
+    return cols
+
+
 def write_json_atomic(path: Path, data: dict[str, Any]) -> None:
     tmp = path.with_suffix(path.suffix + ".tmp")
     tmp.write_text(json.dumps(data, indent=2, default=str))
@@ -56,25 +80,29 @@ class RunWriter:
         write_json_atomic(self.dir / "meta.json", self.meta)
 
     def probe_row(self, t: float, step: int, values: dict[str, float | None]) -> None:
-        """One CSV row; a dry gauge is written as the word ``dry``, never as NaN."""
-        row: list[Any] = [repr(float(t)), step]
+        """One CSV row; a dry gauge is written as the word ``dry``, never as NaN (the server's
+        gauge reader, server/store.py, expects that word). Times are printed short."""
+        row: list[Any] = [format_time(t), step]
         for c in self.columns[2:]:
             v = values.get(c)
             row.append("dry" if v is None else repr(float(v)))
         self._csv.writerow(row)
         self._csv_file.flush()
 
-    def snapshot(self, t: float, x: np.ndarray, z: np.ndarray, data: dict[str, np.ndarray]) -> Path:
-        """Particles as VTK unstructured points (.vtu) plus a ParaView collection (run.pvd)."""
+    def snapshot(self, t: float, x: np.ndarray, z: np.ndarray, data: dict[str, Any]) -> Path:
+        """Particles as VTK unstructured points (.vtu) plus a ParaView collection (run.pvd);
+        a tuple value of ``data`` is a vector field (x, y, z components)."""
         from pyevtk.hl import pointsToVTK
 
         k = len(self.snapshots)
         stem = self.dir / "snapshots" / f"particles_{k:05d}"
         y = np.zeros_like(x)
         path = pointsToVTK(str(stem), np.ascontiguousarray(x), y, np.ascontiguousarray(z),
-                           data={key: np.ascontiguousarray(v) for key, v in data.items()})
+                           data={key: (tuple(np.ascontiguousarray(c) for c in v)
+                                       if isinstance(v, tuple) else np.ascontiguousarray(v))
+                                 for key, v in data.items()})
         self.snapshots.append((t, Path(path).name))
-        entries = "\n".join(f'    <DataSet timestep="{tt!r}" file="snapshots/{name}"/>'
+        entries = "\n".join(f'    <DataSet timestep="{format_time(tt)}" file="snapshots/{name}"/>'
                             for tt, name in self.snapshots)
         pvd = ('<?xml version="1.0"?>\n<VTKFile type="Collection" version="0.1">\n  <Collection>\n'
                f"{entries}\n  </Collection>\n</VTKFile>\n")

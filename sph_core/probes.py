@@ -19,9 +19,9 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from .kernels import w_of_q
+from .kernels import f_of_q, w_of_q
 from .neighbours import block_of, cell_at
-from .particles import FLUID
+from .particles import FLUID, INLET, OUTLET
 
 
 @njit(cache=True)
@@ -124,3 +124,45 @@ def fluid_neighbour_counts(ps, n, cells, h, counts):
                         if dx * dx + dz * dz < s2:
                             k += 1
             counts[i] = k
+
+
+@njit(cache=True)
+def wall_force(ps, cells, slots, xm, zm, h, alpha_f):
+    """(F_x, F_z, M_y) the fluid exerts on the wall particles ``slots``: minus the pressure pair
+    forces m_f m_s (p_f + p_s)/(rho_f rho_s) F_fs r_fs of wcsph.fluid_pass; M_y about (xm, zm)."""
+    x = ps.x
+    z = ps.z
+    kind = ps.kind
+    cell_start = cells.start
+    ncx = cells.ncx
+    s2 = 4.0 * h * h
+    fx = 0.0
+    fz = 0.0
+    my = 0.0
+    for k in range(slots.size):
+        s = slots[k]
+        xs = x[s]
+        zs = z[s]
+        cxl, cxh, czl, czh = block_of(cell_at(xs, zs, cells), cells)
+        p_s = ps.p[s]
+        c_s = ps.m[s] / ps.rho[s]  # m_s / rho_s
+        sx = 0.0
+        sz = 0.0
+        for zz in range(czl, czh + 1):
+            row = zz * ncx
+            for j in range(cell_start[row + cxl], cell_start[row + cxh + 1]):
+                kj = kind[j]
+                if kj == FLUID or kj == INLET or kj == OUTLET:
+                    dx = x[j] - xs
+                    dz = z[j] - zs
+                    r2 = dx * dx + dz * dz
+                    if r2 < s2:
+                        pf = c_s * ps.m[j] * (ps.p[j] + p_s) / ps.rho[j]
+                        fij = f_of_q(math.sqrt(r2) / h, alpha_f)
+                        # force on the fluid particle is +pf F r_fs; the wall gets the reaction
+                        sx -= pf * fij * dx
+                        sz -= pf * fij * dz
+        fx += sx
+        fz += sz
+        my += (zs - zm) * sx - (xs - xm) * sz
+    return fx, fz, my

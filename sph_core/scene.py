@@ -46,7 +46,8 @@ class Tank(Rect):
     """The fluid domain: walls of dummy particles left (x0), right (x1) and below (z0).
 
     The walls reach up to z1, which is also the top of the computational domain: a particle above
-    z1 has left the domain and stops the run."""
+    z1 has left the domain and is excluded (Constants.exclude_limit), as one whose density left
+    the band."""
 
 
 class WaterBlock(Rect):
@@ -88,10 +89,11 @@ class Constants(_Model):
     # A drop thrown off the surface (splash, run-up on a staircase bed) keeps few neighbours: its
     # density leaves the band by continuity and, landing, it can be crushed against the wall
     # particles. Such particles are removed and logged, as DualSPHysics excludes particles
-    # leaving [700, 1300] kg/m^3; more than this share means a real blow-up: the run stops.
+    # leaving [700, 1300] kg/m^3 or the domain; more than this share means a real blow-up:
+    # the run stops.
     exclude_limit: float = Field(0.01, ge=0, le=1, description=(
-        "share of the initial fluid particles that may be excluded for density out of the band "
-        "before the run stops as unstable"))
+        "share of the initial fluid particles that may be excluded (density out of the band, or "
+        "left the tank over its top or through a wall) before the run stops as unstable"))
     integrator: Literal["kdk", "symplectic_pc"] = Field(
         "kdk", description="kdk: leapfrog, 1 force pass/step; symplectic_pc: DualSPHysics-style, 2 passes")
 
@@ -129,7 +131,46 @@ class FrontProbe(_Model):
     min_neighbours: int = Field(3, ge=0)
 
 
-Probe = Annotated[Union[PointProbe, ElevationProbe, FrontProbe], Field(discriminator="kind")]
+class ForceProbe(Rect):
+    """Force and moment per metre of width that the fluid exerts on the wall, bed or structure
+    particles whose centres lie in the rectangle [x0, x1] x [z0, z1]: the reaction of the
+    pressure pair forces those particles exert on the fluid (wcsph.fluid_pass),
+    F = -sum_s sum_f m_f m_s (p_f + p_s)/(rho_f rho_s) F_fs (r_f - r_s), and the moment
+    M = sum_s (z_s - z_m) F_x,s - (x_s - x_m) F_z,s about ``moment_about`` (x_m, z_m) [N m/m],
+    positive when F_x above the point tips the wall towards +x. Columns: <name>_fx, <name>_fz
+    [N/m], <name>_my [N m/m]. Viscous and artificial-viscosity forces are not included (wall
+    shear; small against pressure on a structure)."""
+
+    kind: Literal["force"]
+    name: str = Field(min_length=1)
+    moment_about: tuple[float, float] | None = Field(
+        None, description="(x, z) of the moment's axis [m]; default (x-centre of the box, z0)")
+
+
+class PressureLineProbe(_Model):
+    """Pressure at points along a wall (DualSPHysics' MeasureTool): the Shepard kernel
+    interpolation of the fluid's pressure at each point, as a point probe's p. Put the points on
+    the wall face or up to dp inside the fluid. Columns <name>_p<k> [Pa] for points[k]; a point
+    with no fluid near it is dry (empty)."""
+
+    kind: Literal["pressure_line"]
+    name: str = Field(min_length=1)
+    points: list[tuple[float, float]] = Field(min_length=1, description="(x, z) of each point [m]")
+
+
+class OvertoppingProbe(_Model):
+    """Volume of fluid that has crossed the vertical section at ``x`` towards +x (net, per metre
+    of width), counted by particle (volume m/rho) between records, so it is exact in the
+    particles' own terms: <name>_volume [m^3/m] since the start, <name>_q [m^2/s] the mean flux
+    over the interval since the previous record."""
+
+    kind: Literal["overtopping"]
+    name: str = Field(min_length=1)
+    x: float
+
+
+Probe = Annotated[Union[PointProbe, ElevationProbe, FrontProbe, ForceProbe, PressureLineProbe,
+                        OvertoppingProbe], Field(discriminator="kind")]
 
 
 # buffer pressure of an outlet (elevation "extrapolated") that does not name one. Extrapolated
@@ -234,7 +275,8 @@ def _format_errors(exc: ValidationError) -> str:
     for err in exc.errors():
         loc = [str(p) for p in err["loc"] if p not in ("function-after",)]
         # discriminated unions add the tag name to the path: drop it
-        loc = [p for p in loc if p not in ("point", "elevation", "front")]
+        loc = [p for p in loc if p not in ("point", "elevation", "front", "force",
+                                           "pressure_line", "overtopping")]
         msg = err["msg"].removeprefix("Value error, ")
         if ": " in msg and not msg.startswith(("Input", "Field")):
             head, tail = msg.split(": ", 1)

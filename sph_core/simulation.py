@@ -30,6 +30,7 @@ from .eos import hydrostatic_density, tait_b
 from .geometry import build_layout
 from .kernels import wendland_alpha
 from .neighbours import CellGrid, compute_cells, counting_sort
+from .load_probes import LoadProbes
 from .open_ends import OpenBoundaries
 from .output import RunWriter
 from .particles import FLUID, INACTIVE, M, P, RHO, VX, VZ, WALL, X, Z, Checkpoint, ParticleSet
@@ -113,7 +114,7 @@ class Simulation:
         self.v_max = 0.0
         self.fluid_mass0 = self.fluid_mass()
         self.n_fluid0 = self.n_fluid
-        self.excluded: list[dict[str, float]] = []  # particles removed for density (_exclude)
+        self.excluded: list[dict[str, Any]] = []  # particles removed: density band, left the tank
         # probes
         self._points = [p for p in scene.probes if isinstance(p, PointProbe)]
         self._elev = [p for p in scene.probes if isinstance(p, ElevationProbe)]
@@ -121,6 +122,7 @@ class Simulation:
         self._px = np.array([p.x for p in self._points], dtype=float)
         self._pz = np.array([p.z for p in self._points], dtype=float)
         self._pout = np.zeros((len(self._points), 4))
+        self.loads = LoadProbes(scene)  # force, pressure_line, overtopping
         nz = int(math.floor((t.z1 - t.z0) / (0.5 * dp)))
         self._line_z = t.z0 + (np.arange(nz) + 0.5) * 0.5 * dp
         self._line_rho = np.zeros(self._line_z.size)
@@ -183,7 +185,7 @@ class Simulation:
                 cols.append(f"{p.name}_eta")
         for p in self._fronts:
             cols.append(f"{p.name}_x")
-        return cols
+        return cols + self.loads.columns()
 
     def probe_values(self) -> dict[str, float | None]:
         """Configured probes at the current state [SI]; None marks a dry probe."""
@@ -212,6 +214,9 @@ class Simulation:
             for p in self._fronts:
                 sel = counts >= p.min_neighbours
                 out[f"{p.name}_x"] = float(x[sel].max()) if sel.any() else None
+        if self.loads:
+            out.update(self.loads.values(self.particles, self.cells, self.h, aw,
+                                         self.prm.alpha_f, self.t))
         return out
 
     # ---------------------------------------------------------------- outputs
@@ -250,6 +255,9 @@ class Simulation:
         fld["kind"] = ps.kind[: ps.n][sel].astype(np.int32)
         fld["id"] = ps.ids[: ps.n][sel].astype(np.int64)
         fld["speed"] = np.hypot(fld["vx"], fld["vz"])
+        fld["velocity"] = (fld["vx"], np.zeros_like(fld["vx"]), fld["vz"])  # a vector for glyphs
+        fld["mass"] = ps.field(M)[sel]
+        fld["h"] = np.full(fld["mass"].size, self.h)
         self.writer.snapshot(self.t, ps.field(X)[sel], ps.field(Z)[sel], fld)
 
     def _next_output_time(self, t_target: float) -> float:
@@ -369,16 +377,16 @@ class Simulation:
         return self.open.counts()
 
     def _exclude(self, bad: np.ndarray, ids: np.ndarray, x: np.ndarray, z: np.ndarray,
-                 rho: np.ndarray) -> bool:
+                 rho: np.ndarray, reason: str) -> bool:
         """Remove the fluid particles ``bad`` (indices into the fluid selection) from the run
-        and log them, if the scene's exclude_limit allows; False if it does not."""
+        and log them with ``reason``, if the scene's exclude_limit allows; False if it does not."""
         limit = self.scene.constants.exclude_limit * self.n_fluid0
         if bad.size == 0 or len(self.excluded) + bad.size > limit:
             return False
         slots = np.nonzero(self.particles.mask(FLUID))[0][bad]
         self.particles.kind[slots] = INACTIVE  # skipped by every pass, sorted to the end
         self.excluded += [{"id": int(ids[k]), "t": self.t, "step": self.steps, "x": float(x[k]),
-                           "z": float(z[k]), "rho": float(rho[k])} for k in bad]
+                           "z": float(z[k]), "rho": float(rho[k]), "reason": reason} for k in bad]
         if self.writer:
             self.writer.update_meta(**self._meta_fields())
         return True
@@ -395,13 +403,17 @@ class Simulation:
             lo, hi = self.scene.constants.density_band
             rho0 = self.scene.constants.rho0
             bad = np.nonzero((rho < lo * rho0) | (rho > hi * rho0))[0]
-            if self._exclude(bad, ids, x, z, rho):
+            if self._exclude(bad, ids, x, z, rho, "density out of band"):
                 return
             cause += f" [{lo}, {hi}] rho0 (after {len(self.excluded)} excluded)"
         elif status == wcsph.ST_LEFT_DOMAIN:
-            t = self.scene.tank
-            hd = 0.5 * self.scene.dp
-            bad = np.nonzero(~((x >= t.x0 - hd) & (x <= t.x1 + hd) & (z >= t.z0 - hd) & (z <= t.z1)))[0]
+            # a particle thrown over the top or through a wall is removed like one whose density
+            # left the band (same log, same exclude_limit): one splash must not end the run
+            q = self.prm
+            bad = np.nonzero(~((x >= q.fx0) & (x <= q.fx1) & (z >= q.fz0) & (z <= q.fz1)))[0]
+            if self._exclude(bad, ids, x, z, rho, "left the tank"):
+                return
+            cause += f" (after {len(self.excluded)} excluded)"
         else:
             v = np.hypot(ps.field(VX)[sel], ps.field(VZ)[sel])
             bad = np.nonzero(~(np.isfinite(v) & np.isfinite(rho)))[0]
@@ -437,6 +449,7 @@ class Simulation:
         else:
             self._rebuild_cells()
         self.open.set_state(c.open_state)
+        self.loads.reset_sides()
         self.status = "paused"
         o = self.scene.output
         self._k_probe = int(math.floor(self.t / o.probe_every + 1e-9)) + 1 if o.probe_every else 0

@@ -81,9 +81,9 @@ def initialise(ps, ps2, cells, prm, ends, n):
 @njit(cache=True)
 def _step_kdk(ps, ps2, cells, prm, ends, n, t, dt):
     """One leapfrog step; the state ends in ps2. Returns (n, status, n_flag, v2max, a2max, rmax)."""
+    # a particle that left the tank box finishes the step like the others (the sort clamps it
+    # to the grid); the verdict then reports it and the Simulation excludes it
     n_out = kdk_kick_drift(ps, n, dt, prm)
-    if n_out > 0:
-        return n, ST_LEFT_DOMAIN, n_out, 0.0, 0.0, 0.0, False
     n_new = update_buffers(ps, n, t + dt, dt, ends, prm)
     if n_new < 0:
         return n, ST_CAPACITY, n, 0.0, 0.0, 0.0, False
@@ -92,7 +92,7 @@ def _step_kdk(ps, ps2, cells, prm, ends, n, t, dt):
     _forces(ps2, n, cells, prm)
     n_bad, n_band, v2max, a2max, rmax = kdk_kick(ps2, n, dt, prm)
     measure_boundaries(ps2, cells, ends, prm)
-    return _verdict(n, n_bad, n_band, 0, v2max, a2max, rmax)
+    return _verdict(n, n_bad, n_band, n_out, v2max, a2max, rmax)
 
 
 @njit(cache=True)

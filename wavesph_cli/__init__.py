@@ -26,14 +26,36 @@ COMMANDS: dict[str, tuple[str, str]] = {
 OUR_PACKAGES = {"protocol", "sph_core", "wave_client", "server", "cases"}
 
 
+def version() -> str:
+    """The installed wavesph version (from its metadata), or "unknown" in a bare checkout."""
+    from importlib import metadata
+
+    try:
+        return metadata.version("wavesph")
+    except metadata.PackageNotFoundError:
+        return "unknown"
+
+
+class HelpFormatter(argparse.ArgumentDefaultsHelpFormatter):
+    """Defaults in every --help: "(default: X)" after each option that has one."""
+
+    def _get_help_string(self, action: argparse.Action) -> str | None:
+        # an option whose default is None/False says its default in words (or has none)
+        if action.default in (None, False) or "default" in (action.help or ""):
+            return action.help
+        return super()._get_help_string(action)
+
+
 def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else argv
-    parser = argparse.ArgumentParser(prog="wavesph", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(prog="wavesph", description=__doc__.splitlines()[0],
+                                     formatter_class=HelpFormatter)
+    parser.add_argument("--version", action="version", version=f"wavesph {version()}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     for name, (_, help_text) in COMMANDS.items():
         sub.add_parser(name, help=help_text, add_help=False)
     if not argv or argv[0] not in COMMANDS:
-        parser.parse_args(argv or ["--help"])
+        parser.parse_args(argv or ["--help"])  # --help / --version exit here
         return 2
     name = argv[0]
     module_name, help_text = COMMANDS[name]
@@ -44,7 +66,13 @@ def main(argv: list[str] | None = None) -> int:
             print(f"wavesph {name}: not available in this build ({exc})", file=sys.stderr)
             return 2
         raise
-    cmd_parser = argparse.ArgumentParser(prog=f"wavesph {name}", description=help_text)
+    cmd_parser = argparse.ArgumentParser(prog=f"wavesph {name}", description=help_text,
+                                         formatter_class=HelpFormatter)
     module.add_arguments(cmd_parser)
-    return int(module.main(cmd_parser.parse_args(argv[1:])) or 0)
+    args = cmd_parser.parse_args(argv[1:])
+    try:
+        return int(module.main(args) or 0)
+    except KeyboardInterrupt:  # a subcommand that does not say more about its partial results
+        print(f"\nwavesph {name}: interrupted", file=sys.stderr)
+        return 130
 

@@ -2,7 +2,7 @@
 
     wavesph couple --url ws://127.0.0.1:8000/runs/r1/couple --model stokes --H 0.08 --T 2
     wavesph couple --url tcp://127.0.0.1:8766 --run-id r1 --model irregular --H 0.15 --T 2 \
-                   --output gauges.csv
+                   --out gauges.csv
 
 The still-water depth defaults to the scene's (sent by the server in WELCOME); --d is checked
 against it. Exit status: 0 done, 1 the coupled run failed (reason on stderr), 2 bad arguments.
@@ -64,7 +64,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     p.add_argument("--queue-timeout", type=float, default=3600.0,
                    help="longest wait for the run to start [s] (it may be queued on the server; "
                         "it is reserved for this client meanwhile)")
-    p.add_argument("--output", default=None, help="CSV file for the gauge series (must not exist)")
+    p.add_argument("-o", "--out", dest="output", default=None,
+                   help="CSV file for the gauge series (must not exist)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
 
 

@@ -19,17 +19,21 @@ import sys
 import time
 from pathlib import Path
 
+from ._common import refuse_non_empty
+
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--t-end", type=float, default=8.0,
+    parser.add_argument("--t-end", type=float, default=None,
                         help="simulated time [s] (default 8: 2 ramp periods, then ~3 periods "
-                             "of full waves at the flat-bed gauge)")
-    parser.add_argument("--dp", type=float, default=0.02,
+                             "of full waves at the flat-bed gauge; --dambreak: T = t sqrt(2g/a) "
+                             "= 3.3, 0.332 s)")
+    parser.add_argument("--dp", type=float, default=None,
                         help="particle spacing [m] (default 0.02: ~3300 particles, H/dp = 2, "
-                             "about a minute; 0.01 resolves the wave better at ~8x the time)")
+                             "about a minute; 0.01 resolves the wave better at ~8x the time; "
+                             "--dambreak: 0.0025, 40 particles across the 0.1 m column)")
     parser.add_argument("--transport", choices=("ws", "tcp"), default="ws",
                         help="coupling socket: WebSocket (default) or plain TCP")
-    parser.add_argument("--out", type=Path, default=None,
+    parser.add_argument("-o", "--out", type=Path, default=None,
                         help="run directory (default ./runs/demo-<UTC time>); must be new or empty")
     parser.add_argument("--no-plot", action="store_true", help="skip the figure")
     parser.add_argument("--dambreak", action="store_true",
@@ -43,24 +47,42 @@ def main(args: argparse.Namespace) -> int:
     # numba's OpenMP threads spin while waiting by default: on a busy machine (more runnable
     # threads than cores) a step then costs 10-20x more. Passive waiting costs little otherwise.
     os.environ.setdefault("OMP_WAIT_POLICY", "passive")  # before numba loads: cases import lazily
+    t_end = 8.0 if args.t_end is None else args.t_end
+    dp = 0.02 if args.dp is None else args.dp
     if args.dambreak:
-        from cases.dambreak_demo import run_dambreak_demo
-
-        return run_dambreak_demo(args.out, make_plot=not args.no_plot)
-    from cases.demo_flume import GAUGES, demo_figures, depth_for, plot_demo, run_demo
-
-    if not (args.t_end > 0 and math.isfinite(args.t_end)) or not 0.002 <= args.dp <= 0.05:
+        dp = 0.0025 if args.dp is None else args.dp
+    if not (t_end > 0 and math.isfinite(t_end)) or not 0.002 <= dp <= 0.05:
         print("wavesph demo: --t-end must be > 0 s and --dp within [0.002, 0.05] m", file=sys.stderr)
         return 2
     out = args.out or Path("runs") / f"demo-{time.strftime('%Y%m%dT%H%M%SZ', time.gmtime())}"
-    if out.exists() and any(out.iterdir()):
-        print(f"wavesph demo: --out {out} exists and is not empty: choose a new directory",
-              file=sys.stderr)
+    if refuse_non_empty("demo", out):
         return 2
+    if args.dambreak:
+        from cases.dambreak_demo import DAMBREAK_A, run_dambreak_demo
+
+        # the column is a = 0.1 m wide: --dp sets the particles across it, --t-end the time
+        resolution = round(DAMBREAK_A / dp)
+        if resolution < 4 or abs(resolution * dp - DAMBREAK_A) > 1e-9:
+            print(f"wavesph demo --dambreak: --dp must divide the {DAMBREAK_A} m column into "
+                  f">= 4 particles, got {dp}", file=sys.stderr)
+            return 2
+        T_end = 3.3 if args.t_end is None else t_end * math.sqrt(2 * 9.81 / DAMBREAK_A)
+        try:
+            return run_dambreak_demo(out, a=DAMBREAK_A, resolution=resolution, T_end=T_end,
+                                     make_plot=not args.no_plot)
+        except KeyboardInterrupt:
+            print(f"\nwavesph demo: interrupted; partial results in {out}", file=sys.stderr)
+            return 130
+    from cases.demo_flume import GAUGES, demo_figures, depth_for, plot_demo, run_demo
+
     out.mkdir(parents=True, exist_ok=True)
     tic = time.perf_counter()
-    info, report = run_demo(args.dp, args.t_end, args.transport, out)
-    depth = depth_for(args.dp)
+    try:
+        info, report = run_demo(dp, t_end, args.transport, out)
+    except KeyboardInterrupt:
+        print(f"\nwavesph demo: interrupted; partial results in {out}", file=sys.stderr)
+        return 130
+    depth = depth_for(dp)
     wall = time.perf_counter() - tic
     run_dir = out / info["id"]
     if info["state"] != "finished" or report is None:
@@ -78,7 +100,7 @@ def main(args: argparse.Namespace) -> int:
           f"measured vs Stokes 2): "
           f"{_rmse_text(figures['rmse_over_H_flat'])}", file=sys.stderr)
     if not args.no_plot:
-        plot_demo(report, info, out / "elevation.png", args.dp, args.t_end, figures["compare_from_s"])
+        plot_demo(report, info, out / "elevation.png", dp, t_end, figures["compare_from_s"])
     print(f"outputs in {out.resolve()}:\n"
           f"  {info['id']}/gauges.csv   SPH-measured gauges (server)\n"
           f"  {info['id']}/meta.json    run record ({info['status']})\n"

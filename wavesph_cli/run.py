@@ -8,38 +8,71 @@ import time
 from pathlib import Path
 
 from sph_core.progress import advance_with_progress
-from sph_core.scene import SceneError, load_scene
+from sph_core.scene import SceneError, load_scene, make_scene
 from sph_core.simulation import Simulation
+
+from ._common import positive_float, refuse_non_empty
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("scene", type=Path, help="scene file (TOML)")
-    parser.add_argument("--out", type=Path, default=None,
-                        help="run directory (default: runs/<scene name>-<UTC time>)")
-    parser.add_argument("--t-end", type=float, default=None, help="override the scene's end time [s]")
+    parser.add_argument("-o", "--out", type=Path, default=None,
+                        help="run directory, new or empty (default: runs/<scene name>-<UTC time>)")
+    parser.add_argument("--t-end", type=positive_float, default=None,
+                        help="end time [s] (default: the scene's t_end)")
+    parser.add_argument("--dp", type=positive_float, default=None,
+                        help="particle spacing [m] (default: the scene's dp)")
+    parser.add_argument("--snapshot-every", type=float, default=None,
+                        help="VTK snapshot interval [s], 0 = none (default: the scene's "
+                             "output.snapshot_every)")
+    parser.add_argument("--threads", type=int, default=None,
+                        help="numba threads (default: NUMBA_NUM_THREADS or all cores)")
+    parser.add_argument("--no-progress", action="store_true", help="no progress bar or lines")
 
 
 def main(args: argparse.Namespace) -> int:
     try:
         scene = load_scene(args.scene)
+        data = scene.model_dump(mode="json")
+        if args.t_end is not None:
+            data["t_end"] = args.t_end      # meta.json records the real end
+        if args.dp is not None:
+            data["dp"] = args.dp
+        length = data["t_end"] - data["t_start"]
+        if args.snapshot_every is not None:
+            data["output"] = {**data["output"], "snapshot_every": args.snapshot_every}
+        elif args.t_end is not None and data["output"]["snapshot_every"] > length:
+            # a shortened run keeps its first and last snapshot, and says so
+            data["output"] = {**data["output"], "snapshot_every": length}
+            print(f"wavesph run: snapshots every {length:g} s (the run is shorter than the "
+                  "scene's output.snapshot_every)", file=sys.stderr)
+        scene = make_scene(data)             # the overrides are validated like the file
     except SceneError as exc:
         print(f"wavesph run: {exc}", file=sys.stderr)
         return 2
-    if args.t_end is not None:
-        if not args.t_end > 0:
-            print("wavesph run: --t-end must be > 0", file=sys.stderr)
+    if args.threads is not None:
+        import numba
+
+        if not 1 <= args.threads <= numba.config.NUMBA_NUM_THREADS:
+            print(f"wavesph run: --threads must be within [1, {numba.config.NUMBA_NUM_THREADS}]",
+                  file=sys.stderr)
             return 2
-        scene = scene.model_copy(update={"t_end": args.t_end})   # meta.json records the real end
-    t_end = scene.t_end
+        numba.set_num_threads(args.threads)
     out = args.out or Path("runs") / f"{scene.name}-{time.strftime('%Y%m%dT%H%M%SZ', time.gmtime())}"
+    if refuse_non_empty("run", out):
+        return 2
     print(f"building particles for '{scene.name}' (dp = {scene.dp} m) ...", file=sys.stderr)
     sim = Simulation(scene, run_dir=out)
     print(f"{sim.n_fluid} fluid + {sim.n_particles - sim.n_fluid} wall particles, c0 = {sim.c0:.2f} m/s, "
           f"h = {sim.h:.4g} m; output in {out}", file=sys.stderr)
-    code = advance_with_progress(sim, t_end, scene.name)
+    try:
+        code = advance_with_progress(sim, scene.t_end, scene.name, show=not args.no_progress)
+    except KeyboardInterrupt:
+        print(f"\nwavesph run: interrupted at t = {sim.t:.4g} s; partial results in {out}",
+              file=sys.stderr)
+        return 130
     if code == 0:
         print(f"done: {sim.steps} steps in {sim.wall_time:.1f} s "
               f"({sim.n_particles * sim.steps / max(sim.wall_time, 1e-9) / 1e6:.2f} M particle-steps/s); "
               f"results in {out}", file=sys.stderr)
     return code
-

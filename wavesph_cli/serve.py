@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import logging
+import socket
 import sys
 from pathlib import Path
 
@@ -24,6 +25,18 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.epilog = "Every option can also be set as WAVESPH_<OPTION> in the environment."
 
 
+def port_in_use(host: str, port: int) -> str | None:
+    """Why ``host:port`` cannot be bound now (the OS's words), or None if it can: checked before
+    the server starts, so a busy port is one line, not a traceback from deep in uvicorn."""
+    try:
+        with socket.socket(socket.AF_INET6 if ":" in host else socket.AF_INET) as s:
+            s.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)  # as uvicorn binds
+            s.bind((host, port))
+    except OSError as exc:
+        return exc.strerror or str(exc)
+    return None
+
+
 def main(args: argparse.Namespace) -> int:
     import uvicorn
 
@@ -38,6 +51,14 @@ def main(args: argparse.Namespace) -> int:
             field = ".".join(str(p) for p in err["loc"]) or "settings"
             print(f"wavesph serve: {field}: {err['msg'].removeprefix('Value error, ')}", file=sys.stderr)
         return 2
+    tcp_host = settings.tcp_host or settings.host
+    for what, host, port in (("--port", settings.host, settings.port),
+                             ("--tcp-port", tcp_host, settings.tcp_port)):
+        busy = port_in_use(host, port)
+        if busy:
+            print(f"wavesph serve: {what} {port} on {host} is not free ({busy}); "
+                  f"choose another port", file=sys.stderr)
+            return 1
     logging.basicConfig(level=logging.INFO, format="%(asctime)s %(name)s %(message)s")
     app = create_app(settings)
     print(f"wavesph serve: http://{settings.host}:{settings.port} (docs at /docs), TCP coupling "

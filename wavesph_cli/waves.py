@@ -9,7 +9,7 @@ from pathlib import Path
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("scene", type=Path, help="TOML scene (grid, bathymetry, wave, sponge, gauges)")
-    parser.add_argument("-o", "--output", type=Path, default=None,
+    parser.add_argument("-o", "--out", dest="output", type=Path, default=None,
                         help="gauge CSV path (default: output.csv of the scene)")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
 

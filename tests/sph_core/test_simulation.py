@@ -10,6 +10,7 @@ import pytest
 
 import wavesph_cli
 from cases.dambreak import dambreak_scene
+from sph_core.particles import FLUID, VZ, Z
 from sph_core.scene import make_scene
 from sph_core.simulation import Simulation, UnstableError
 
@@ -117,6 +118,35 @@ def test_particles_out_of_band_are_excluded_within_the_limit(tmp_path):
         Simulation(small_dambreak(**band, exclude_limit=0.0)).advance_to(scene.t_end)
 
 
+@pytest.mark.parametrize("integrator", ["kdk", "symplectic_pc"])
+def test_particle_thrown_over_the_top_is_excluded(tmp_path, integrator):
+    """A particle leaving the tank over its top is excluded and logged like one out of the
+    density band (same exclude_limit); with a zero limit the run stops, naming it."""
+    def thrown(limit):
+        scene = make_scene({
+            "dp": 0.02, "t_end": 0.2, "still_water_level": 0.1,
+            "tank": {"x0": 0, "x1": 0.4, "z0": 0, "z1": 0.14},
+            "water_blocks": [{"x0": 0, "x1": 0.4, "z0": 0, "z1": 0.1}],
+            "constants": {"exclude_limit": limit, "integrator": integrator}})
+        sim = Simulation(scene, run_dir=tmp_path / f"{limit}")
+        ps = sim.particles
+        top = int(np.argmax(np.where(ps.mask(FLUID), ps.field(Z), -1.0)))  # highest fluid slot
+        ps.f[VZ, top] = 3.0  # 3 m/s up, 0.46 m ballistic rise: over the 0.14 m top
+        return sim, int(ps.ids[top])
+
+    sim, pid = thrown(0.5)
+    n0 = sim.n_fluid
+    sim.advance_to(0.2)
+    sim.close()
+    assert [e["id"] for e in sim.excluded] == [pid] and sim.excluded[0]["reason"] == "left the tank"
+    assert sim.excluded[0]["z"] > 0.14 and sim.n_fluid == n0 - 1
+    meta = json.loads((tmp_path / "0.5" / "meta.json").read_text())
+    assert meta["status"] == "completed" and meta["excluded"] == 1
+    sim, _ = thrown(0.0)
+    with pytest.raises(UnstableError, match="left the tank"):
+        sim.advance_to(0.2)
+
+
 def test_dry_gauge_reports_dry(tmp_path):
     scene = make_scene({
         "dp": 0.01, "t_end": 0.01, "still_water_level": 0.1,
@@ -163,3 +193,26 @@ def test_demo_writes_run_and_figure(tmp_path):
     meta = json.loads((out / "meta.json").read_text())
     assert meta["status"] == "completed"
     assert len(list((out / "snapshots").glob("*.vtu"))) >= 2
+
+
+def test_outputs_follow_the_documented_convention(tmp_path):
+    """probes.csv: short times, read back by load_gauges (dry -> NaN); snapshots carry a
+    velocity vector, mass, h and kind (README "Outputs")."""
+    from sph_core.output import load_gauges
+
+    scene = dambreak_scene(a=0.05, dp=0.005, t_end=0.03, probe_every=0.01, snapshot_every=0.03)
+    sim = Simulation(scene, run_dir=tmp_path)
+    sim.advance_to(scene.t_end)
+    sim.close()
+    text = (tmp_path / "probes.csv").read_text()
+    assert [r.split(",")[0] for r in text.splitlines()[1:]] == ["0", "0.01", "0.02", "0.03"]
+    cols = load_gauges(tmp_path / "probes.csv")
+    assert list(cols) == ["t", "step", "front_x"]
+    np.testing.assert_allclose(cols["front_x"], [r["front_x"] for r in sim.history], rtol=1e-11)
+    (tmp_path / "g.csv").write_text("# a comment\nt,a\n0.5,dry\n1,2.5\n1.5,\n")
+    g = load_gauges(tmp_path / "g.csv")
+    assert np.isnan(g["a"][0]) and g["a"][1] == 2.5 and np.isnan(g["a"][2])
+    vtu = sorted((tmp_path / "snapshots").glob("*.vtu"))[-1].read_bytes()
+    for name in (b'Name="velocity" NumberOfComponents="3"', b'Name="mass"', b'Name="h"',
+                 b'Name="kind"', b'Name="pressure"'):
+        assert name in vtu, name

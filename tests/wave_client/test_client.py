@@ -513,7 +513,7 @@ def test_cli_couples_over_tcp_and_writes_the_series(tmp_path, capsys):
         async with PeerServer(fake, "tcp") as peer:
             args = cli_args("--url", peer.url, "--run-id", "r1", "--model", "stokes", "--H", "0.08",
                             "--T", "2", "--order", "2", "--window", "0.05", "--t-end", "0.2",
-                            "--output", str(out), "--no-progress", "--timeout", "5")
+                            "--out", str(out), "--no-progress", "--timeout", "5")
             return await asyncio.to_thread(couple_cli.main, args)
 
     assert run(scenario()) == 0
@@ -522,7 +522,7 @@ def test_cli_couples_over_tcp_and_writes_the_series(tmp_path, capsys):
     assert len([ln for ln in out.read_text().splitlines() if not ln.startswith("#")]) == 5
     # the same output path again: refused, the first run's data is kept
     assert couple_cli.main(cli_args("--url", "tcp://127.0.0.1:1", "--run-id", "r1", "--model",
-                                    "linear", "--H", "0.08", "--T", "2", "--output", str(out))) == 2
+                                    "linear", "--H", "0.08", "--T", "2", "--out", str(out))) == 2
     assert "refusing to overwrite" in capsys.readouterr().err
 
 

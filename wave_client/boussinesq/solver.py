@@ -25,6 +25,8 @@ import numpy as np
 from numpy.typing import ArrayLike
 from tqdm import tqdm
 
+from wave_client.progress_bars import TQDM_INTERVAL
+
 from . import stepping
 from .dispersion import BETA, G, nwogu_wavenumber
 from .profile import reconstruct_velocity
@@ -340,7 +342,8 @@ class BoussinesqModel:
                     m._refresh_rhs()
         todo = n
         chunk = max(1, min(todo, 2000))
-        with tqdm(total=todo, disable=not progress, unit="step", desc="boussinesq") as bar:
+        with tqdm(total=todo, disable=not progress, unit="step", desc="boussinesq",
+                  mininterval=TQDM_INTERVAL) as bar:
             while todo > 0:
                 m = min(chunk, todo)
                 self.advance_steps(m)

@@ -12,6 +12,8 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
+from wave_client.progress_bars import TQDM_INTERVAL
+
 from .wave_scene import WaveScene, build_model
 from .solver import BoussinesqUnstableError
 
@@ -30,7 +32,8 @@ def run_wave_scene(scene: WaveScene, csv_path: Path, base_dir: Path | None = Non
     csv_path.parent.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
     with open(csv_path, "w", encoding="utf-8") as out, \
-            tqdm(total=n_total, disable=not progress, unit="step", desc="waves") as bar:
+            tqdm(total=n_total, disable=not progress, unit="step", desc="waves",
+                 mininterval=TQDM_INTERVAL) as bar:
         out.write("# wavesph waves: Nwogu extended Boussinesq (z_alpha = -0.531 h), 1D\n")
         out.write(f"# surface elevation eta [m] above still water at gauges x = "
                   f"{', '.join(f'{x:g}' for x in xs)} m; time [s]\n")

@@ -24,6 +24,8 @@ from typing import TextIO
 import numpy as np
 from tqdm import tqdm
 
+from wave_client.progress_bars import TQDM_INTERVAL
+
 from protocol import ErrorCode, ProtocolError, RemoteError, Welcome
 from wave_client.coupling.core import (CouplingCore, CouplingError, CouplingOptions, ModelSource,
                                        ServerEnded, WindowRecord)
@@ -152,7 +154,8 @@ async def run_coupling(url: str, model: ModelSource, options: CouplingOptions | 
         if log is not None:
             for line in core.describe():
                 log.note(line)
-        bar = tqdm(total=core.windows_left, unit="window", desc="coupling", disable=not progress)
+        bar = tqdm(total=core.windows_left, unit="window", desc="coupling", disable=not progress,
+                   mininterval=TQDM_INTERVAL)
         while core.windows_left:
             stage = f"window {core.window_index + 1}/{core.times.size}"
             t_a = time.perf_counter()

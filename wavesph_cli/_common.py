@@ -1,0 +1,29 @@
+"""Argument helpers shared by the subcommands (one rule for output directories and numbers)."""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+from pathlib import Path
+
+
+def positive_float(text: str) -> float:
+    """argparse type: a finite number > 0."""
+    try:
+        v = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
+    if not (v > 0 and math.isfinite(v)):
+        raise argparse.ArgumentTypeError(f"must be a finite number > 0, got {text}")
+    return v
+
+
+def refuse_non_empty(command: str, out: Path) -> bool:
+    """True (after a one-line message) if ``out`` exists and is not an empty directory: a run
+    never overwrites an earlier one's files."""
+    if out.exists() and (not out.is_dir() or any(out.iterdir())):
+        print(f"wavesph {command}: --out {out} exists and is not empty: choose a new directory",
+              file=sys.stderr)
+        return True
+    return False
