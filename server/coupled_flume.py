@@ -315,8 +315,8 @@ def run_coupled(c: FlumeCase, dp: float, out: Path, two_way: bool = True,
         0.25 rad and was 9 % low, RMSE/H 12 %. Kept to show it (bench --absorb sph).
     """
     absorb = absorb or ("none" if two_way else "client")
-    if absorb not in ("none", "client", "sph"):
-        raise ValueError(f"absorb: 'none', 'client' or 'sph', got {absorb!r}")
+    if absorb not in ("none", "client", "incident", "sph"):
+        raise ValueError(f"absorb: 'none', 'client', 'incident' or 'sph', got {absorb!r}")
     import argparse
 
     import httpx
@@ -348,7 +348,9 @@ def run_coupled(c: FlumeCase, dp: float, out: Path, two_way: bool = True,
                                   "--config", str(cfg), "--scene-hash", run["scene_hash"],
                                   "--output", str(out / "client_gauges.csv"), "--no-progress",
                                   "--timeout", "600"]
-                                 + (["--absorb"] if absorb == "client" else []))
+                                 + (["--absorb"] if absorb in ("client", "incident") else [])
+                                 + (["--absorb-wave", "incident"] if absorb == "incident"
+                                    else []))
         with contextlib.redirect_stdout(sys.stderr):  # the CLI's summary line: keep stdout clean
             code = couple_cli.main(args) if info["state"] == "waiting_for_client" else None
         info = _wait(http, run["id"], TERMINAL, timeout=120)

@@ -52,6 +52,7 @@ class _Checkpoint:
     arrays: tuple[np.ndarray, ...]
     pins: dict[int, tuple[float, float]]
     free: "BoussinesqModel | None"
+    recent: tuple[tuple[float, float, float], ...] = ()
 
 
 def sponge_profile(x: np.ndarray, x0: float, x1: float, width_left: float, width_right: float,
@@ -511,6 +512,7 @@ class BoussinesqModel:
     def release(self) -> None:
         """Remove the coupling boundary; the grid beyond it restarts from rest."""
         self._free = None
+        self._recent.clear()
         if self._pins:
             self._pins.clear()
             self._sync_pins(refactor=True)
@@ -529,7 +531,7 @@ class BoussinesqModel:
         arrays = (self._eta.copy(), self._u.copy(), self._uu.copy(), self._e_hist.copy(),
                   self._f_hist.copy(), self._stats.copy())
         return _Checkpoint(self._step, self._t, self.dt, self._n_hist, arrays, dict(self._pins),
-                           copy.deepcopy(self._free))
+                           copy.deepcopy(self._free), tuple(self._recent))
 
     def restore(self, cp: _Checkpoint) -> None:
         """Return to a state saved by `checkpoint`."""
@@ -540,4 +542,5 @@ class BoussinesqModel:
             dst[...] = src
         self._step, self._t, self.dt, self._n_hist = cp.step, cp.t, cp.dt, cp.n_hist
         self._free = copy.deepcopy(cp.free)
+        self._recent = deque(cp.recent)
 
