@@ -308,6 +308,11 @@ def run_coupled(c: FlumeCase, dp: float, out: Path, two_way: bool = True,
         L = (eta - u_ref / r) / 2 and hands it back in the inlet data, so the inlet passes it.
       "client": `wavesph couple --absorb`; mismatch = the inlet gauge's reading minus the
         model's elevation *at the gauge's x* (the uncoupled twin's beyond x_c in two-way mode).
+      "incident": two-way, plus the client's correction on the incident characteristic only
+        (`--absorb --absorb-wave incident`): the boundary lets SPH's reflection out, the
+        correction makes SPH's inlet carry the model's incident wave and level
+        (docs/absorption.md; dp 0.02: RMSE/H 7.3 % against 9.1 % without, 6.6 %
+        absorption-only).
       "sph": the scene's open boundary (`absorb = true`). Over the socket its reference is the
         elevation SET gives for the face (the protocol carries eta at the nodes' x only), not
         at its gauge 2h inside: off by k 2h (0.18 rad at dp = 0.02) of the incident wave.
