@@ -6,10 +6,9 @@ import math
 
 import pytest
 
-from sph_core import open_boundary as ob
 from sph_core.absorption import absorption_gain, source_period, wavenumber
 from sph_core.boundary_data import WaveModelBoundary
-from sph_core.flume import OpenFlume, flume_nodes
+from sph_core.open_ends import OpenBoundaries, flume_nodes
 from sph_core.scene import make_scene
 from wave_client.theories import build_theory
 from wave_client.theories import wavenumber as theory_wavenumber
@@ -50,7 +49,7 @@ def test_wavenumber_agrees_with_the_wave_client_dispersion():
                                                         rel=1e-6)
 
 
-def _flume(absorption: str, period_field: float | None = None) -> OpenFlume:
+def _ends(absorption: str, period_field: float | None = None) -> OpenBoundaries:
     sides = [{"side": s, "elevation": e, "absorption": absorption,
               "absorption_period": period_field}
              for s, e in (("left", "imposed"), ("right", "extrapolated"))]
@@ -62,17 +61,17 @@ def _flume(absorption: str, period_field: float | None = None) -> OpenFlume:
     model = build_theory("linear", height=0.01, period=1.0, depth=D, ramp_time=1.0)
     sources = {side: WaveModelBoundary(model, nd, D, nd.x_face)
                for side, nd in flume_nodes(scene).items()}
-    return OpenFlume(scene, sources=sources)
+    return OpenBoundaries.from_scene(scene, sources, 0.02)
 
 
 def test_flume_takes_the_gain_of_its_scene_and_the_source_period():
     """linear (default): omega/(k d) at the source theory's period, or at the scene's
     absorption_period; shallow: sqrt(g/d) (seed 002)."""
-    lin = _flume("linear")
+    lin = _ends("linear")
     assert source_period(lin.sources["left"]) == 1.0
     for b in (0, 1):
-        assert lin.obp[b, ob.OB_SQGD] == pytest.approx(absorption_gain("linear", G, D, 1.0))
-    assert _flume("linear", 2.5).obp[0, ob.OB_SQGD] == pytest.approx(
+        assert lin.ends.sqgd[b] == pytest.approx(absorption_gain("linear", G, D, 1.0))
+    assert _ends("linear", 2.5).ends.sqgd[0] == pytest.approx(
         absorption_gain("linear", G, D, 2.5))
-    assert _flume("shallow").obp[1, ob.OB_SQGD] == pytest.approx(math.sqrt(G / D))
+    assert _ends("shallow").ends.sqgd[1] == pytest.approx(math.sqrt(G / D))
     assert absorption_gain("linear", G, D, 1.0) < 0.85 * math.sqrt(G / D)  # kd 1.38: 20 % below
