@@ -311,7 +311,7 @@ def run_coupled(c: FlumeCase, dp: float, out: Path, two_way: bool = True,
       "incident": two-way, plus the client's correction on the incident characteristic only
         (`--absorb --absorb-wave incident`): the boundary lets SPH's reflection out, the
         correction makes SPH's inlet carry the model's incident wave and level
-        (docs/absorption.md; dp 0.02: RMSE/H 7.3 % against 9.1 % without, 6.6 %
+        (docs/absorption.md; dp 0.02: RMSE/H 7.2 % against 9.1 % without, 6.6 %
         absorption-only).
       "sph": the scene's open boundary (`absorb = true`). Over the socket its reference is the
         elevation SET gives for the face (the protocol carries eta at the nodes' x only), not
