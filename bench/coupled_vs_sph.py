@@ -60,7 +60,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--sph-only-seconds", type=float, default=3.0,
                     help="simulated seconds of the SPH-only run, extrapolated to t_end (0: full run)")
     ap.add_argument("--modes", default="two_way,absorption_only")
-    ap.add_argument("--absorb", choices=("none", "client", "sph"), default=None,
+    ap.add_argument("--absorb", choices=("none", "client", "incident", "sph"), default=None,
                     help="who absorbs at the SPH inlet (default: the two-way boundary in two-way "
                          "mode, the client in absorption-only; cases/coupled_flume.run_coupled)")
     ap.add_argument("--out", type=Path, default=None, help="run directories (default: a temp dir)")

@@ -2,6 +2,7 @@
 
     python bench/flume_accuracy.py --case III [--dp 0.01] [--periods 5] [--no-absorb]
     python bench/flume_accuracy.py --theory stokes --H 0.08 --T 2.0 --d 1.0 --dp 0.01
+    python bench/flume_accuracy.py --theory stokes2 --H 0.02 --d 0.2 --kd 1.2 --absorption shallow
 
 Runs one case of the seed 002 validation table (tests/data/wave_cases_seed002.csv, cases I-VI)
 or any regular wave through a flume one wavelength long (standing wave: half a wavelength, faces
@@ -10,7 +11,9 @@ case, theory, H, T, d, dp, H_over_dp, periods, rmse_over_H (mid-flume gauge vs t
 periods after the ramp), reflection (first harmonic, least squares over nine gauges within L/4
 of mid-flume with a fitted spatial decay of both waves: the coarse flume damps its waves, and a
 fit without decay reads that as reflection), reflection_3g (the plain fit over mid-flume and L/8
-either side), neither for the standing wave; wall_s, particles, steps, particle_steps_per_s,
+either side), reflection_harmonics (Mansard & Funke per harmonic, first and bound second, nine
+gauges with decay), none for the standing wave; absorption (the open ends' gain: linear
+omega/(k d) at the wave period, or the seed 002 shallow sqrt(g/d); sph_core.absorption), kd; wall_s, particles, steps, particle_steps_per_s,
 boundary counts, the mean water level at mid-flume (mean_level_m), the change of the flume's
 water volume per length since the start (level_drift_m) and the gauges' mean level over the
 last period (level_last_period_m).
@@ -46,7 +49,8 @@ def case_theory(theory: str, height: float, period: float, depth: float, ramp: f
 
 
 def run_flume_case(theory: str, height: float, period: float, depth: float, dp: float, periods: float,
-        ramp_periods: float = 1.0, absorb: bool = True, case: str | None = None) -> dict:
+                   ramp_periods: float = 1.0, absorb: bool = True, case: str | None = None,
+                   absorption: str = "linear") -> dict:
     ramp = ramp_periods * period
     model = case_theory(theory, height, period, depth, ramp)
     if theory == "irregular":  # flume length and gauges from the peak wave
@@ -56,7 +60,7 @@ def run_flume_case(theory: str, height: float, period: float, depth: float, dp: 
     out = flume_case(model, height=height, period=period, depth=depth, wavelength=wavelength,
                      dp=dp, periods=periods, ramp=ramp, standing=theory == "standing",
                      absorb=(absorb, absorb), regular=theory != "irregular",
-                     name=f"flume_{case or theory}")
+                     name=f"flume_{case or theory}", absorption=absorption)
     return {"case": case, "theory": theory, **out}
 
 
@@ -68,24 +72,29 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--H", type=float)
     ap.add_argument("--T", type=float)
     ap.add_argument("--d", type=float)
+    ap.add_argument("--kd", type=float, help="instead of --T: the period of linear waves of this "
+                                             "kd in depth --d")
     ap.add_argument("--dp", type=float, help="particle spacing [m] (default: H/10)")
     ap.add_argument("--periods", type=float, default=5.0, help="periods measured after the ramp")
     ap.add_argument("--ramp-periods", type=float, default=1.0)
     ap.add_argument("--no-absorb", action="store_true", help="switch the seed 002 correction off")
+    ap.add_argument("--absorption", choices=("linear", "shallow"), default="linear",
+                    help="gain of the correction (sph_core.absorption)")
     a = ap.parse_args(argv)
     if a.case:
         row = read_cases()[a.case]
         theory = row["theory"]
         height, period, depth = float(row["H"]), float(row["T"]), float(row["d"])
-    elif a.theory and a.H and a.T and a.d:
-        theory, height, period, depth = a.theory, a.H, a.T, a.d
+    elif a.theory and a.H and a.d and (a.T or a.kd):
+        theory, height, depth = a.theory, a.H, a.d
+        period = a.T if a.T else 2 * math.pi / math.sqrt(9.81 * a.kd / a.d * math.tanh(a.kd))
         if theory.startswith("stokes") and theory not in THEORY_OF:
             THEORY_OF[theory] = ("stokes", {"order": int(theory[-1])})
     else:
-        ap.error("give --case, or --theory with --H --T --d")
+        ap.error("give --case, or --theory with --H --d and --T or --kd")
     dp = a.dp if a.dp else height / 10.0
     out = run_flume_case(theory, height, period, depth, dp, a.periods, a.ramp_periods, not a.no_absorb,
-              a.case)
+                         a.case, a.absorption)
     print(json.dumps(out), flush=True)
     return 0
 

@@ -14,11 +14,19 @@ either side where the decay-aware fit over 9 gauges within L/4 of it gives 4.0 %
 ``decay=True`` both waves decay along their direction of travel at one rate delta [1/m],
     A_j = a_I exp(-(i k + delta) x_j) + a_R exp(+(i k + delta) x_j),   x_j from the array centre,
 delta chosen by least squares too, and K_R is the ratio at the centre of the gauge array.
+
+Per harmonic (``separate_harmonics``): the n-th harmonic n omega of the records is separated the
+same way with the wavenumber the caller gives for it: n k for the bound harmonics of a steady
+nonlinear wave (they travel at the fundamental's phase speed), the linear-dispersion k(n omega)
+for free waves (e.g. spurious harmonics emitted by a boundary). Mansard & Funke (1980) fit the
+same least squares with a residual ("noise") term: uncorrelated noise adds only to the residual
+returned here.
 """
 
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 from scipy.optimize import minimize_scalar
@@ -61,37 +69,74 @@ def _separate(amp: np.ndarray, xs: np.ndarray, k: float, delta: float
     return complex(a_i), complex(a_r), float(np.linalg.norm(a @ np.array([a_i, a_r]) - amp))
 
 
-def reflection_coefficient(t: np.ndarray, etas: np.ndarray, xs: np.ndarray, period: float,
-                           k: float, decay: bool = False) -> tuple[float, float, float]:
-    """(K_R, |a_I|, |a_R|) from records ``etas[j, :]`` at gauge positions ``xs[j]`` [m].
+@dataclass(frozen=True)
+class Separation:
+    """Incident and reflected components of one harmonic (amplitudes [m] and phases [rad] of
+    Re(a exp(i omega t)) at the array centre with ``decay``, else at x = 0), the fitted decay
+    rate [1/m] (0 without ``decay``) and the least-squares residual norm [m]."""
 
-    The records are trimmed to the largest whole number of periods from their start. ``decay``:
-    fit a common spatial decay rate too (>= 3 gauges; see the module docstring); amplitudes
-    are then those at the centre of the gauge array."""
-    t = np.asarray(t, dtype=float)
-    etas = np.atleast_2d(np.asarray(etas, dtype=float))
-    xs = np.asarray(xs, dtype=float)
-    if etas.shape != (xs.size, t.size) or xs.size < 2:
-        raise ValueError(f"etas: expected shape ({xs.size}, {t.size}) with >= 2 gauges, "
-                         f"got {etas.shape}")
-    if decay and xs.size < 3:
-        raise ValueError(f"xs: the decay fit needs >= 3 gauges, got {xs.size}")
+    harmonic: int
+    kr: float
+    a_incident: float
+    a_reflected: float
+    phase_incident: float
+    phase_reflected: float
+    decay: float
+    residual: float
+
+
+def _whole_periods(t: np.ndarray, etas: np.ndarray, xs: np.ndarray, period: float,
+                   n_gauges: int) -> int:
+    """Checks the records; returns the sample count spanning the most whole periods."""
+    if etas.shape != (xs.size, t.size) or xs.size < n_gauges:
+        raise ValueError(f"etas: expected shape ({xs.size}, {t.size}) with >= {n_gauges} "
+                         f"gauges, got {etas.shape}")
     if not np.all(np.isfinite(etas)):
         raise ValueError("etas: records contain dry or non-finite samples")
     dt = t[1] - t[0]
     n_per = math.floor((t[-1] - t[0] + dt) / period + 1e-9)
     if n_per < 1:
         raise ValueError(f"t: records shorter than one period ({period} s)")
-    m = int(round(n_per * period / dt))
+    return int(round(n_per * period / dt))
+
+
+def separate_harmonics(t: np.ndarray, etas: np.ndarray, xs: np.ndarray, period: float,
+                       wavenumbers: list[float] | np.ndarray, decay: bool = False
+                       ) -> list[Separation]:
+    """Incident/reflected separation of harmonics 1..len(wavenumbers) of records
+    ``etas[j, :]`` at gauge positions ``xs[j]`` [m] (uniform ``t``, trimmed to whole periods).
+
+    ``wavenumbers[n - 1]``: the wavenumber [1/m] of harmonic n (see the module docstring).
+    Two gauges suffice without ``decay`` (Goda & Suzuki 1976), three or more with it (the
+    decay rate is fitted per harmonic). Gauge spacings near a multiple of half the harmonic's
+    wavelength make its fit ill-conditioned."""
+    t = np.asarray(t, dtype=float)
+    etas = np.atleast_2d(np.asarray(etas, dtype=float))
+    xs = np.asarray(xs, dtype=float)
+    m = _whole_periods(t, etas, xs, period, 3 if decay else 2)
     omega = 2.0 * math.pi / period
-    amp = np.array([harmonic_amplitude(t[:m], e[:m], omega) for e in etas])
-    if not decay:
-        a_i, a_r, _ = _separate(amp, xs, k, 0.0)
-        return float(abs(a_r) / abs(a_i)), float(abs(a_i)), float(abs(a_r))
-    xc = xs - 0.5 * (xs.min() + xs.max())
-    # residual vs delta is smooth with one minimum for |delta| well below k (a decay by e over a
-    # wavelength/(2 pi) is far beyond any usable flume)
-    fit = minimize_scalar(lambda dl: _separate(amp, xc, k, dl)[2], bounds=(-0.5 * k, 0.5 * k),
-                          method="bounded", options={"xatol": 1e-6 * k})
-    a_i, a_r, _ = _separate(amp, xc, k, float(fit.x))
-    return float(abs(a_r) / abs(a_i)), float(abs(a_i)), float(abs(a_r))
+    out = []
+    for n, k in enumerate(np.asarray(wavenumbers, dtype=float), start=1):
+        amp = np.array([harmonic_amplitude(t[:m], e[:m], n * omega) for e in etas])
+        dl = 0.0
+        x = xs
+        if decay:
+            x = xs - 0.5 * (xs.min() + xs.max())
+            # residual vs delta is smooth with one minimum for |delta| well below k (a decay by
+            # e over a wavelength/(2 pi) is far beyond any usable flume)
+            fit = minimize_scalar(lambda d: _separate(amp, x, k, d)[2], bounds=(-0.5 * k, 0.5 * k),
+                                  method="bounded", options={"xatol": 1e-6 * k})
+            dl = float(fit.x)
+        a_i, a_r, res = _separate(amp, x, k, dl)
+        out.append(Separation(n, float(abs(a_r) / abs(a_i)), float(abs(a_i)), float(abs(a_r)),
+                              float(np.angle(a_i)), float(np.angle(a_r)), dl, res))
+    return out
+
+
+def reflection_coefficient(t: np.ndarray, etas: np.ndarray, xs: np.ndarray, period: float,
+                           k: float, decay: bool = False) -> tuple[float, float, float]:
+    """(K_R, |a_I|, |a_R|) of the first harmonic (``separate_harmonics``) from records
+    ``etas[j, :]`` at gauge positions ``xs[j]`` [m]; with ``decay`` (>= 3 gauges) the
+    amplitudes are those at the centre of the gauge array."""
+    s = separate_harmonics(t, etas, xs, period, [k], decay=decay)[0]
+    return s.kr, s.a_incident, s.a_reflected

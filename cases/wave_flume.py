@@ -25,7 +25,8 @@ from sph_core.open_ends import flume_nodes
 from sph_core.simulation import Simulation
 from sph_core.scene import Scene, make_scene
 
-from .wave_analysis import group_velocity, reflection_coefficient, rmse_over_height
+from .wave_analysis import (group_velocity, reflection_coefficient, rmse_over_height,
+                            separate_harmonics)
 
 # gauges [wavelengths from mid-flume] of the reflection analysis: L/16 apart within L/4 of
 # mid-flume (nine, for the decay-aware fit), among them refl_a, mid, refl_b at -L/8, 0, +L/8 (the
@@ -40,7 +41,7 @@ def wave_flume_scene(*, depth: float, wavelength: float, height: float, dp: floa
                      length: float | None = None, absorb: tuple[bool, bool] = (True, True),
                      right_elevation: str = "extrapolated", probe_every: float = 0.02,
                      c0: float | None = None, g: float = 9.81, name: str = "wave_flume",
-                     **constants: Any) -> Scene:
+                     absorption: str = "linear", **constants: Any) -> Scene:
     """A flat-bed flume [0, length] x [0, top] (floor z = 0, still water at z = depth) with open
     ends and elevation gauges mid-flume and L/16 apart within L/4 of it.
 
@@ -61,8 +62,10 @@ def wave_flume_scene(*, depth: float, wavelength: float, height: float, dp: floa
         "constants": cst, "output": {"probe_every": probe_every},
         "probes": probes,
         "open_boundaries": [
-            {"side": "left", "elevation": "imposed", "absorb": absorb[0]},
-            {"side": "right", "elevation": right_elevation, "absorb": absorb[1]}],
+            {"side": "left", "elevation": "imposed", "absorb": absorb[0],
+             "absorption": absorption},
+            {"side": "right", "elevation": right_elevation, "absorb": absorb[1],
+             "absorption": absorption}],
     })
 
 
@@ -120,7 +123,8 @@ def run_wave_flume(scene: Scene, model: Any, *, window: float, x_model_left: flo
 def flume_case(model: Any, *, height: float, period: float, depth: float, wavelength: float,
                dp: float, periods: float, ramp: float, standing: bool = False,
                absorb: tuple[bool, bool] = (True, True), window_per_period: int = 50,
-               regular: bool = True, name: str = "wave_flume", **constants: Any) -> dict[str, Any]:
+               regular: bool = True, name: str = "wave_flume", absorption: str = "linear",
+               **constants: Any) -> dict[str, Any]:
     """Run one wave case and score it: the figures of ``bench/flume_accuracy.py``.
 
     Flume one wavelength long (standing wave: half, faces at the nodes of eta, antinode
@@ -143,11 +147,13 @@ def flume_case(model: Any, *, height: float, period: float, depth: float, wavele
     scene = wave_flume_scene(depth=depth, wavelength=wavelength, height=height, dp=dp,
                              t_end=t_start + periods * period, length=length, absorb=absorb,
                              right_elevation="imposed" if standing else "extrapolated",
-                             probe_every=period / 40, name=name, **constants)
+                             probe_every=period / 40, name=name, absorption=absorption,
+                             **constants)
     x_left = -0.5 * scene.tank.x1 if standing else 0.0
     res = run_wave_flume(scene, model, window=period / window_per_period, x_model_left=x_left)
     sel = res.t >= t_start - 1e-9
     refl = refl_3g = None
+    refl_h: list[float] | None = None
     if regular and not standing:
         def kr(names: list[str], decay: bool) -> float:
             return reflection_coefficient(
@@ -155,6 +161,11 @@ def flume_case(model: Any, *, height: float, period: float, depth: float, wavele
                 np.array([res.gauge_x[n] for n in names]), period, k, decay=decay)[0]
         refl = kr(REFLECTION_GAUGES, True)
         refl_3g = kr(["refl_a", "mid", "refl_b"], False)
+        # per harmonic (bound harmonics: wavenumber n k), nine gauges, fitted decay
+        refl_h = [round(s.kr, 5) for s in separate_harmonics(
+            res.t[sel], np.array([res.eta[n][sel] for n in REFLECTION_GAUGES]),
+            np.array([res.gauge_x[n] for n in REFLECTION_GAUGES]), period, [k, 2 * k],
+            decay=True)]
     nf = res.n_fluid
     # water level drift: a flume one wavelength long holds the volume of still water at any
     # phase of a regular progressive wave; each fluid particle carries dp^2 of the initial lattice
@@ -168,7 +179,8 @@ def flume_case(model: Any, *, height: float, period: float, depth: float, wavele
     return {"H": height, "T": period, "d": depth, "dp": dp, "H_over_dp": round(height / dp, 3),
             "periods": periods,
             "rmse_over_H": rmse_over_height(res.eta["mid"][sel], res.theory["mid"][sel], height),
-            "reflection": refl, "reflection_3g": refl_3g, "absorb": list(absorb),
+            "reflection": refl, "reflection_3g": refl_3g, "reflection_harmonics": refl_h,
+            "absorb": list(absorb), "absorption": absorption, "kd": round(kd, 4),
             "wall_s": round(res.wall_s, 2),
             "particles": res.particles, "steps": res.steps,
             "particle_steps_per_s": round(res.particles * res.steps / max(res.wall_s, 1e-9)),

@@ -23,6 +23,7 @@ from typing import Mapping
 
 import numpy as np
 
+from .absorption import absorption_gain, source_period
 from .boundary_data import (BoundaryData, BoundaryDataError, BoundaryNodes, BoundarySample,
                             still_sample, validate_sample)
 from .eos import GAMMA, hydrostatic_density
@@ -114,7 +115,8 @@ class OpenBoundaries:
             e.x_face[b] = nd.x_face
             e.nx[b] = -1.0 if b == 0 else 1.0
             e.swl[b] = swl
-            e.sqgd[b] = math.sqrt(c.g / depth)
+            period = o.absorption_period or source_period(sources.get(o.side))
+            e.sqgd[b] = absorption_gain(o.absorption, c.g, depth, period)
             e.absorb[b] = o.absorb
             e.imposed[b] = o.elevation == "imposed"
             e.ghost[b] = buffer_pressure(o) == "extrapolated"

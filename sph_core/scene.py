@@ -188,11 +188,17 @@ class OpenBoundary(_Model):
     ``elevation``: ``imposed`` takes the source's elevation (inlet of seed 002); ``extrapolated``
     takes the one measured by the boundary gauge inside the fluid (outlet). ``absorb`` applies the
     seed 002 correction u = u_theory + n_x (eta_measured - eta_theory) sqrt(g/d), n_x the outward
-    normal (-1 left, +1 right). The gauge stands ``gauge_offset`` [m] inside the face (default 2h)."""
+    normal (-1 left, +1 right). The gauge stands ``gauge_offset`` [m] inside the face (default 2h).
+    ``absorption`` picks the correction's gain (``sph_core.absorption``): ``linear`` omega/(k d) at
+    the wave period (``absorption_period``, else the source theory's period; sqrt(g/d) when
+    neither is known), ``shallow`` the seed 002 sqrt(g/d) at every kd."""
 
     side: Literal["left", "right"]
     elevation: Literal["imposed", "extrapolated"] = "imposed"
     absorb: bool = True
+    absorption: Literal["shallow", "linear"] = "linear"
+    absorption_period: float | None = Field(None, gt=0, description="wave period [s] of the "
+                                            "linear absorption gain (None: the source's)")
     gauge_offset: float | None = Field(None, gt=0, description="boundary gauge distance inside the face [m]")
     pressure: Literal["hydrostatic", "extrapolated"] | None = Field(
         None, description="buffer pressure: hydrostatic below the buffer's surface, or "

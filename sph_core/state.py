@@ -112,7 +112,7 @@ class OpenEnds(NamedTuple):
     nx: np.ndarray        # outward normal (-1 left, +1 right)
     length: np.ndarray    # buffer width [m]
     swl: np.ndarray       # still-water level [m]
-    sqgd: np.ndarray      # sqrt(g / depth) of the absorption correction [1/s]
+    sqgd: np.ndarray      # gain G of the absorption correction [1/s] (sph_core.absorption)
     absorb: np.ndarray    # bool[2]: absorption correction on
     imposed: np.ndarray   # bool[2]: surface imposed (else measured)
     ghost: np.ndarray     # bool[2]: buffer pressure extrapolated from ghost nodes

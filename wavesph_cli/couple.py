@@ -47,6 +47,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     p.add_argument("--absorb", action="store_true",
                    help="apply the seed 002 active-absorption correction on the client side; only "
                         "for a server whose open boundaries do not absorb themselves")
+    p.add_argument("--absorb-wave", choices=("total", "incident"), default="total",
+                   help="what the client's correction compares: the total elevation (seed 002), "
+                        "or the incident (right-going) characteristic, for two-way models whose "
+                        "boundary already lets SPH's reflection out (CouplingOptions.absorb_wave)")
     p.add_argument("--absorb-cutoff", type=float, default=None,
                    help="low-pass cutoff [Hz] of the absorption's measured mismatch (default 3/T)")
     p.add_argument("--x-offset", type=float, default=None,
@@ -129,7 +133,7 @@ def main(args: argparse.Namespace) -> int:
             if len(scene_hash) != 32:
                 raise ValueError("--scene-hash must be 64 hex digits (SHA-256)")
         options = CouplingOptions(window=window, t_end=args.t_end, absorb=args.absorb,
-                                  absorb_cutoff=args.absorb_cutoff,
+                                  absorb_cutoff=args.absorb_cutoff, absorb_wave=args.absorb_wave,
                                   x_offset=args.x_offset, inlet_gauge=args.inlet_gauge,
                                   outlet_gauge=args.outlet_gauge)
         if args.url.startswith("tcp://") and not args.run_id:

@@ -194,3 +194,37 @@ def test_checkpoint_restore_is_exact():
     m.advance_steps(100)
     assert m.t == t1
     np.testing.assert_array_equal(m.eta_nodes, eta1)
+
+
+@pytest.mark.parametrize("split", ["model", "sph"])
+def test_sph_mean_point_velocity_does_not_set_the_boundary_mean(monkeypatch, split):
+    """SPH's velocity at z_alpha is a point value: its mean over a period is not the zone's
+    mass-flux velocity (measured in the coupled flume: +8..+23 mm/s where the flux velocity is
+    the model's return flow, -4.6 mm/s). With the mean split ("model", the default) a constant
+    offset of SPH's u_ref leaves the model unchanged; taking it at face value ("sph", before)
+    turns it into a left-going long wave of -offset/(2 r) at the boundary, which here (the model
+    reading back its own boundary values) feeds on itself until the model blows up."""
+    from wave_client.boussinesq import solver
+
+    monkeypatch.setattr(solver, "MEAN_SPLIT", split)
+    depth, period = 0.5, 2.0
+    plain, wl = flume(depth, period, -3, 6, height=0.01)
+    biased, _ = flume(depth, period, -3, 6, height=0.01)
+    x_b = 3.0 * wl
+    offset = 0.02
+    try:
+        while plain.t < 12 * period:
+            for m, extra in ((plain, 0.0), (biased, offset)):
+                if m.t > 0:
+                    u = float(m.velocity(x_b, np.array([BETA * depth]))[0][0])
+                    m.impose(x_b, float(m.elevation(x_b)), u + extra)
+                m.advance_steps(1)
+    except solver.BoussinesqUnstableError:
+        assert split == "sph"  # the offset fed back on itself every step: it blew up
+        return
+    xs = np.array([1.0, 2.0, 2.9]) * wl
+    diff = np.max(np.abs(biased.elevation(xs) - plain.elevation(xs)))
+    if split == "model":
+        assert diff < 1e-9
+    else:
+        assert diff > 0.3 * offset / (2 * plain.progressive_ratio(depth))

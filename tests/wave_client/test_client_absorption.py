@@ -93,3 +93,44 @@ def test_unfiltered_lagged_correction_amplifies_short_waves():
                     n_periods=40)
     assert abs(env[5] - H) < 0.05 * H
     assert env[-1] > 10 * H, env / H
+
+
+def test_incident_mismatch_ignores_the_reflected_wave_and_reads_the_inlet_deficit():
+    """absorb_wave="incident" (two-way models): the mismatch is that of the right-going
+    characteristic (eta + u_ref/r)/2 at the inlet gauge, so SPH's reflected wave (which the
+    two-way boundary lets out itself) adds nothing, and an incident wave 10 % short reads as
+    -10 % of it."""
+    from types import SimpleNamespace
+
+    r, a, k, omega = 5.0, 0.01, 2.0, 4.0
+
+    class Progressive:
+        t, depth, x_couple = 0.0, D, 0.0
+
+        def progressive_ratio(self, h):
+            return r
+
+        def advance_to(self, t):
+            self.t = t
+
+        def elevation(self, x):
+            return a * np.cos(k * np.asarray(x, float) - omega * self.t)
+
+        def velocity(self, x, z):
+            return r * self.elevation(x), np.zeros_like(np.asarray(x, float))
+
+        def impose(self, x, eta, u_ref):
+            pass
+
+    model = Progressive()
+    core = CouplingCore(model, CouplingOptions(absorb=True, absorb_wave="incident"))
+    core.welcome = SimpleNamespace(depth=D, g=G, z_ref=-0.2)
+    for t in np.linspace(0.0, 1.5, 7):
+        model.advance_to(t)
+        x = 0.3
+        inc = float(model.elevation(x))
+        refl = 0.3 * a * math.cos(-k * x - omega * t + 0.4)
+        m = core._incident_mismatch(x, inc + refl, r * (inc - refl), inc)
+        assert m == pytest.approx(0.0, abs=1e-15)
+        short = core._incident_mismatch(x, 0.9 * inc + refl, r * (0.9 * inc - refl), inc)
+        assert short == pytest.approx(-0.1 * inc, abs=1e-15)

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import copy
 import math
+from collections import deque
 from dataclasses import dataclass
 
 import numpy as np
@@ -31,6 +32,9 @@ from . import stepping
 from .dispersion import BETA, G, nwogu_wavenumber
 from .profile import reconstruct_velocity
 from .source import SourceFunction, components_from_series, make_source
+
+
+MEAN_SPLIT = "model"  # experiment switch: "sph" (SPH's mean u_ref) or "model"
 
 
 class BoussinesqUnstableError(RuntimeError):
@@ -50,6 +54,7 @@ class _Checkpoint:
     arrays: tuple[np.ndarray, ...]
     pins: dict[int, tuple[float, float]]
     free: "BoussinesqModel | None"
+    recent: tuple[tuple[float, float, float], ...] = ()
 
 
 def sponge_profile(x: np.ndarray, x0: float, x1: float, width_left: float, width_right: float,
@@ -176,6 +181,7 @@ class BoussinesqModel:
         self._pin_idx, self._pin_in, self._pin_ratio = np.zeros(0, np.int64), np.zeros(0), np.zeros(0)
         self.coupling_omega: float | None = None  # frequency of the u/eta split at the boundary
         self._free: BoussinesqModel | None = None  # uncoupled twin, answers beyond the boundary
+        self._recent: deque[tuple[float, float, float]] = deque()  # (t, u_ref, u_b) of impose
         self._lower, self._diag, self._upper = np.zeros(nm), np.zeros(nm), np.zeros(nm)
         self._cprime, self._minv = np.zeros(nm), np.zeros(nm)
         self._factor()
@@ -477,8 +483,25 @@ class BoussinesqModel:
         if self._free is None:  # the uncoupled twin starts from the state before any feedback
             self._free = copy.deepcopy(self)
         moved = i not in self._pins
-        self._pins = {i: (0.5 * (float(eta) - float(u_ref) / r), r)}
+        u_split = self._mean_corrected_velocity(float(u_ref), float(self.u_nodes[i]), moved)
+        self._pins = {i: (0.5 * (float(eta) - u_split / r), r)}
         self._sync_pins(refactor=moved)
+
+    def _mean_corrected_velocity(self, u_ref: float, u_model: float, restart: bool) -> float:
+        """SPH's velocity with its mean over the last wave period replaced by the model's own at
+        the boundary (MEAN_SPLIT; see `impose`)."""
+        if MEAN_SPLIT == "sph" or self.coupling_omega is None:
+            return u_ref
+        if restart:
+            self._recent.clear()
+        period = 2.0 * math.pi / self.coupling_omega
+        self._recent.append((self.t, u_ref, u_model))
+        while self._recent and self._recent[0][0] <= self.t - period * (1.0 - 1e-9):
+            self._recent.popleft()
+        n = len(self._recent)
+        u_sph_mean = sum(v[1] for v in self._recent) / n
+        u_model_mean = sum(v[2] for v in self._recent) / n
+        return u_ref - u_sph_mean + u_model_mean
 
     def progressive_ratio(self, h: float) -> float:
         """u_alpha / eta [1/s] of a linear progressive Nwogu wave at `coupling_omega` in depth h:
@@ -504,7 +527,7 @@ class BoussinesqModel:
         arrays = (self._eta.copy(), self._u.copy(), self._uu.copy(), self._e_hist.copy(),
                   self._f_hist.copy(), self._stats.copy())
         return _Checkpoint(self._step, self._t, self.dt, self._n_hist, arrays, dict(self._pins),
-                           copy.deepcopy(self._free))
+                           copy.deepcopy(self._free), tuple(self._recent))
 
     def restore(self, cp: _Checkpoint) -> None:
         """Return to a state saved by `checkpoint`."""
@@ -515,4 +538,5 @@ class BoussinesqModel:
             dst[...] = src
         self._step, self._t, self.dt, self._n_hist = cp.step, cp.t, cp.dt, cp.n_hist
         self._free = copy.deepcopy(cp.free)
+        self._recent = deque(cp.recent)
 

@@ -72,6 +72,12 @@ class CouplingOptions:
     t_end:    stop at this time [s] (None: the server's t_end).
     absorb:   apply the seed 002 correction at the inlet and outlet (off by default: the SPH
               side normally absorbs itself, see the module docstring).
+    absorb_wave: "total": the mismatch is eta_measured - eta_model at the gauge (seed 002);
+              "incident": the mismatch of the incident (right-going) characteristic at the inlet
+              gauge, R = (eta + u_ref / r) / 2 measured minus the model's, r the model's
+              ``progressive_ratio`` (else sqrt(g/d)): it leaves SPH's reflected wave alone, which
+              a two-way model's boundary lets out itself, and corrects only what SPH's inlet
+              makes of the incident wave (level and wave). The outlet keeps "total".
     absorb_cutoff: low-pass cutoff f_c [Hz] of the measured mismatch; None: 3 / model period
               (50 windows' period for a model without ``period``); math.inf: no filter.
     x_offset: model x = SPH x + x_offset [m] (the two codes may use different x origins); None:
@@ -84,6 +90,7 @@ class CouplingOptions:
     window: float | None = None
     t_end: float | None = None
     absorb: bool = False
+    absorb_wave: str = "total"
     absorb_cutoff: float | None = None
     x_offset: float | None = None
     inlet_gauge: int | None = None
@@ -327,6 +334,10 @@ class CouplingCore:
                                     "outside the wave model: choose another gauge")
             # a dry gauge measured nothing: no correction rather than a spurious one
             m = float(result.eta[g] - eta_model[g]) if g is not None and result.wet[g] else 0.0
+            if (m != 0.0 or result.wet[g]) and side is Side.INLET \
+                    and self.options.absorb_wave == "incident" and g is not None:
+                m = self._incident_mismatch(float(gx[g] + x_off), float(result.eta[g]),
+                                            float(result.u_ref[g]), float(eta_model[g]))
             self._mismatch[side] += a * (m - self._mismatch[side])
         inlet = self._sides.get(Side.INLET)
         if inlet is not None and inlet.gauge is not None and result.wet[inlet.gauge]:
@@ -337,6 +348,15 @@ class CouplingCore:
         self.window_index += 1
         return WindowRecord(t0, t1, int(result.steps), result.eta.copy(), result.wet.copy(),
                             result.u_ref.copy(), result.w_ref.copy(), eta_model, du_in, du_out)
+
+    def _incident_mismatch(self, x: float, eta: float, u_ref: float, eta_model: float) -> float:
+        """(eta + u_ref / r)/2 measured minus the model's at model x (see absorb_wave)."""
+        assert self.model is not None and self.welcome is not None
+        ratio = getattr(self.model, "progressive_ratio", None)
+        r = ratio(self.welcome.depth) if ratio else math.sqrt(self.welcome.g / self.welcome.depth)
+        u_model = float(np.asarray(self.model.velocity(np.array([x]),
+                                                       np.array([self.welcome.z_ref]))[0])[0])
+        return 0.5 * ((eta + u_ref / r) - (eta_model + u_model / r))
 
     def _model_at_gauges(self, x: np.ndarray) -> np.ndarray:
         """Model elevation at the gauges; NaN (in the log only) where the model has no value,
