@@ -25,6 +25,7 @@ import numba
 import numpy as np
 
 from . import step, wcsph
+from .bodies import BodyLog, BodySet
 from .boundary_data import BoundaryData, BoundaryDataError, BoundarySample
 from .eos import hydrostatic_density, tait_b
 from .geometry import build_layout
@@ -70,7 +71,13 @@ class Simulation:
         self.open = OpenBoundaries.from_scene(scene, sources, window)
         if spare is None:
             spare = 0.3 if self.open.active else 0.1
-        n = layout.wall_x.size + layout.fluid_x.size
+        # rigid bodies (issue 14): their particles replace the fluid inside them
+        self.bodies = BodySet(scene, layout.n_layers * dp)
+        if self.bodies.active:
+            keep = self.bodies.fluid_outside(layout.fluid_x, layout.fluid_z, dp)
+            layout.fluid_x, layout.fluid_z = layout.fluid_x[keep], layout.fluid_z[keep]
+            layout.fluid_surface = layout.fluid_surface[keep]
+        n = layout.wall_x.size + layout.fluid_x.size + self.bodies.x.size
         self.particles = ps = ParticleSet(max(int(n * (1.0 + spare)), n + 1))
         vol = dp * dp
         ps.add(layout.wall_x, layout.wall_z, WALL, np.full(layout.wall_x.size, c.rho0),
@@ -79,6 +86,7 @@ class Simulation:
         # mass = rho * dp^2: the lattice is the compressed hydrostatic state, so the initial
         # pressure is hydrostatic and the particle volume is exactly dp^2
         ps.add(layout.fluid_x, layout.fluid_z, FLUID, rho_f, rho_f * vol)
+        self.bodies.attach(ps, c.rho0, dp)
         self.n_layers = layout.n_layers
         self.open.attach(ps, scene, self.b, layout.n_layers * dp)
         t = scene.tank
@@ -98,7 +106,8 @@ class Simulation:
         self.integrator = wcsph.INTEGRATORS[c.integrator]
         self.passes_per_step = wcsph.PASSES_PER_STEP[c.integrator]
         self._counts = np.zeros(ps.capacity, dtype=np.int64)
-        dt, n_new = step.initialise(ps.view, ps.view2, self.cells, self.prm, self.open.ends, ps.n)
+        dt, n_new = step.initialise(ps.view, ps.view2, self.cells, self.prm, self.open.ends,
+                                   self.bodies.state, ps.n)
         self.dt = float(dt)
         ps.swap()
         ps.n = int(n_new)
@@ -121,6 +130,7 @@ class Simulation:
         self._line_z = t.z0 + (np.arange(nz) + 0.5) * 0.5 * dp
         self._line_rho = np.zeros(self._line_z.size)
         self.history: list[dict[str, float | None]] = []
+        self.body_history: list[dict[str, float]] = []  # on the probe cadence (bodies.csv)
         self._k_probe = 0
         self._k_snap = 0
         self.status = "created"
@@ -128,6 +138,9 @@ class Simulation:
         if run_dir is not None:
             self.writer = RunWriter(run_dir, self.probe_columns(), scene.model_dump(mode="json"))
             self.writer.update_meta(**self._meta_fields())
+            if self.bodies.active:
+                self.bodies.log = BodyLog(run_dir, self.bodies.columns())
+                self.writer.update_meta(bodies=self.bodies.properties)
         self._record_outputs()
 
     # ---------------------------------------------------------------- state access
@@ -236,6 +249,11 @@ class Simulation:
             self.history.append({"t": self.t, **values})
             if self.writer:
                 self.writer.probe_row(self.t, self.steps, values)
+            if self.bodies.active:
+                rows = self.bodies.rows()
+                self.body_history.append({"t": self.t, **rows})
+                if self.bodies.log:
+                    self.bodies.log.row(self.t, self.steps, rows)
             self._k_probe = int(math.floor(self.t / o.probe_every + 1e-6)) + 1
         if self.writer and o.snapshot_every > 0 and self.t >= self._k_snap * o.snapshot_every - eps:
             self.write_snapshot()
@@ -251,6 +269,7 @@ class Simulation:
         fld["kind"] = ps.kind[: ps.n][sel].astype(np.int32)
         fld["id"] = ps.ids[: ps.n][sel].astype(np.int64)
         fld["speed"] = np.hypot(fld["vx"], fld["vz"])
+        fld["body"] = self.bodies.particle_body(fld["id"])  # -1: not a body particle
         self.writer.snapshot(self.t, ps.field(X)[sel], ps.field(Z)[sel], fld)
 
     def _next_output_time(self, t_target: float) -> float:
@@ -338,8 +357,8 @@ class Simulation:
         ends.next_id[0] = ps.next_id
         tic = time.perf_counter()
         t, dt, steps, status, swapped, n_flag, vmax, n = step.run(
-            ps.view, ps.view2, self.cells, self.prm, ends, self.integrator, ps.n, self.t, self.dt,
-            t_stop, max_steps)
+            ps.view, ps.view2, self.cells, self.prm, ends, self.bodies.state, self.integrator, ps.n,
+            self.t, self.dt, t_stop, max_steps)
         self.wall_time += time.perf_counter() - tic
         if swapped:
             ps.swap()
@@ -423,6 +442,7 @@ class Simulation:
         c.cell = self.particles.cell[: c.n].copy()
         c.cell_start = self.cells.start.copy()
         c.open_state = self.open.state()
+        c.body_state = self.bodies.get_state()
         return c
 
     def restore(self, c: Checkpoint) -> None:
@@ -438,6 +458,7 @@ class Simulation:
         else:
             self._rebuild_cells()
         self.open.set_state(c.open_state)
+        self.bodies.set_state(c.body_state)
         self.status = "paused"
         o = self.scene.output
         self._k_probe = int(math.floor(self.t / o.probe_every + 1e-9)) + 1 if o.probe_every else 0
@@ -457,3 +478,5 @@ class Simulation:
         if self.writer:
             self.writer.update_meta(**self._meta_fields())
             self.writer.close()
+        if self.bodies.log:
+            self.bodies.log.close()
