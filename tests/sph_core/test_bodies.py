@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from cases.bodies import (archimedes_draft, floating_box_scene, hinged_flap_scene,
+from cases.rigid_bodies import (archimedes_draft, box_draft, floating_box_scene, hinged_flap_scene,
                           spring_flap_period, zero_crossing_period, zero_gravity)
 from sph_core.particles import FLUID, M, VX, VZ
 from sph_core.scene import SceneError, make_scene
@@ -136,3 +136,16 @@ def test_prescribed_body_follows_its_series_and_checkpoint_restores_it(tmp_path)
     from pyevtk.vtk import VtkFile  # noqa: F401  (pyevtk present: snapshots were written)
     vtu = sorted((tmp_path / "snapshots").glob("*.vtu"))
     assert vtu and b'Name="body"' in vtu[-1].read_bytes()
+
+
+@pytest.mark.slow
+def test_floating_box_settles_at_the_archimedes_draft() -> None:
+    """Box (B 0.4 m, H 0.2 m, 500 kg/m^3: draft 0.1 m = 5 dp) released 0.02 m too deep, heave
+    only, with a heave damper (no force at rest) so it settles; its mean draft over the last
+    0.5 s, below the level the closed tank's water has, within 1 % of rho_b H / rho0."""
+    sim = Simulation(floating_box_scene(dp=0.02, offset=0.02, damper=800.0, t_end=2.0))
+    sim.advance_to(2.0)
+    t = np.array([r["t"] for r in sim.body_history])
+    zb = np.array([r["box_z"] for r in sim.body_history]) - 0.1
+    draft = box_draft(sim, z_bottom=zb)[t > 1.5].mean()
+    assert draft == pytest.approx(archimedes_draft(500.0, 0.2), rel=0.01)

@@ -1,6 +1,7 @@
 """Rigid-body test problems (issue 14): scene builders and their analytic references.
 
     floating_box_scene(dp, ...)    a 2D box of density rho_b floating in a tank (heave, Archimedes)
+    box_draft(sim)                 its draft below the level the closed tank's water has now
     hinged_flap_scene(dp, ...)     a bottom-hinged flap in still water (at rest), or in air with a
                                    torsion spring (period of the hinge dynamics)
     zero_gravity(sim)              the same run without gravity (momentum check)
@@ -45,6 +46,23 @@ def floating_box_scene(dp: float = 0.02, breadth: float = 0.4, height: float = 0
 def archimedes_draft(density: float, height: float, rho0: float = 1000.0) -> float:
     """Equilibrium draft [m] of a floating box: its weight equals the displaced water's."""
     return density * height / rho0
+
+
+def box_draft(sim, name: str = "box", z_bottom=None):
+    """Draft [m] of a floating box in a closed tank, below the still-water level the fluid has
+    now: the fluid area (n_fluid dp^2, the lattice volume) plus the box's submerged part fill the
+    tank's length L up to eta, so eta (L - B) = A_fluid - B z_bottom. (The box displaces water
+    in the closed tank: the nominal still-water level is no longer the level.) ``z_bottom``:
+    the box bottom(s) [m] to evaluate at (default: the current one)."""
+    scene = sim.scene
+    body = next(b for b in scene.bodies if b.name == name)
+    k = sim.bodies.names.index(name)
+    breadth, height = body.x1 - body.x0, body.z1 - body.z0
+    if z_bottom is None:
+        z_bottom = float(sim.bodies.state.q[k, 1]) - 0.5 * height
+    length = scene.tank.x1 - scene.tank.x0
+    eta = (sim.n_fluid * scene.dp ** 2 - breadth * z_bottom) / (length - breadth)
+    return eta - z_bottom
 
 
 def hinged_flap_scene(dp: float = 0.02, thickness: float = 0.04, height: float = 0.4,
