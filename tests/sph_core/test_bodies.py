@@ -149,3 +149,15 @@ def test_floating_box_settles_at_the_archimedes_draft() -> None:
     zb = np.array([r["box_z"] for r in sim.body_history]) - 0.1
     draft = box_draft(sim, z_bottom=zb)[t > 1.5].mean()
     assert draft == pytest.approx(archimedes_draft(500.0, 0.2), rel=0.01)
+
+
+def test_example_scene_with_a_box_and_a_flap_runs() -> None:
+    from pathlib import Path
+
+    from sph_core.scene import load_scene
+
+    path = Path(__file__).resolve().parents[2] / "examples" / "scenes" / "floating_box_and_flap.toml"
+    sim = Simulation(load_scene(path))
+    assert sim.bodies.names == ["box", "flap"]
+    sim.advance_to(0.05)
+    assert np.all(np.isfinite(sim.bodies.state.q)) and sim.body_history[-1]["box_fz"] > 0
