@@ -18,16 +18,20 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
+import sys
 import time
+from pathlib import Path
 
 import numpy as np
 
-from cases.rigid_bodies import (archimedes_draft, box_draft, floating_box_scene, hinged_flap_scene,
-                                spring_flap_period, zero_crossing_period, zero_gravity)
-from sph_core.particles import FLUID, M, VX, VZ
-from sph_core.scene import make_scene
-from sph_core.simulation import Simulation
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from cases.rigid_bodies import (archimedes_draft, box_draft, floating_box_scene,  # noqa: E402
+                                hinged_flap_scene, spring_flap_period, zero_crossing_period,
+                                zero_gravity)
+from sph_core.particles import FLUID, M, VX, VZ  # noqa: E402
+from sph_core.scene import make_scene  # noqa: E402
+from sph_core.simulation import Simulation  # noqa: E402
 
 DENSITY, HEIGHT, BREADTH, DEPTH = 500.0, 0.2, 0.4, 0.3   # the floating box of the checks
 

@@ -136,7 +136,7 @@ def _prescribed(bd, b, t):
 @njit(cache=True)
 def _set_prescribed(bd, b, t_pos, t_vel):
     d, v = _prescribed(bd, b, t_pos)
-    d2, v2 = _prescribed(bd, b, t_vel)
+    _, v2 = _prescribed(bd, b, t_vel)
     for c in range(3):
         bd.q[b, c] = bd.q0[b, c] + d[c]
         bd.qd[b, c] = v2[c]
