@@ -158,7 +158,7 @@ def momentum(dp: float) -> dict:
                  time.perf_counter() - tic, dp=dp, unit="|dP| / |P_body(0)| after 300 steps")
 
 
-def throughput(dp: float, steps: int) -> list[dict]:
+def flume_throughput(dp: float, steps: int) -> list[dict]:
     """Particle-steps/s of the demo flume (closed, still water) without and with a floating box."""
     from cases.demo_flume import demo_scene, depth_for
 
@@ -200,7 +200,7 @@ def main() -> None:
         if c in runners:
             print(json.dumps(runners[c](a.dp)), flush=True)
         elif c == "throughput":
-            for line in throughput(a.dp, a.steps):
+            for line in flume_throughput(a.dp, a.steps):
                 print(json.dumps(line), flush=True)
         else:
             print(json.dumps({"check": c, "value": None, "reference": None, "rel_error": None,

@@ -208,6 +208,26 @@ def bodies_correct(bd, t, dt):
             _set_prescribed(bd, b, t + dt, t + dt)
 
 
+@njit(cache=True)
+def bodies_v2max(bd):
+    """Largest squared body-particle speed |V + omega x r|^2 (for the time step's CFL bound)."""
+    v2max = 0.0
+    if not bd.active:
+        return v2max
+    for k in range(bd.npart):
+        b = bd.owner[k]
+        th = bd.q[b, 2]
+        om = bd.qd[b, 2]
+        c = math.cos(th)
+        s = math.sin(th)
+        rx = c * bd.rx[k] - s * bd.rz[k]
+        rz = s * bd.rx[k] + c * bd.rz[k]
+        u = bd.qd[b, 0] - om * rz
+        w = bd.qd[b, 1] + om * rx
+        v2max = max(v2max, u * u + w * w)
+    return v2max
+
+
 @njit(parallel=True, cache=True)
 def place_bodies(ps, n, bd):
     """Position, velocity (V + omega x r) and acceleration of every body particle from q, qd, acc."""

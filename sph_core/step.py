@@ -4,9 +4,10 @@
                                                           integrator, n, t, dt, t_stop, max_steps)
 
 State lives in the typed containers of ``state.py`` (Particles ``ps`` and its twin ``ps2``,
-Cells, Params, OpenEnds) and ``bodies.Bodies`` ``bd`` (rigid bodies; inactive without any); ``swapped`` = 1 means the current state is in the twin (the caller
-swaps its references), ``n`` the slots in use after the call (a sort drops inactive slots, open
-ends append).
+Cells, Params, OpenEnds) and of ``bodies.py`` (Bodies ``bd``: rigid bodies, inactive without
+any); ``swapped`` = 1 means the current state is in the twin (the caller swaps its
+references), ``n`` the slots in use after the call (a sort drops inactive slots, open ends
+append).
 
 One step, as the two integrators order the same stages (wcsph.py has the equations):
 
@@ -54,9 +55,9 @@ import math
 
 from numba import njit
 
+from .bodies import (bodies_correct, bodies_kick, bodies_kick_drift, bodies_predict,
+                     bodies_v2max, body_loads, place_bodies)
 from .neighbours import sort_by_cell
-from .bodies import (bodies_correct, bodies_kick, bodies_kick_drift, bodies_predict, body_loads,
-                     place_bodies)
 from .open_boundary import extrapolate_buffers, measure_boundaries, update_buffers
 from .particles import N_SORTED_KDK, N_SORTED_PC
 from .wcsph import (KDK, ST_CAPACITY, ST_DENSITY, ST_LEFT_DOMAIN, ST_NONFINITE, ST_REACHED_T,
@@ -83,7 +84,7 @@ def initialise(ps, ps2, cells, prm, ends, bd, n):
     _forces(ps2, n, cells, prm, bd)
     n_bad, n_band, v2max, a2max, rmax = kdk_kick(ps2, n, 0.0, prm)
     measure_boundaries(ps2, cells, ends, prm)
-    return stable_dt(v2max, a2max, rmax, prm), n
+    return stable_dt(max(v2max, bodies_v2max(bd)), a2max, rmax, prm), n
 
 
 @njit(cache=True)
@@ -174,7 +175,7 @@ def run(ps, ps2, cells, prm, ends, bd, integrator, n, t, dt, t_stop, max_steps):
             swapped = 1 - swapped
             t = t_stop if last else t + dts
             steps += 1
-            v2max = v2
+            v2max = max(v2, bodies_v2max(bd))   # a fast body bounds dt as fluid does
         if status != ST_REACHED_T:
             break
         dt = stable_dt(v2max, a2max, rmax, prm)
