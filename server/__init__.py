@@ -14,6 +14,7 @@ HTTP (OpenAPI docs at /docs):
                                     coupling_overhead_share, stability, last_gauges, scene_hash
     GET    /runs/{id}/scene         canonical scene bytes (protocol scene hash = their SHA-256)
     GET    /runs/{id}/gauges        ?format=csv|json
+    GET    /runs/{id}/bodies        ?format=csv|json (rigid bodies of the scene; 404 without)
     GET    /runs/{id}/events        Server-Sent Events, one `progress` event per change
     DELETE /runs/{id}               cancel (data so far kept)
     POST   /runs/{id}/resume        a failed/cancelled coupled run continues from its saved state

@@ -53,6 +53,7 @@ class Checkpoint:
     cell: np.ndarray | None = None        # cell lists of the copy (set by the Simulation), so a
     cell_start: np.ndarray | None = None  # restore needs no re-sort and continues bit for bit
     open_state: Any = None                # open_ends.OpenState of a run with open ends
+    body_state: Any = None                # bodies.BodySet state (q, qd, acc, load) of a run with bodies
 
 
 class ParticleSet:

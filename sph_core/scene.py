@@ -71,6 +71,76 @@ class Structure(Rect):
     """A fixed rectangular structure: a shell of dummy particles one kernel support thick."""
 
 
+class Body(_Model):
+    """A rigid body of boundary particles (issue 14; physics in ``sph_core.bodies``).
+
+    Shape (scene coordinates at t_start): ``box`` and ``flap`` by their corners x0, x1, z0, z1
+    (a flap is a box hinged by default at the centre of its bottom edge); ``wedge`` by its
+    ``apex`` (x, z), top ``breadth`` and ``deadrise_deg`` (apex down); ``polygon`` by ``points``.
+    Mass per metre of span: ``mass`` [kg/m] or ``density`` [kg/m^3] (times the shape's area);
+    ``inertia`` [kg m^2/m] about the centre of mass (default: the uniform shape's).
+
+    Motion: ``fixed``; ``prescribed`` (``series`` rows (t, dx, dz, dtheta): displacement from
+    the initial position, linear in time between rows, held after the last); ``free`` in the
+    ``dofs`` named (surge x, heave z, pitch theta; theta counter-clockwise with x right, z up);
+    ``hinged`` about ``pivot``. ``spring`` / ``damper``: per DOF (surge, heave, pitch) for a
+    free body [N/m, N s/m, N m/rad, N m s/rad], one value (pitch) for a hinged one; springs pull
+    towards the initial position. ``velocity`` (u, w, omega): initial velocity of a free or
+    hinged body (only omega counts for a hinged one)."""
+
+    name: str = Field(min_length=1)
+    shape: Literal["box", "wedge", "flap", "polygon"]
+    x0: float | None = None
+    x1: float | None = None
+    z0: float | None = None
+    z1: float | None = None
+    apex: tuple[float, float] | None = None
+    breadth: float | None = Field(None, gt=0)
+    deadrise_deg: float | None = Field(None, gt=0, lt=90)
+    points: list[tuple[float, float]] | None = None
+    mass: float | None = Field(None, gt=0)
+    density: float | None = Field(None, gt=0)
+    inertia: float | None = Field(None, gt=0)
+    com: tuple[float, float] | None = None
+    motion: Literal["fixed", "prescribed", "free", "hinged"] = "free"
+    dofs: list[Literal["surge", "heave", "pitch"]] = ["surge", "heave", "pitch"]
+    pivot: tuple[float, float] | None = None
+    spring: float | tuple[float, float, float] = 0.0
+    damper: float | tuple[float, float, float] = 0.0
+    velocity: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    series: list[tuple[float, float, float, float]] = []
+
+    @model_validator(mode="after")
+    def _complete(self) -> "Body":
+        if self.shape in ("box", "flap"):
+            if None in (self.x0, self.x1, self.z0, self.z1):
+                raise ValueError(f"x0: a {self.shape} needs x0, x1, z0, z1")
+            if not (self.x1 > self.x0 and self.z1 > self.z0):
+                raise ValueError("x1: must exceed x0, and z1 z0")
+        elif self.shape == "wedge":
+            if self.apex is None or self.breadth is None or self.deadrise_deg is None:
+                raise ValueError("apex: a wedge needs apex, breadth and deadrise_deg")
+        elif self.points is None or len(self.points) < 3:
+            raise ValueError("points: a polygon needs at least 3 points")
+        if (self.mass is None) == (self.density is None) and self.motion in ("free", "hinged"):
+            raise ValueError("mass: give exactly one of mass and density")
+        if self.motion == "hinged" and self.pivot is None and self.shape != "flap":
+            raise ValueError("pivot: a hinged body other than a flap needs a pivot")
+        if self.motion == "prescribed" and len(self.series) < 2:
+            raise ValueError("series: a prescribed motion needs at least 2 rows (t, dx, dz, dtheta)")
+        ts = [r[0] for r in self.series]
+        if any(b <= a for a, b in zip(ts, ts[1:])):
+            raise ValueError("series: t must increase strictly")
+        for name in ("spring", "damper"):
+            v = getattr(self, name)
+            if self.motion == "hinged" and not isinstance(v, (int, float)):
+                raise ValueError(f"{name}: one value (pitch) for a hinged body")
+            vals = (v,) if isinstance(v, (int, float)) else v
+            if any(x < 0 for x in vals):
+                raise ValueError(f"{name}: must be >= 0")
+        return self
+
+
 class Constants(_Model):
     """Physical and numerical constants (SI)."""
 
@@ -231,6 +301,7 @@ class Scene(_Model):
     output: Output = Output()
     probes: list[Probe] = []
     open_boundaries: list[OpenBoundary] = []
+    bodies: list[Body] = []
 
     @model_validator(mode="after")
     def _consistent(self) -> "Scene":
@@ -254,6 +325,9 @@ class Scene(_Model):
             x = getattr(p, "x", None)
             if x is not None and not (t.x0 <= x <= t.x1):
                 raise ValueError(f"probes.{i}.x: must lie inside the tank [{t.x0}, {t.x1}]")
+        bnames = [b.name for b in self.bodies]
+        if len(set(bnames)) != len(bnames):
+            raise ValueError(f"bodies: duplicate names {bnames}")
         if self.output.snapshot_every and self.output.snapshot_every > self.t_end - self.t_start:
             raise ValueError("output.snapshot_every: must not exceed the run's length t_end - t_start")
         return self

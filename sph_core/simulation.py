@@ -25,6 +25,7 @@ import numba
 import numpy as np
 
 from . import step, wcsph
+from .bodies import BodyLog, BodySet
 from .boundary_data import BoundaryData, BoundaryDataError, BoundarySample
 from .eos import hydrostatic_density, tait_b
 from .geometry import build_layout
@@ -74,7 +75,13 @@ class Simulation:
         self.open = OpenBoundaries.from_scene(scene, sources, window)
         if spare is None:
             spare = 0.3 if self.open.active else 0.1
-        n = layout.wall_x.size + layout.fluid_x.size
+        # rigid bodies (issue 14): their particles replace the fluid inside them
+        self.bodies = BodySet(scene, layout.n_layers * dp)
+        if self.bodies.active:
+            keep = self.bodies.fluid_outside(layout.fluid_x, layout.fluid_z, dp)
+            layout.fluid_x, layout.fluid_z = layout.fluid_x[keep], layout.fluid_z[keep]
+            layout.fluid_surface = layout.fluid_surface[keep]
+        n = layout.wall_x.size + layout.fluid_x.size + self.bodies.x.size
         self.particles = ps = ParticleSet(max(int(n * (1.0 + spare)), n + 1))
         vol = dp * dp
         ps.add(layout.wall_x, layout.wall_z, WALL, np.full(layout.wall_x.size, c.rho0),
@@ -83,6 +90,7 @@ class Simulation:
         # mass = rho * dp^2: the lattice is the compressed hydrostatic state, so the initial
         # pressure is hydrostatic and the particle volume is exactly dp^2
         ps.add(layout.fluid_x, layout.fluid_z, FLUID, rho_f, rho_f * vol)
+        self.bodies.attach(ps, c.rho0, dp)
         self.n_layers = layout.n_layers
         self.open.attach(ps, scene, self.b, layout.n_layers * dp)
         t = scene.tank
@@ -103,7 +111,8 @@ class Simulation:
         self.integrator = wcsph.INTEGRATORS[c.integrator]
         self.passes_per_step = wcsph.PASSES_PER_STEP[c.integrator]
         self._counts = np.zeros(ps.capacity, dtype=np.int64)
-        dt, n_new = step.initialise(ps.view, ps.view2, self.cells, self.prm, self.open.ends, ps.n)
+        dt, n_new = step.initialise(ps.view, ps.view2, self.cells, self.prm, self.open.ends,
+                                   self.bodies.state, ps.n)
         self.dt = float(dt)
         ps.swap()
         ps.n = int(n_new)
@@ -127,6 +136,7 @@ class Simulation:
         self._line_z = t.z0 + (np.arange(nz) + 0.5) * 0.5 * dp
         self._line_rho = np.zeros(self._line_z.size)
         self.history: list[dict[str, float | None]] = []
+        self.body_history: list[dict[str, float]] = []  # on the probe cadence (bodies.csv)
         self._k_probe = 0
         self._k_snap = 0
         self.status = "created"
@@ -134,6 +144,9 @@ class Simulation:
         if run_dir is not None:
             self.writer = RunWriter(run_dir, self.probe_columns(), scene.model_dump(mode="json"))
             self.writer.update_meta(**self._meta_fields())
+            if self.bodies.active:
+                self.bodies.log = BodyLog(run_dir, self.bodies.columns())
+                self.writer.update_meta(bodies=self.bodies.properties)
         self._record_outputs()
 
     # ---------------------------------------------------------------- state access
@@ -240,6 +253,11 @@ class Simulation:
             self.history.append({"t": self.t, **values})
             if self.writer:
                 self.writer.probe_row(self.t, self.steps, values)
+            if self.bodies.active:
+                rows = self.bodies.rows()
+                self.body_history.append({"t": self.t, **rows})
+                if self.bodies.log:
+                    self.bodies.log.row(self.t, self.steps, rows)
             self._k_probe = int(math.floor(self.t / o.probe_every + 1e-6)) + 1
         if self.writer and o.snapshot_every > 0 and self.t >= self._k_snap * o.snapshot_every - eps:
             self.write_snapshot()
@@ -258,6 +276,7 @@ class Simulation:
         fld["velocity"] = (fld["vx"], np.zeros_like(fld["vx"]), fld["vz"])  # a vector for glyphs
         fld["mass"] = ps.field(M)[sel]
         fld["h"] = np.full(fld["mass"].size, self.h)
+        fld["body"] = self.bodies.particle_body(fld["id"])  # -1: not a body particle
         self.writer.snapshot(self.t, ps.field(X)[sel], ps.field(Z)[sel], fld)
 
     def _next_output_time(self, t_target: float) -> float:
@@ -345,8 +364,8 @@ class Simulation:
         ends.next_id[0] = ps.next_id
         tic = time.perf_counter()
         t, dt, steps, status, swapped, n_flag, vmax, n = step.run(
-            ps.view, ps.view2, self.cells, self.prm, ends, self.integrator, ps.n, self.t, self.dt,
-            t_stop, max_steps)
+            ps.view, ps.view2, self.cells, self.prm, ends, self.bodies.state, self.integrator, ps.n,
+            self.t, self.dt, t_stop, max_steps)
         self.wall_time += time.perf_counter() - tic
         if swapped:
             ps.swap()
@@ -434,6 +453,7 @@ class Simulation:
         c.cell = self.particles.cell[: c.n].copy()
         c.cell_start = self.cells.start.copy()
         c.open_state = self.open.state()
+        c.body_state = self.bodies.get_state()
         return c
 
     def restore(self, c: Checkpoint) -> None:
@@ -450,6 +470,7 @@ class Simulation:
             self._rebuild_cells()
         self.open.set_state(c.open_state)
         self.loads.reset_sides()
+        self.bodies.set_state(c.body_state)
         self.status = "paused"
         o = self.scene.output
         self._k_probe = int(math.floor(self.t / o.probe_every + 1e-9)) + 1 if o.probe_every else 0
@@ -469,3 +490,5 @@ class Simulation:
         if self.writer:
             self.writer.update_meta(**self._meta_fields())
             self.writer.close()
+        if self.bodies.log:
+            self.bodies.log.close()

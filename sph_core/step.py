@@ -1,12 +1,13 @@
 """The one jitted time loop: every scene, every integrator, with or without open ends.
 
-    t, dt, steps, status, swapped, n_flag, v_max, n = run(ps, ps2, cells, prm, ends, integrator,
-                                                          n, t, dt, t_stop, max_steps)
+    t, dt, steps, status, swapped, n_flag, v_max, n = run(ps, ps2, cells, prm, ends, bd,
+                                                          integrator, n, t, dt, t_stop, max_steps)
 
 State lives in the typed containers of ``state.py`` (Particles ``ps`` and its twin ``ps2``,
-Cells, Params, OpenEnds); ``swapped`` = 1 means the current state is in the twin (the caller
-swaps its references), ``n`` the slots in use after the call (a sort drops inactive slots, open
-ends append).
+Cells, Params, OpenEnds) and of ``bodies.py`` (Bodies ``bd``: rigid bodies, inactive without
+any); ``swapped`` = 1 means the current state is in the twin (the caller swaps its
+references), ``n`` the slots in use after the call (a sort drops inactive slots, open ends
+append).
 
 One step, as the two integrators order the same stages (wcsph.py has the equations):
 
@@ -22,7 +23,11 @@ One step, as the two integrators order the same stages (wcsph.py has the equatio
                                              update_buffers                [D]
 
 [F] forces = ``wall_pass`` (Adami wall state) then ``fluid_pass`` (continuity, delta-SPH,
-pressure, viscosity, gravity): ``_forces`` below. The open-end hooks ([D] after the drift:
+pressure, viscosity, gravity) then ``body_loads`` (fluid loads on the rigid bodies, their
+accelerations): ``_forces`` below. Bodies follow the fluid's stages: kdk half-kick + drift with
+the fluid's, half-kick after the fluid's; symplectic predictor / corrector likewise; each stage
+then places the body particles (``place_bodies``: x, v = V + omega x r, a). Without bodies every
+body hook returns at once. The open-end hooks ([D] after the drift:
 buffers imposed and moved, crossings; [S'] after the sort: ghost-node pressure; [G] after the
 forces: boundary gauges) return at once when ``ends.active`` is False, so a closed tank runs the
 same code. Buffer particles are not FLUID: the integrators never move them; update_buffers does,
@@ -50,6 +55,8 @@ import math
 
 from numba import njit
 
+from .bodies import (bodies_correct, bodies_kick, bodies_kick_drift, bodies_predict,
+                     bodies_v2max, body_loads, place_bodies)
 from .neighbours import sort_by_cell
 from .open_boundary import extrapolate_buffers, measure_boundaries, update_buffers
 from .particles import N_SORTED_KDK, N_SORTED_PC
@@ -59,52 +66,62 @@ from .wcsph import (KDK, ST_CAPACITY, ST_DENSITY, ST_LEFT_DOMAIN, ST_NONFINITE, 
 
 
 @njit(cache=True)
-def _forces(ps, n, cells, prm):
-    """Rates of every fluid particle (ax, az, drho) at the current, sorted state."""
+def _forces(ps, n, cells, prm, bd):
+    """Rates of every fluid particle (ax, az, drho) and body (acc) at the current, sorted state."""
     wall_pass(ps, n, cells, prm)
     fluid_pass(ps, n, cells, prm)
+    body_loads(ps, n, cells, prm, bd)
 
 
 @njit(cache=True)
-def initialise(ps, ps2, cells, prm, ends, n):
+def initialise(ps, ps2, cells, prm, ends, bd, n):
     """Sort, evaluate rates at the initial state, measure the boundary gauges; returns (dt, n).
     The sorted state ends in ``ps2`` (the caller swaps)."""
     update_pressure(ps, n, prm)
+    place_bodies(ps, n, bd)
     n = sort_by_cell(ps, ps2, N_SORTED_PC, n, cells)
     extrapolate_buffers(ps2, n, cells, ends, prm)
-    _forces(ps2, n, cells, prm)
+    _forces(ps2, n, cells, prm, bd)
     n_bad, n_band, v2max, a2max, rmax = kdk_kick(ps2, n, 0.0, prm)
     measure_boundaries(ps2, cells, ends, prm)
-    return stable_dt(v2max, a2max, rmax, prm), n
+    return stable_dt(max(v2max, bodies_v2max(bd)), a2max, rmax, prm), n
 
 
 @njit(cache=True)
-def _step_kdk(ps, ps2, cells, prm, ends, n, t, dt):
+def _step_kdk(ps, ps2, cells, prm, ends, bd, n, t, dt):
     """One leapfrog step; the state ends in ps2. Returns (n, status, n_flag, v2max, a2max, rmax)."""
     # a particle that left the tank box finishes the step like the others (the sort clamps it
     # to the grid); the verdict then reports it and the Simulation excludes it
     n_out = kdk_kick_drift(ps, n, dt, prm)
+    bodies_kick_drift(bd, t, dt)
+    place_bodies(ps, n, bd)
     n_new = update_buffers(ps, n, t + dt, dt, ends, prm)
     if n_new < 0:
         return n, ST_CAPACITY, n, 0.0, 0.0, 0.0, False
     n = sort_by_cell(ps, ps2, N_SORTED_KDK, n_new, cells)
     extrapolate_buffers(ps2, n, cells, ends, prm)
-    _forces(ps2, n, cells, prm)
+    _forces(ps2, n, cells, prm, bd)
     n_bad, n_band, v2max, a2max, rmax = kdk_kick(ps2, n, dt, prm)
+    bodies_kick(bd, t, dt)
+    place_bodies(ps2, n, bd)
     measure_boundaries(ps2, cells, ends, prm)
     return _verdict(n, n_bad, n_band, n_out, v2max, a2max, rmax)
 
 
 @njit(cache=True)
-def _step_pc(ps, ps2, cells, prm, ends, n, t, dt):
+def _step_pc(ps, ps2, cells, prm, ends, bd, n, t, dt):
     """One symplectic predictor-corrector step; the state ends in ps2. Same returns as _step_kdk."""
     n = sort_by_cell(ps, ps2, N_SORTED_PC, n, cells)
     extrapolate_buffers(ps2, n, cells, ends, prm)
-    _forces(ps2, n, cells, prm)
+    _forces(ps2, n, cells, prm, bd)
     measure_boundaries(ps2, cells, ends, prm)
     pc_predict(ps2, n, dt, prm)
-    _forces(ps2, n, cells, prm)
+    bodies_predict(bd, t, dt)
+    place_bodies(ps2, n, bd)
+    _forces(ps2, n, cells, prm, bd)
     n_bad, n_band, n_out, v2max, a2max, rmax = pc_correct(ps2, n, dt, prm)
+    bodies_correct(bd, t, dt)
+    place_bodies(ps2, n, bd)
     if n_bad == 0 and n_out == 0:
         n_new = update_buffers(ps2, n, t + dt, dt, ends, prm)
         if n_new < 0:
@@ -126,7 +143,7 @@ def _verdict(n, n_bad, n_band, n_out, v2max, a2max, rmax):
 
 
 @njit(cache=True)
-def run(ps, ps2, cells, prm, ends, integrator, n, t, dt, t_stop, max_steps):
+def run(ps, ps2, cells, prm, ends, bd, integrator, n, t, dt, t_stop, max_steps):
     """Run steps until t reaches t_stop or max_steps were taken, or a guard trips.
 
     Returns (t, dt_next, steps, status, swapped, n_flagged, v_max, n)."""
@@ -148,17 +165,17 @@ def run(ps, ps2, cells, prm, ends, integrator, n, t, dt, t_stop, max_steps):
             dts = t_stop - t
             last = True
         if integrator == KDK:
-            n, status, n_flag, v2, a2max, rmax, done = _step_kdk(ps, ps2, cells, prm, ends, n, t,
-                                                                  dts)
+            n, status, n_flag, v2, a2max, rmax, done = _step_kdk(ps, ps2, cells, prm, ends, bd, n,
+                                                                  t, dts)
         else:
-            n, status, n_flag, v2, a2max, rmax, done = _step_pc(ps, ps2, cells, prm, ends, n, t,
-                                                                 dts)
+            n, status, n_flag, v2, a2max, rmax, done = _step_pc(ps, ps2, cells, prm, ends, bd, n,
+                                                                 t, dts)
         if done:  # the step got to its sort: the state is in the twin
             ps, ps2 = ps2, ps
             swapped = 1 - swapped
             t = t_stop if last else t + dts
             steps += 1
-            v2max = v2
+            v2max = max(v2, bodies_v2max(bd))   # a fast body bounds dt as fluid does
         if status != ST_REACHED_T:
             break
         dt = stable_dt(v2max, a2max, rmax, prm)

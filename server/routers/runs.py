@@ -105,6 +105,20 @@ async def get_gauges(run: RunDep, format: Literal["csv", "json"] = Query("csv"))
     return Response(json.dumps({"columns": columns, "rows": rows}), media_type="application/json")
 
 
+@router.get("/{run_id}/bodies", responses=NOT_FOUND)
+async def get_bodies(run: RunDep, format: Literal["csv", "json"] = Query("csv")) -> Response:
+    """Rigid-body series (sph_core bodies.csv: per body x, z, theta, u, w, omega, fx, fz, my) as
+    CSV or JSON; 404 if the scene has no bodies. A coupled run restarted into sph.<k>/ serves the
+    newest."""
+    paths = sorted(run.dir.glob("sph*/bodies.csv"), key=lambda p: p.stat().st_mtime)
+    if not paths:
+        raise HTTPException(404, f"run {run.info.id} has no body data")
+    if format == "csv":
+        return FileResponse(paths[-1], media_type="text/csv", filename=f"{run.info.id}-bodies.csv")
+    columns, rows = await asyncio.to_thread(read_gauges, paths[-1])
+    return Response(json.dumps({"columns": columns, "rows": rows}), media_type="application/json")
+
+
 @router.delete("/{run_id}", response_model=RunInfo, responses=NOT_FOUND)
 async def cancel_run(run: RunDep, manager: Manager) -> RunInfo:
     """Cancel a queued, waiting or running run; its data so far stays on disk."""

@@ -1,0 +1,211 @@
+"""Rigid bodies in the SPH zone (issue 14): physics checks and the cost of a body.
+
+Questions: does a floating box settle at its Archimedes draft; at what period does it heave and
+how fast does that decay; does a hinged flap stay at rest in still water; does a spring flap
+oscillate at its analytic period; is fluid + body momentum conserved; and how much does a body
+slow the flume scene (goal: <= 10 % fewer particle-steps/s)?
+
+Output: one JSON object per line, each with check, value, reference, rel_error, wall_s (and
+status "not_run" for the checks not run: wedge_pressure (Zhao et al. 1996 drop test), flap_pitch
+(flap in regular waves)).
+
+    python bench/bodies.py [--dp 0.02] [--checks archimedes_draft heave_period ...]
+
+Wall times are single-run, this machine's load at the time (label them so in reports).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from cases.rigid_bodies import (archimedes_draft, box_draft, floating_box_scene,  # noqa: E402
+                                hinged_flap_scene, spring_flap_period, zero_crossing_period,
+                                zero_gravity)
+from sph_core.particles import FLUID, M, VX, VZ  # noqa: E402
+from sph_core.scene import make_scene  # noqa: E402
+from sph_core.simulation import Simulation  # noqa: E402
+
+DENSITY, HEIGHT, BREADTH, DEPTH = 500.0, 0.2, 0.4, 0.3   # the floating box of the checks
+
+
+def _line(check: str, value, reference, wall: float, **extra) -> dict:
+    rel = (abs(value - reference) / abs(reference)
+           if value is not None and reference not in (None, 0) else None)
+    return {"check": check, "value": value, "reference": reference, "rel_error": rel,
+            "wall_s": round(wall, 2), **extra}
+
+
+def _series(sim: Simulation, key: str) -> tuple[np.ndarray, np.ndarray]:
+    return (np.array([r["t"] for r in sim.body_history]),
+            np.array([r[key] for r in sim.body_history]))
+
+
+def archimedes(dp: float) -> dict:
+    """Box released 0.02 m (20 % of its draft) too deep, heave only, with a heave damper (zero at
+    rest: the equilibrium is unchanged) so it settles in ~1 s; draft = mean of the last 0.5 s."""
+    t_end = 2.0
+    sim = Simulation(floating_box_scene(dp=dp, breadth=BREADTH, height=HEIGHT, density=DENSITY,
+                                        depth=DEPTH, offset=0.02, damper=800.0, t_end=t_end))
+    tic = time.perf_counter()
+    sim.advance_to(t_end)
+    t, zc = _series(sim, "box_z")
+    # the draft below the level the water has (the box displaces water in the closed tank):
+    draft = box_draft(sim, z_bottom=zc - 0.5 * HEIGHT)
+    last = t > t_end - 0.5
+    return _line("archimedes_draft", float(draft[last].mean()), archimedes_draft(DENSITY, HEIGHT),
+                 time.perf_counter() - tic, dp=dp, draft_std_last=float(draft[last].std()),
+                 unit="m")
+
+
+def _crossings(t: np.ndarray, y: np.ndarray) -> np.ndarray:
+    k = np.nonzero(np.sign(y[:-1]) != np.sign(y[1:]))[0]
+    return t[k] - y[k] * (t[k + 1] - t[k]) / (y[k + 1] - y[k])
+
+
+def heave(dp: float) -> dict:
+    """Undamped release 0.02 m too deep in a 3.2 m closed tank, heave only, against linear
+    potential flow for the same tank and release (cases/heave_potential.py, converged: dx 0.01
+    and 0.005 m give the same crossings within 0.3 %). Heave Z from the equilibrium position;
+    the period measure is twice the time between its first two zero crossings (the motion is
+    a heave mode coupled with the tank's sloshing, the same measure on both); the decay is the
+    ratio of the first two half-cycle peaks, for both."""
+    from cases.heave_potential import heave_release
+
+    t_end, length = 1.2, 3.2
+    d = archimedes_draft(DENSITY, HEIGHT)
+    sim = Simulation(floating_box_scene(dp=dp, breadth=BREADTH, height=HEIGHT, density=DENSITY,
+                                        depth=DEPTH, offset=0.02, tank_length=length, t_end=t_end,
+                                        probe_every=0.005))
+    tic = time.perf_counter()
+    sim.advance_to(t_end)
+    wall = time.perf_counter() - tic
+    t, zc = _series(sim, "box_z")
+    zb = zc - 0.5 * HEIGHT
+    # equilibrium bottom: the level the water has then, minus the draft
+    area = sim.n_fluid * dp * dp
+    zb_eq = (area + BREADTH * d) / length - d
+    z_sph = zb - zb_eq
+    tl, z_lin = heave_release(length, DEPTH, BREADTH, d, DENSITY * BREADTH * HEIGHT,
+                              float(z_sph[0]), t_end, dx=0.01)
+    cs, cl = _crossings(t, z_sph), _crossings(tl, z_lin)
+
+    def peaks(tt, zz, c):
+        return [float(np.max(np.abs(zz[(tt >= a) & (tt <= b)]))) for a, b in zip(c[:-1], c[1:])]
+
+    ps, pl = peaks(t, z_sph, cs), peaks(tl, z_lin, cl)
+    period = 2.0 * float(cs[1] - cs[0]) if cs.size > 1 else None
+    ref = 2.0 * float(cl[1] - cl[0])
+    return _line("heave_period", period, ref, wall, dp=dp, tank_length=length,
+                 first_crossing=float(cs[0]), first_crossing_linear=float(cl[0]),
+                 peak_ratio=(ps[0] / abs(z_sph[0]) if ps else None),
+                 peak_ratio_linear=pl[0] / abs(z_lin[0]),
+                 added_mass_inf_linear=heave_release.last["a_inf"], unit="s",
+                 note="draft = 5 dp; later half-cycles are below dp/4 (SPH noise level)")
+
+
+def flap_still(dp: float) -> dict:
+    t_end = 1.0
+    sim = Simulation(hinged_flap_scene(dp=dp, t_end=t_end))
+    tic = time.perf_counter()
+    sim.advance_to(t_end)
+    _, th = _series(sim, "flap_theta")
+    return _line("flap_still", float(np.max(np.abs(th))), 0.0, time.perf_counter() - tic, dp=dp,
+                 unit="rad (max |theta| over 1 s)")
+
+
+def spring_flap(dp: float) -> dict:
+    """In air (the water is a pool held away from the flap): hinge inertia, gravity, spring."""
+    k = 40.0
+    ref = spring_flap_period(0.04, 0.4, 500.0, k)
+    sim = Simulation(hinged_flap_scene(dp=dp, spring=k, omega0=0.05, in_water=False,
+                                       t_end=3.2 * ref, probe_every=ref / 100))
+    tic = time.perf_counter()
+    sim.advance_to(sim.scene.t_end)
+    t, th = _series(sim, "flap_theta")
+    return _line("spring_flap_period", zero_crossing_period(t, th), ref,
+                 time.perf_counter() - tic, dp=dp, medium="air (no water on the flap)", unit="s")
+
+
+def momentum(dp: float) -> dict:
+    scene = make_scene({
+        "dp": dp, "t_end": 1.0, "tank": {"x0": 0, "x1": 1.2, "z0": 0, "z1": 1.2},
+        "water_blocks": [{"x0": 0.3, "x1": 0.9, "z0": 0.3, "z1": 0.9}],
+        "bodies": [{"name": "box", "shape": "box", "x0": 0.52, "x1": 0.68, "z0": 0.52,
+                    "z1": 0.6, "density": 800.0, "velocity": (0.5, -0.3, 1.0)}]})
+    sim = Simulation(scene)
+    zero_gravity(sim)
+
+    def total() -> np.ndarray:
+        ps, bd = sim.particles, sim.bodies.state
+        fl = ps.mask(FLUID)
+        m = ps.field(M)[fl]
+        return np.array([np.sum(m * ps.field(VX)[fl]) + bd.mass[0] * bd.qd[0, 0],
+                         np.sum(m * ps.field(VZ)[fl]) + bd.mass[0] * bd.qd[0, 1]])
+
+    p0 = total()
+    scale = float(np.hypot(*(sim.bodies.state.mass[0] * sim.bodies.state.qd[0, :2])))
+    tic = time.perf_counter()
+    sim.advance_steps(300)
+    return _line("momentum_zero_gravity", float(np.linalg.norm(total() - p0) / scale), 0.0,
+                 time.perf_counter() - tic, dp=dp, unit="|dP| / |P_body(0)| after 300 steps")
+
+
+def flume_throughput(dp: float, steps: int) -> list[dict]:
+    """Particle-steps/s of the demo flume (closed, still water) without and with a floating box."""
+    from cases.demo_flume import demo_scene, depth_for
+
+    base = demo_scene(dp, 10.0)
+    base.pop("open_boundaries")
+    d = depth_for(dp)
+    box = {"name": "box", "shape": "box", "x0": 1.0, "x1": 1.2, "z0": d - 0.04, "z1": d + 0.04,
+           "density": 500.0}
+    out = []
+    for label, bodies in (("without_body", []), ("with_body", [box])):
+        sim = Simulation(make_scene({**base, "bodies": bodies}))
+        sim.advance_steps(20)   # compile + warm-up
+        w0, s0 = sim.wall_time, sim.steps
+        sim.advance_steps(steps)
+        wall = sim.wall_time - w0
+        out.append({"check": "flume_throughput", "variant": label, "dp": dp,
+                    "particles": sim.n_particles, "steps": sim.steps - s0,
+                    "particle_steps_per_s": sim.n_particles * (sim.steps - s0) / wall,
+                    "wall_s": round(wall, 2)})
+    out.append({"check": "flume_throughput_ratio", "value": out[1]["particle_steps_per_s"]
+                / out[0]["particle_steps_per_s"], "reference": 0.9,
+                "note": "with/without body; goal >= 0.9 (under load: noisy)"})
+    return out
+
+
+CHECKS = ("archimedes_draft", "heave_period", "flap_still", "spring_flap_period",
+          "momentum_zero_gravity", "wedge_pressure", "flap_pitch", "throughput")
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--dp", type=float, default=0.02)
+    ap.add_argument("--steps", type=int, default=1000, help="steps per throughput variant")
+    ap.add_argument("--checks", nargs="*", default=list(CHECKS), choices=CHECKS)
+    a = ap.parse_args()
+    runners = {"archimedes_draft": archimedes, "heave_period": heave, "flap_still": flap_still,
+               "spring_flap_period": spring_flap, "momentum_zero_gravity": momentum}
+    for c in a.checks:
+        if c in runners:
+            print(json.dumps(runners[c](a.dp)), flush=True)
+        elif c == "throughput":
+            for line in flume_throughput(a.dp, a.steps):
+                print(json.dumps(line), flush=True)
+        else:
+            print(json.dumps({"check": c, "value": None, "reference": None, "rel_error": None,
+                              "wall_s": 0.0, "status": "not_run"}), flush=True)
+
+
+if __name__ == "__main__":
+    main()

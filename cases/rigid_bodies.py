@@ -1,0 +1,128 @@
+"""Rigid-body test problems (issue 14): scene builders and their analytic references.
+
+    floating_box_scene(dp, ...)    a 2D box of density rho_b floating in a tank (heave, Archimedes)
+    box_draft(sim)                 its draft below the level the closed tank's water has now
+    hinged_flap_scene(dp, ...)     a bottom-hinged flap in still water (at rest), or in air with a
+                                   torsion spring (period of the hinge dynamics)
+    zero_gravity(sim)              the same run without gravity (momentum check)
+
+References (per metre of span, still-water level ``swl``, bed z = 0):
+    Archimedes draft  d = rho_b H / rho0 for a box of height H (its weight = the displaced water)
+    spring flap (no water) T = 2 pi sqrt(I_p / (k - m g h_c)), I_p about the hinge, h_c the height
+                      of its centre of mass above the hinge (gravity destabilises an upright flap)
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from sph_core.scene import Scene, make_scene
+
+
+def floating_box_scene(dp: float = 0.02, breadth: float = 0.4, height: float = 0.2,
+                       density: float = 500.0, offset: float = 0.0, depth: float = 0.3,
+                       tank_length: float = 1.6, damper: float = 0.0,
+                       dofs: tuple[str, ...] = ("heave",), t_end: float = 1.0,
+                       integrator: str = "kdk", probe_every: float = 0.01) -> Scene:
+    """A box (breadth x height) of density ``density`` in the middle of a tank of water ``depth``
+    deep, its bottom ``offset`` [m] below the Archimedes equilibrium (negative: above);
+    ``damper`` [N s/m] on heave (zero force at rest: the equilibrium is unchanged)."""
+    draft = density * height / 1000.0
+    z0 = depth - draft - offset
+    xc = 0.5 * tank_length
+    return make_scene({
+        "name": "floating_box", "dp": dp, "t_end": t_end, "still_water_level": depth,
+        "tank": {"x0": 0.0, "x1": tank_length, "z0": 0.0, "z1": depth + 1.5 * height},
+        "water_blocks": [{"x0": 0.0, "x1": tank_length, "z0": 0.0, "z1": depth}],
+        "constants": {"integrator": integrator},
+        "output": {"probe_every": probe_every},
+        "bodies": [{"name": "box", "shape": "box", "x0": xc - 0.5 * breadth,
+                    "x1": xc + 0.5 * breadth, "z0": z0, "z1": z0 + height, "density": density,
+                    "motion": "free", "dofs": list(dofs), "damper": (0.0, damper, 0.0)}]})
+
+
+def archimedes_draft(density: float, height: float, rho0: float = 1000.0) -> float:
+    """Equilibrium draft [m] of a floating box: its weight equals the displaced water's."""
+    return density * height / rho0
+
+
+def box_draft(sim, name: str = "box", z_bottom=None):
+    """Draft [m] of a floating box in a closed tank, below the still-water level the fluid has
+    now: the fluid area (n_fluid dp^2, the lattice volume) plus the box's submerged part fill the
+    tank's length L up to eta, so eta (L - B) = A_fluid - B z_bottom. (The box displaces water
+    in the closed tank: the nominal still-water level is no longer the level.) ``z_bottom``:
+    the box bottom(s) [m] to evaluate at (default: the current one)."""
+    scene = sim.scene
+    body = next(b for b in scene.bodies if b.name == name)
+    k = sim.bodies.names.index(name)
+    breadth, height = body.x1 - body.x0, body.z1 - body.z0
+    if z_bottom is None:
+        z_bottom = float(sim.bodies.state.q[k, 1]) - 0.5 * height
+    length = scene.tank.x1 - scene.tank.x0
+    eta = (sim.n_fluid * scene.dp ** 2 - breadth * z_bottom) / (length - breadth)
+    return eta - z_bottom
+
+
+def hinged_flap_scene(dp: float = 0.02, thickness: float = 0.04, height: float = 0.4,
+                      density: float = 500.0, depth: float = 0.3, spring: float = 0.0,
+                      omega0: float = 0.0, in_water: bool = True, t_end: float = 1.0,
+                      integrator: str = "kdk", probe_every: float = 0.005) -> Scene:
+    """A flap (thickness x height) hinged at the centre of its bottom edge, on the bed at x = 1 m
+    of a 2 m tank. ``in_water`` False: the water is a block at the far left (x < 0.3 m), out of
+    the flap's reach, so only gravity and the spring act. ``omega0`` [rad/s]: initial rate."""
+    length = 2.0
+    xc = 1.0
+    water = ({"x0": 0.0, "x1": length, "z0": 0.0, "z1": depth} if in_water
+             else {"x0": 0.0, "x1": 0.3, "z0": 0.0, "z1": depth})
+    return make_scene({
+        "name": "hinged_flap", "dp": dp, "t_end": t_end, "still_water_level": depth,
+        "tank": {"x0": 0.0, "x1": length, "z0": 0.0, "z1": max(depth, height) + 0.2},
+        "water_blocks": [water],
+        "structures": [] if in_water else [{"x0": 0.3, "x1": 0.4, "z0": 0.0, "z1": depth + 0.1}],
+        "constants": {"integrator": integrator},
+        "output": {"probe_every": probe_every},
+        "bodies": [{"name": "flap", "shape": "flap", "x0": xc - 0.5 * thickness,
+                    "x1": xc + 0.5 * thickness, "z0": 0.0, "z1": height, "density": density,
+                    "motion": "hinged", "spring": spring, "velocity": (0.0, 0.0, omega0)}]})
+
+
+def spring_flap_period(thickness: float, height: float, density: float, spring: float,
+                       g: float = 9.81) -> float:
+    """Small-amplitude period [s] of an upright flap on a torsion spring, hinged at its bottom
+    edge's centre, in air: I_p theta'' = -(k - m g h/2) theta, I_p = m (t^2 + 4 h^2) / 12."""
+    m = density * thickness * height
+    i_p = m * (thickness ** 2 + 4.0 * height ** 2) / 12.0
+    k_eff = spring - m * g * 0.5 * height
+    if k_eff <= 0:
+        raise ValueError("spring: too weak, the upright flap is unstable")
+    return 2.0 * math.pi * math.sqrt(i_p / k_eff)
+
+
+def zero_crossing_period(t: np.ndarray, y: np.ndarray) -> float:
+    """Mean period [s] from the upward zero crossings of y - mean(y) (linear interpolation)."""
+    y = np.asarray(y) - np.mean(y)
+    k = np.nonzero((y[:-1] < 0) & (y[1:] >= 0))[0]
+    tc = t[k] - y[k] * (t[k + 1] - t[k]) / (y[k + 1] - y[k])
+    if tc.size < 2:
+        raise ValueError("zero_crossing_period: fewer than two upward crossings")
+    return float((tc[-1] - tc[0]) / (tc.size - 1))
+
+
+def zero_gravity(sim) -> None:
+    """Turn gravity off in a built Simulation (the scene's g must be > 0): fluid at rho0, rates
+    re-evaluated. For conservation checks only."""
+    from sph_core import step
+    from sph_core.particles import FLUID, P, RHO
+
+    ps = sim.particles
+    sim.prm = sim.prm._replace(gz=0.0)
+    fl = ps.mask(FLUID)
+    ps.field(RHO)[fl] = sim.prm.rho0
+    ps.field(P)[fl] = 0.0
+    dt, n = step.initialise(ps.view, ps.view2, sim.cells, sim.prm, sim.open.ends,
+                            sim.bodies.state, ps.n)
+    ps.swap()
+    ps.n = int(n)
+    sim.dt = float(dt)

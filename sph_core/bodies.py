@@ -1,0 +1,634 @@
+"""Rigid bodies of boundary particles in the SPH zone (issue 14): fixed, prescribed, free, hinged.
+
+    bodies = BodySet.from_scene(scene)         # shapes -> particles, mass, inertia, motion
+    keep = bodies.fluid_outside(x, z, dp)      # fluid lattice points not inside a body
+    bodies.attach(ps)                          # appends the body particles (kind WALL)
+    bd = bodies.state                          # the kernels' typed container (``Bodies``)
+    bodies.rows() -> dict                      # motions and loads for bodies.csv
+
+Particles. A body is a set of dummy particles on the tank's lattice inside its shape, a shell
+``n_layers * dp`` thick (as a fixed Structure), of kind WALL: the Adami wall treatment of the
+tank applies unchanged (wcsph.wall_pass, fluid_pass). Body particles have the consecutive ids
+``id0 .. id0 + npart - 1`` (kept through every sort), which index their offsets (rx, rz) from the
+body's reference point at theta = 0. The kinematics set each particle's position, velocity
+v = V + omega x r (continuity and no-slip terms) and acceleration a = A + alpha x r - omega^2 r
+(the Adami pressure extrapolation uses g - a).
+
+Reference point: the centre of mass for fixed, prescribed and free bodies; the pivot of a hinged
+one. State per body q = (x_ref, z_ref, theta), qd its rate, acc its second derivative; theta is
+counter-clockwise with x right and z up, so v = omega (-r_z, r_x) and the moment about the
+reference point is M = r_x F_z - r_z F_x.
+
+Loads (``body_loads``): the force on body particle k is minus the sum of the pair forces it
+exerts on its fluid neighbours, -sum_i m_i a_ik with a_ik the very pair term of fluid_pass
+(pressure + Monaghan AV + Lo & Shao laminar, with the Adami wall state of k), computed as a gather
+over body particles (no scatter, no race), then summed per body. Fluid + body momentum is thus
+conserved to round-off (tests/sph_core/test_bodies.py).
+
+Dynamics (per metre of span):
+    free:    m dU/dt = F_x - k_x (x - x0) - c_x U,   m dW/dt = F_z + m g_z - k_z (z - z0) - c_z W,
+             I_c domega/dt = M_c - k_t (theta - theta0) - c_t omega;  DOFs not listed stay at rest
+    hinged:  I_p domega/dt = M_p + (c x m g) - k (theta - theta0) - c omega,  I_p = I_c + m |c|^2,
+             c the centre of mass relative to the pivot
+    prescribed: q(t) = q(t_start) + series(t) (linear in t), qd its slope, acc = 0.
+The bodies are integrated by the fluid's integrator stages (kdk: half-kick, drift, forces,
+half-kick; symplectic_pc: predictor, forces at the half step, corrector), in the same jitted step.
+
+Contact (stated limitation): there is none. Body particles interact with fluid only; a body may
+pass through the tank walls, beds, structures or another body, and a body particle leaving the
+tank's grid is clamped into its edge cells. Scenes must keep bodies clear of the walls.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+from pathlib import Path
+from typing import NamedTuple
+
+import numpy as np
+from numba import njit, prange
+
+from .kernels import f_of_q
+from .particles import FLUID, WALL, ParticleSet
+from .scene import Body, Scene
+
+FIXED = 0
+PRESCRIBED = 1
+FREE = 2
+HINGED = 3
+MOTIONS = {"fixed": FIXED, "prescribed": PRESCRIBED, "free": FREE, "hinged": HINGED}
+DOF_INDEX = {"surge": 0, "heave": 1, "pitch": 2}
+
+
+class Bodies(NamedTuple):
+    """The bodies of a run, as the kernels see them (arrays shared with ``BodySet``).
+
+    Per body b: settings and the state q, qd, acc [b, 3] = (x_ref, z_ref, theta) and rates;
+    qn, qdn the symplectic predictor's state at t^n; load [b, 3] = fluid (F_x, F_z, M about the
+    reference point). Per body particle k (id - id0): owner, offsets rx, rz at theta = 0, and the
+    gather's per-particle load (fk_x, fk_z, fk_m)."""
+
+    active: bool           # False: every body hook returns at once (no body in the scene)
+    nb: int
+    id0: int
+    npart: int
+    motion: np.ndarray     # int64[nb]
+    dof: np.ndarray        # [nb, 3] 1.0 free, 0.0 held (free bodies)
+    mass: np.ndarray       # [nb] kg/m
+    inertia: np.ndarray    # [nb] kg m^2/m about the reference point (pivot for hinged)
+    com0: np.ndarray       # [nb, 2] centre of mass - reference point at theta = 0
+    spring: np.ndarray     # [nb, 3]
+    damper: np.ndarray     # [nb, 3]
+    q0: np.ndarray         # [nb, 3] state at t_start (spring rest, prescribed origin)
+    q: np.ndarray
+    qd: np.ndarray
+    acc: np.ndarray
+    qn: np.ndarray
+    qdn: np.ndarray
+    load: np.ndarray
+    series_t: np.ndarray   # [nb, m] prescribed: times (absolute) ...
+    series_q: np.ndarray   # [nb, m, 3] ... and displacements
+    series_n: np.ndarray   # int64[nb] rows used
+    owner: np.ndarray      # int64[npart]
+    rx: np.ndarray
+    rz: np.ndarray
+    fk_x: np.ndarray
+    fk_z: np.ndarray
+    fk_m: np.ndarray
+
+
+def no_bodies() -> Bodies:
+    """An inactive container of the same numba type (a scene without bodies)."""
+    z = lambda *s: np.zeros(s)  # noqa: E731
+    return Bodies(False, 0, 0, 0, np.zeros(1, dtype=np.int64), z(1, 3), z(1), z(1), z(1, 2),
+                  z(1, 3), z(1, 3), z(1, 3), z(1, 3), z(1, 3), z(1, 3), z(1, 3), z(1, 3), z(1, 3),
+                  z(1, 2), z(1, 2, 3), np.zeros(1, dtype=np.int64), np.zeros(1, dtype=np.int64),
+                  z(1), z(1), z(1), z(1), z(1))
+
+
+# ------------------------------------------------------------------------------ kernels
+@njit(cache=True)
+def _prescribed(bd, b, t):
+    """Displacement (3) and its slope at time t of prescribed body b (linear between rows)."""
+    m = bd.series_n[b]
+    ts = bd.series_t[b]
+    d = np.zeros(3)
+    v = np.zeros(3)
+    if t <= ts[0]:
+        for c in range(3):
+            d[c] = bd.series_q[b, 0, c]
+        return d, v
+    if t >= ts[m - 1]:
+        for c in range(3):
+            d[c] = bd.series_q[b, m - 1, c]
+        return d, v
+    k = np.searchsorted(ts[:m], t, side="right") - 1
+    s = (t - ts[k]) / (ts[k + 1] - ts[k])
+    for c in range(3):
+        a = bd.series_q[b, k, c]
+        e = bd.series_q[b, k + 1, c]
+        d[c] = a + s * (e - a)
+        v[c] = (e - a) / (ts[k + 1] - ts[k])
+    return d, v
+
+
+@njit(cache=True)
+def _set_prescribed(bd, b, t_pos, t_vel):
+    d, v = _prescribed(bd, b, t_pos)
+    _, v2 = _prescribed(bd, b, t_vel)
+    for c in range(3):
+        bd.q[b, c] = bd.q0[b, c] + d[c]
+        bd.qd[b, c] = v2[c]
+        bd.acc[b, c] = 0.0
+
+
+@njit(cache=True)
+def bodies_kick_drift(bd, t, dt):
+    """kdk first half: qd += dt/2 acc, q += dt qd (prescribed: q(t + dt), qd(t + dt/2))."""
+    if not bd.active:
+        return
+    hdt = 0.5 * dt
+    for b in range(bd.nb):
+        mo = bd.motion[b]
+        if mo == FREE or mo == HINGED:
+            for c in range(3):
+                bd.qd[b, c] += hdt * bd.acc[b, c]
+                bd.q[b, c] += dt * bd.qd[b, c]
+        elif mo == PRESCRIBED:
+            _set_prescribed(bd, b, t + dt, t + hdt)
+
+
+@njit(cache=True)
+def bodies_kick(bd, t, dt):
+    """kdk second half: qd += dt/2 acc (prescribed: qd(t + dt)); t is the step's start."""
+    if not bd.active:
+        return
+    for b in range(bd.nb):
+        mo = bd.motion[b]
+        if mo == FREE or mo == HINGED:
+            for c in range(3):
+                bd.qd[b, c] += 0.5 * dt * bd.acc[b, c]
+        elif mo == PRESCRIBED:
+            _set_prescribed(bd, b, t + dt, t + dt)
+
+
+@njit(cache=True)
+def bodies_predict(bd, t, dt):
+    """Symplectic predictor: save (q, qd); q += dt/2 qd, qd += dt/2 acc."""
+    if not bd.active:
+        return
+    hdt = 0.5 * dt
+    for b in range(bd.nb):
+        for c in range(3):
+            bd.qn[b, c] = bd.q[b, c]
+            bd.qdn[b, c] = bd.qd[b, c]
+        mo = bd.motion[b]
+        if mo == FREE or mo == HINGED:
+            for c in range(3):
+                bd.q[b, c] += hdt * bd.qd[b, c]
+                bd.qd[b, c] += hdt * bd.acc[b, c]
+        elif mo == PRESCRIBED:
+            _set_prescribed(bd, b, t + hdt, t + hdt)
+
+
+@njit(cache=True)
+def bodies_correct(bd, t, dt):
+    """Symplectic corrector: qd = qdn + dt acc^{n+1/2}, q = qn + dt/2 (qd + qdn)."""
+    if not bd.active:
+        return
+    for b in range(bd.nb):
+        mo = bd.motion[b]
+        if mo == FREE or mo == HINGED:
+            for c in range(3):
+                u = bd.qdn[b, c] + dt * bd.acc[b, c]
+                bd.q[b, c] = bd.qn[b, c] + 0.5 * dt * (u + bd.qdn[b, c])
+                bd.qd[b, c] = u
+        elif mo == PRESCRIBED:
+            _set_prescribed(bd, b, t + dt, t + dt)
+
+
+@njit(cache=True)
+def bodies_v2max(bd):
+    """Largest squared body-particle speed |V + omega x r|^2 (for the time step's CFL bound)."""
+    v2max = 0.0
+    if not bd.active:
+        return v2max
+    for k in range(bd.npart):
+        b = bd.owner[k]
+        th = bd.q[b, 2]
+        om = bd.qd[b, 2]
+        c = math.cos(th)
+        s = math.sin(th)
+        rx = c * bd.rx[k] - s * bd.rz[k]
+        rz = s * bd.rx[k] + c * bd.rz[k]
+        u = bd.qd[b, 0] - om * rz
+        w = bd.qd[b, 1] + om * rx
+        v2max = max(v2max, u * u + w * w)
+    return v2max
+
+
+@njit(parallel=True, cache=True)
+def place_bodies(ps, n, bd):
+    """Position, velocity (V + omega x r) and acceleration of every body particle from q, qd, acc."""
+    if not bd.active:
+        return
+    x = ps.x
+    z = ps.z
+    vx = ps.vx
+    vz = ps.vz
+    ax = ps.ax
+    az = ps.az
+    ids = ps.ids
+    id0 = bd.id0
+    npart = bd.npart
+    for i in prange(n):
+        k = ids[i] - id0
+        if k >= 0 and k < npart:
+            b = bd.owner[k]
+            th = bd.q[b, 2]
+            om = bd.qd[b, 2]
+            al = bd.acc[b, 2]
+            c = math.cos(th)
+            s = math.sin(th)
+            rx = c * bd.rx[k] - s * bd.rz[k]
+            rz = s * bd.rx[k] + c * bd.rz[k]
+            x[i] = bd.q[b, 0] + rx
+            z[i] = bd.q[b, 1] + rz
+            vx[i] = bd.qd[b, 0] - om * rz
+            vz[i] = bd.qd[b, 1] + om * rx
+            ax[i] = bd.acc[b, 0] - al * rz - om * om * rx
+            az[i] = bd.acc[b, 1] + al * rx - om * om * rz
+
+
+@njit(parallel=True, cache=True)
+def _particle_loads(ps, n, cells, prm, bd):
+    """Per body particle k: minus the pair forces it exerts on its fluid neighbours (the pair term
+    of wcsph.fluid_pass for a WALL neighbour, times the fluid particle's mass), and its moment
+    about the body's reference point."""
+    x = ps.x
+    z = ps.z
+    vx = ps.vx
+    vz = ps.vz
+    rho = ps.rho
+    p = ps.p
+    m = ps.m
+    vwx = ps.vwx
+    vwz = ps.vwz
+    kind = ps.kind
+    ids = ps.ids
+    cell = ps.cell
+    cell_start = cells.start
+    ncx = cells.ncx
+    ncz = cells.ncz
+    h = prm.h
+    inv_h = 1.0 / h
+    s2 = 4.0 * h * h
+    eta2 = 0.01 * h * h
+    af = prm.alpha_f
+    av = prm.alpha * prm.c0 * h
+    nu4 = 4.0 * prm.nu
+    noslip = prm.noslip
+    id0 = bd.id0
+    npart = bd.npart
+    owner = bd.owner
+    q = bd.q
+    fk_x = bd.fk_x
+    fk_z = bd.fk_z
+    fk_m = bd.fk_m
+    for j in prange(n):
+        k = ids[j] - id0
+        if k >= 0 and k < npart and kind[j] == WALL:
+            xj = x[j]
+            zj = z[j]
+            rhoj = rho[j]
+            pj = p[j]
+            mj = m[j]
+            wx = vwx[j]
+            wz = vwz[j]
+            fx = 0.0
+            fz = 0.0
+            c = cell[j]
+            cz = c // ncx
+            cx = c - cz * ncx
+            cxl = cx - 1 if cx > 0 else 0
+            cxh = cx + 1 if cx < ncx - 1 else ncx - 1
+            for zz in range(max(cz - 1, 0), min(cz + 2, ncz)):
+                row = zz * ncx
+                for i in range(cell_start[row + cxl], cell_start[row + cxh + 1]):
+                    if kind[i] == FLUID:
+                        dx = x[i] - xj
+                        dz = z[i] - zj
+                        r2 = dx * dx + dz * dz
+                        if r2 < s2:
+                            fij = f_of_q(math.sqrt(r2) * inv_h, af)
+                            rhoi = rho[i]
+                            pf = mj * (p[i] + pj) / (rhoi * rhoj)
+                            pax = 0.0
+                            paz = 0.0
+                            if noslip:
+                                dvx = vx[i] - wx
+                                dvz = vz[i] - wz
+                                vr = dvx * dx + dvz * dz
+                                if vr < 0.0:
+                                    pf -= mj * av * vr / (0.5 * (rhoi + rhoj) * (r2 + eta2))
+                                lam = mj * nu4 * r2 / ((rhoi + rhoj) * (r2 + eta2))
+                                pax -= lam * fij * dvx
+                                paz -= lam * fij * dvz
+                            pax += pf * fij * dx
+                            paz += pf * fij * dz
+                            # fluid particle i receives m_i (pax, paz) from j; j the opposite
+                            fx -= m[i] * pax
+                            fz -= m[i] * paz
+            b = owner[k]
+            rx = xj - q[b, 0]
+            rz = zj - q[b, 1]
+            fk_x[k] = fx
+            fk_z[k] = fz
+            fk_m[k] = rx * fz - rz * fx
+
+
+@njit(cache=True)
+def body_loads(ps, n, cells, prm, bd):
+    """Fluid loads on every body (gather, then a per-body sum) and the resulting accelerations."""
+    if not bd.active:
+        return
+    _particle_loads(ps, n, cells, prm, bd)
+    for b in range(bd.nb):
+        for c in range(3):
+            bd.load[b, c] = 0.0
+    for k in range(bd.npart):
+        b = bd.owner[k]
+        bd.load[b, 0] += bd.fk_x[k]
+        bd.load[b, 1] += bd.fk_z[k]
+        bd.load[b, 2] += bd.fk_m[k]
+    gx = prm.gx
+    gz = prm.gz
+    for b in range(bd.nb):
+        mo = bd.motion[b]
+        ma = bd.mass[b]
+        if mo == FREE:
+            fx = (bd.load[b, 0] + ma * gx - bd.spring[b, 0] * (bd.q[b, 0] - bd.q0[b, 0])
+                  - bd.damper[b, 0] * bd.qd[b, 0])
+            fz = (bd.load[b, 1] + ma * gz - bd.spring[b, 1] * (bd.q[b, 1] - bd.q0[b, 1])
+                  - bd.damper[b, 1] * bd.qd[b, 1])
+            mt = (bd.load[b, 2] - bd.spring[b, 2] * (bd.q[b, 2] - bd.q0[b, 2])
+                  - bd.damper[b, 2] * bd.qd[b, 2])
+            bd.acc[b, 0] = bd.dof[b, 0] * fx / ma
+            bd.acc[b, 1] = bd.dof[b, 1] * fz / ma
+            bd.acc[b, 2] = bd.dof[b, 2] * mt / bd.inertia[b]
+        elif mo == HINGED:
+            th = bd.q[b, 2]
+            co = math.cos(th)
+            si = math.sin(th)
+            cxr = co * bd.com0[b, 0] - si * bd.com0[b, 1]
+            czr = si * bd.com0[b, 0] + co * bd.com0[b, 1]
+            mg = cxr * ma * gz - czr * ma * gx
+            f = (bd.load[b, 2] + mg - bd.spring[b, 2] * (th - bd.q0[b, 2])
+                 - bd.damper[b, 2] * bd.qd[b, 2])
+            bd.acc[b, 0] = 0.0
+            bd.acc[b, 1] = 0.0
+            bd.acc[b, 2] = f / bd.inertia[b]
+
+
+# ------------------------------------------------------------------------------ geometry
+def shape_polygon(body: Body) -> np.ndarray:
+    """The body's outline [k, 2] (counter-clockwise) in scene coordinates at t_start."""
+    if body.shape in ("box", "flap"):
+        pts = [(body.x0, body.z0), (body.x1, body.z0), (body.x1, body.z1), (body.x0, body.z1)]
+    elif body.shape == "wedge":
+        ax_, az_ = body.apex
+        half = 0.5 * body.breadth
+        top = az_ + half * math.tan(math.radians(body.deadrise_deg))
+        pts = [(ax_, az_), (ax_ + half, top), (ax_ - half, top)]
+    else:
+        pts = list(body.points)
+    poly = np.asarray(pts, dtype=float)
+    if _signed_area(poly) < 0:
+        poly = poly[::-1].copy()
+    return poly
+
+
+def _signed_area(poly: np.ndarray) -> float:
+    x, z = poly[:, 0], poly[:, 1]
+    return 0.5 * float(np.sum(x * np.roll(z, -1) - np.roll(x, -1) * z))
+
+
+def polygon_properties(poly: np.ndarray) -> tuple[float, np.ndarray, float]:
+    """Area, centroid and polar second moment of area about the centroid (per unit density)."""
+    x, z = poly[:, 0], poly[:, 1]
+    xn, zn = np.roll(x, -1), np.roll(z, -1)
+    cr = x * zn - xn * z
+    area = 0.5 * cr.sum()
+    cx = ((x + xn) * cr).sum() / (6.0 * area)
+    cz = ((z + zn) * cr).sum() / (6.0 * area)
+    ixx = ((z * z + z * zn + zn * zn) * cr).sum() / 12.0   # about the origin
+    izz = ((x * x + x * xn + xn * xn) * cr).sum() / 12.0
+    j0 = ixx + izz
+    jc = j0 - area * (cx * cx + cz * cz)
+    return float(area), np.array([cx, cz]), float(jc)
+
+
+def _inside(poly: np.ndarray, x: np.ndarray, z: np.ndarray) -> np.ndarray:
+    """Even-odd point-in-polygon test."""
+    inside = np.zeros(x.shape, dtype=bool)
+    n = len(poly)
+    for a in range(n):
+        (xa, za), (xb, zb) = poly[a], poly[(a + 1) % n]
+        crosses = (za > z) != (zb > z)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            xc = xa + (z - za) * (xb - xa) / (zb - za)
+        inside ^= crosses & (x < xc)
+    return inside
+
+
+def _distance(poly: np.ndarray, x: np.ndarray, z: np.ndarray) -> np.ndarray:
+    d = np.full(x.shape, np.inf)
+    n = len(poly)
+    for a in range(n):
+        (xa, za), (xb, zb) = poly[a], poly[(a + 1) % n]
+        ex, ez = xb - xa, zb - za
+        s = np.clip(((x - xa) * ex + (z - za) * ez) / (ex * ex + ez * ez), 0.0, 1.0)
+        d = np.minimum(d, np.hypot(x - (xa + s * ex), z - (za + s * ez)))
+    return d
+
+
+def _lattice_in(scene: Scene, poly: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Points of the tank lattice (x0 + (i + 1/2) dp, z0 + (j + 1/2) dp) inside the polygon."""
+    dp, t = scene.dp, scene.tank
+    i0 = math.floor((poly[:, 0].min() - t.x0) / dp) - 1
+    i1 = math.ceil((poly[:, 0].max() - t.x0) / dp) + 1
+    j0 = math.floor((poly[:, 1].min() - t.z0) / dp) - 1
+    j1 = math.ceil((poly[:, 1].max() - t.z0) / dp) + 1
+    gx, gz = np.meshgrid(t.x0 + (np.arange(i0, i1) + 0.5) * dp,
+                         t.z0 + (np.arange(j0, j1) + 0.5) * dp, indexing="ij")
+    gx, gz = gx.ravel(), gz.ravel()
+    keep = _inside(poly, gx, gz)
+    return gx[keep], gz[keep]
+
+
+# ------------------------------------------------------------------------------ the run's bodies
+class BodySet:
+    """The bodies of a scene: their particles, settings and state (``state``, the kernels' view)."""
+
+    def __init__(self, scene: Scene, thickness: float) -> None:
+        self.scene = scene
+        self.names = [b.name for b in scene.bodies]
+        self.polygons = [shape_polygon(b) for b in scene.bodies]
+        nb = len(scene.bodies)
+        px, pz, owner = [], [], []
+        for b, poly in enumerate(self.polygons):
+            x, z = _lattice_in(scene, poly)
+            shell = _distance(poly, x, z) < thickness
+            x, z = x[shell], z[shell]
+            if x.size == 0:
+                raise ValueError(f"bodies.{b}: no particle fits inside the shape at dp = {scene.dp}")
+            px.append(x)
+            pz.append(z)
+            owner.append(np.full(x.size, b, dtype=np.int64))
+        self.x = np.concatenate(px) if nb else np.zeros(0)
+        self.z = np.concatenate(pz) if nb else np.zeros(0)
+        self.owner = np.concatenate(owner) if nb else np.zeros(0, dtype=np.int64)
+        self.state = no_bodies()
+        self.log: BodyLog | None = None
+
+    @property
+    def active(self) -> bool:
+        return bool(self.scene.bodies)
+
+    def fluid_outside(self, x: np.ndarray, z: np.ndarray, dp: float) -> np.ndarray:
+        """Mask of fluid lattice points outside every body (and not closer than dp/2 to it)."""
+        keep = np.ones(x.shape, dtype=bool)
+        half = 0.5 * dp * (1.0 - 1e-6)
+        for poly in self.polygons:
+            keep &= ~(_inside(poly, x, z) | (_distance(poly, x, z) < half))
+        return keep
+
+    def attach(self, ps: ParticleSet, rho0: float, dp: float) -> None:
+        """Append the body particles (kind WALL, mass rho0 dp^2) and build ``state``."""
+        if not self.active:
+            return
+        ids = ps.add(self.x, self.z, WALL, np.full(self.x.size, rho0),
+                     np.full(self.x.size, rho0 * dp * dp))
+        nb = len(self.scene.bodies)
+        motion = np.zeros(nb, dtype=np.int64)
+        dof = np.zeros((nb, 3))
+        mass = np.zeros(nb)
+        inertia = np.zeros(nb)
+        com0 = np.zeros((nb, 2))
+        spring = np.zeros((nb, 3))
+        damper = np.zeros((nb, 3))
+        q = np.zeros((nb, 3))
+        qd = np.zeros((nb, 3))
+        rows = max([len(b.series) for b in self.scene.bodies] + [2])
+        series_t = np.zeros((nb, rows))
+        series_q = np.zeros((nb, rows, 3))
+        series_n = np.zeros(nb, dtype=np.int64)
+        rx = np.zeros(self.x.size)
+        rz = np.zeros(self.x.size)
+        self.properties = []
+        for b, (body, poly) in enumerate(zip(self.scene.bodies, self.polygons)):
+            area, centroid, j_c = polygon_properties(poly)
+            m = body.mass if body.mass is not None else (body.density or self.scene.constants.rho0) * area
+            com = np.array(body.com, dtype=float) if body.com is not None else centroid
+            i_c = body.inertia if body.inertia is not None else m * j_c / area
+            motion[b] = MOTIONS[body.motion]
+            if body.motion == "hinged":
+                ref = np.array(body.pivot if body.pivot is not None
+                               else (0.5 * (body.x0 + body.x1), body.z0), dtype=float)
+                i_ref = i_c + m * float(np.sum((com - ref) ** 2))
+                dof[b] = (0.0, 0.0, 1.0)
+                qd[b, 2] = body.velocity[2]
+            else:
+                ref = com
+                i_ref = i_c
+                dof[b] = [1.0 if name in body.dofs else 0.0 for name in DOF_INDEX]
+                if body.motion == "free":
+                    qd[b] = np.asarray(body.velocity) * dof[b]
+            mass[b], inertia[b], com0[b] = m, i_ref, com - ref
+            k = np.broadcast_to(np.asarray(body.spring, dtype=float), (3,))
+            c = np.broadcast_to(np.asarray(body.damper, dtype=float), (3,))
+            if body.motion == "hinged":
+                spring[b, 2], damper[b, 2] = k[-1], c[-1]
+            else:
+                spring[b], damper[b] = k, c
+            q[b, :2] = ref
+            if body.series:
+                s = np.asarray(body.series, dtype=float)
+                series_n[b] = len(s)
+                series_t[b, : len(s)] = s[:, 0]
+                series_q[b, : len(s)] = s[:, 1:]
+            sel = self.owner == b
+            rx[sel] = self.x[sel] - ref[0]
+            rz[sel] = self.z[sel] - ref[1]
+            self.properties.append({"name": body.name, "mass": m, "inertia_ref": i_ref,
+                                    "inertia_com": i_c, "area": area, "com": com.tolist(),
+                                    "reference": ref.tolist(), "particles": int(sel.sum())})
+        npart = self.x.size
+        z = lambda *s: np.zeros(s)  # noqa: E731
+        self.state = Bodies(True, nb, int(ids[0]), int(npart), motion, dof, mass, inertia, com0,
+                            spring, damper, q.copy(), q, qd, z(nb, 3), z(nb, 3), z(nb, 3),
+                            z(nb, 3), series_t, series_q, series_n, self.owner.copy(), rx, rz,
+                            z(npart), z(npart), z(npart))
+        # prescribed motion is at its t_start displacement from the first step on
+        for b in range(nb):
+            if motion[b] == PRESCRIBED:
+                _set_prescribed(self.state, b, self.scene.t_start, self.scene.t_start)
+
+    # ---------------------------------------------------------------- reading and checkpoints
+    def rows(self) -> dict[str, float]:
+        """Motions and loads of every body: name_x, _z, _theta (reference point), _u, _w, _omega,
+        _fx, _fz, _my (fluid force [N/m] and moment about the reference point [N m/m])."""
+        bd = self.state
+        out: dict[str, float] = {}
+        for b, name in enumerate(self.names):
+            for c, key in enumerate(("x", "z", "theta")):
+                out[f"{name}_{key}"] = float(bd.q[b, c])
+            for c, key in enumerate(("u", "w", "omega")):
+                out[f"{name}_{key}"] = float(bd.qd[b, c])
+            for c, key in enumerate(("fx", "fz", "my")):
+                out[f"{name}_{key}"] = float(bd.load[b, c])
+        return out
+
+    def columns(self) -> list[str]:
+        return [f"{n}_{k}" for n in self.names
+                for k in ("x", "z", "theta", "u", "w", "omega", "fx", "fz", "my")]
+
+    def particle_body(self, ids: np.ndarray) -> np.ndarray:
+        """Body index of each particle id (-1: not a body particle), for snapshots."""
+        out = np.full(ids.shape, -1, dtype=np.int32)
+        if self.active:
+            k = ids - self.state.id0
+            sel = (k >= 0) & (k < self.state.npart)
+            out[sel] = self.state.owner[k[sel]]
+        return out
+
+    def get_state(self) -> tuple[np.ndarray, ...] | None:
+        bd = self.state
+        return None if not self.active else tuple(a.copy() for a in (bd.q, bd.qd, bd.acc, bd.load))
+
+    def set_state(self, s: tuple[np.ndarray, ...] | None) -> None:
+        if s is None or not self.active:
+            return
+        bd = self.state
+        for dst, src in zip((bd.q, bd.qd, bd.acc, bd.load), s):
+            dst[:] = src
+
+
+class BodyLog:
+    """bodies.csv beside probes.csv: t, step, then BodySet.columns(); flushed per row."""
+
+    def __init__(self, run_dir: str | Path, columns: list[str]) -> None:
+        self.columns = ["t", "step"] + columns
+        self._file = open(Path(run_dir) / "bodies.csv", "w", newline="")
+        self._csv = csv.writer(self._file)
+        self._csv.writerow(self.columns)
+        self._file.flush()
+
+    def row(self, t: float, step: int, values: dict[str, float]) -> None:
+        self._csv.writerow([repr(float(t)), step] + [repr(values[c]) for c in self.columns[2:]])
+        self._file.flush()
+
+    def close(self) -> None:
+        if not self._file.closed:
+            self._file.close()
