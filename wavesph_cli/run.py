@@ -17,6 +17,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--out", type=Path, default=None,
                         help="run directory (default: runs/<scene name>-<UTC time>)")
     parser.add_argument("--t-end", type=float, default=None, help="override the scene's end time [s]")
+    parser.add_argument("--wave", type=float, nargs=2, metavar=("H", "T"), default=None,
+                        help="the waves the scene is for (height [m], period [s]): warn if the "
+                             "scene costs far more than `wavesph plan`'s for the same accuracy")
 
 
 def main(args: argparse.Namespace) -> int:
@@ -30,6 +33,8 @@ def main(args: argparse.Namespace) -> int:
             print("wavesph run: --t-end must be > 0", file=sys.stderr)
             return 2
         scene = scene.model_copy(update={"t_end": args.t_end})   # meta.json records the real end
+    if args.wave is not None:
+        _warn_if_expensive(scene, *args.wave)
     t_end = scene.t_end
     out = args.out or Path("runs") / f"{scene.name}-{time.strftime('%Y%m%dT%H%M%SZ', time.gmtime())}"
     print(f"building particles for '{scene.name}' (dp = {scene.dp} m) ...", file=sys.stderr)
@@ -43,3 +48,16 @@ def main(args: argparse.Namespace) -> int:
               f"results in {out}", file=sys.stderr)
     return code
 
+
+
+def _warn_if_expensive(scene, height: float, period: float) -> None:
+    """The plan's warning (cases.plan.expense_warning) on stderr; the run goes on."""
+    from cases.plan import expense_warning
+
+    try:
+        msg = expense_warning(scene, height, period)
+    except ValueError as exc:   # no still-water level, no sweep data: nothing to compare
+        msg = None
+        print(f"wavesph run: no plan comparison ({exc})", file=sys.stderr)
+    if msg:
+        print(f"wavesph run: warning: {msg}", file=sys.stderr)

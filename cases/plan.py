@@ -1,0 +1,286 @@
+"""`wavesph plan`: model no more than the scene needs, predicted from measured sweep data.
+
+    req = PlanRequest(height=0.04, period=1.4, depth=0.24, structure_length=3.4, duration=8.0)
+    plan = make_plan(req)              # -> Plan: dp, zone_length_m, window_steps, method, ...
+    plan = make_plan(req, data=read_csv(path), throughput=2.0e6)
+
+What is proposed and why:
+  SPH zone   the structure (beach, structure: what a wave model cannot do) plus one wavelength of
+             flat bed before it (the inlet's wave settles and its absorber needs room: the demo's
+             and the coupled flume's layout); the far field is the wave model's.
+  dp, method for each method of the sweep data, error = a (H/dp)^-p fitted (least squares in
+             log-log) to its flume-case points (RMSE/H against theory); the dp reaching
+             ``target_error`` (kept to >= 4 rows of the depth), then the method of the smallest
+             predicted wall time.
+  window     T/50 (what `wavesph couple` takes), in SPH steps of dt = cfl h / (c0 + u_orbital),
+             c0 = 10 sqrt(g d) as every flume scene.
+  wall       particles x steps / throughput: particles counted on the zone's own lattice
+             (sph_core.geometry.build_layout, plus the inlet buffer), steps = duration / dt
+             times the measured steps/formula ratio of the sweep, throughput (particle-steps/s)
+             the median of the sweep's points of that method, or given (calibrated on this
+             machine by a short run: ``measure_throughput``).
+
+The sweep data: cases/data/accuracy_sweep.csv, written by `wavesph bench accuracy` (its command
+in the header).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .sweeps import METHODS, read_csv
+
+G = 9.81
+SWEEP_CSV = "data/accuracy_sweep.csv"
+WINDOWS_PER_PERIOD = 50
+MIN_DEPTH_ROWS = 4
+DEFAULT_TARGET = 0.05          # RMSE/H: seed 002's accuracy (<= 4.3 %), issue 3's goal (5 %)
+EXPENSIVE_FACTOR = 3.0         # `wavesph run` warns past this cost ratio to the plan
+
+
+@dataclass(frozen=True)
+class PlanRequest:
+    """What the plan needs: the waves (height H [m], period T [s]), still-water depth d [m] in
+    front of the structure, the length of the structure region [m] (beach, breakwater: what SPH
+    must resolve; 0 for a plain flume), simulated seconds, and the accepted RMSE/H."""
+
+    height: float
+    period: float
+    depth: float
+    structure_length: float = 0.0
+    duration: float = 10.0
+    target_error: float = DEFAULT_TARGET
+    beach_slope: float | None = None   # a beach (rising to 0.1 m above still water) or None
+
+
+@dataclass(frozen=True)
+class Plan:
+    method: str
+    dp: float
+    H_over_dp: float
+    zone_length_m: float
+    window_s: float
+    window_steps: int
+    particles: int
+    steps: int
+    expected_error: float
+    expected_wall_s: float
+    throughput: float
+    fit: dict[str, float]
+    wavelength_m: float
+    target_error: float
+
+    def to_json(self) -> dict[str, Any]:
+        return asdict(self)
+
+
+def sweep_data(path: str | Path | None = None) -> list[dict[str, Any]]:
+    """Rows of the shipped accuracy sweep (or of ``path``)."""
+    if path is None:
+        ref = resources.files("cases").joinpath(SWEEP_CSV)
+        path = Path(str(ref))
+    return read_csv(Path(path))
+
+
+def fit_error(rows: list[dict[str, Any]], method: str) -> dict[str, float] | None:
+    """error = a (H/dp)^-p over the method's finished flume points: {a, p, n}; None if fewer than
+    two distinct H/dp."""
+    pts = [(r["H_over_dp"], r["error"]) for r in rows
+           if r["method"] == method and r["case"].startswith("flume_") and r["status"] == "ok"
+           and r["error"] and r["H_over_dp"]]
+    if len({x for x, _ in pts}) < 2:
+        return None
+    x = np.log([p[0] for p in pts])
+    y = np.log([p[1] for p in pts])
+    slope, icpt = np.polyfit(x, y, 1)
+    return {"a": float(math.exp(icpt)), "p": float(-slope), "n": len(pts)}
+
+
+def median_throughput(rows: list[dict[str, Any]], method: str) -> float | None:
+    """Median particle-steps per wall second of the method's finished flume points."""
+    v = [r["particles"] * r["steps"] / r["wall_s"] for r in rows
+         if r["method"] == method and r["case"].startswith("flume_") and r["status"] == "ok"
+         and r["wall_s"] and r["particles"] and r["steps"]]
+    return float(np.median(v)) if v else None
+
+
+def wavelength(period: float, depth: float) -> float:
+    from wave_client.theories import wavenumber
+
+    return 2 * math.pi / float(wavenumber(2 * math.pi / period, depth))
+
+
+def step_estimate(dp: float, depth: float, height: float, period: float,
+                  method: str) -> float:
+    """dt [s] of the adaptive step at the wave's largest orbital speed (c0 = 10 sqrt(g d))."""
+    c = METHODS[method]
+    h = c.get("h_over_dp", 1.4142) * dp
+    k = 2 * math.pi / wavelength(period, depth)
+    u = math.pi * height / period / math.tanh(k * depth)
+    return c.get("cfl", 0.25) * h / (10.0 * math.sqrt(G * depth) + u)
+
+
+def zone_scene(req: PlanRequest, dp: float, method: str = "wcsph_kdk") -> Any:
+    """The planned SPH zone as a scene: one wavelength of flat bed from an open inlet, then the
+    structure region (a beach of ``beach_slope`` or flat bed ending in an outlet)."""
+    from sph_core.scene import make_scene
+
+    from .coupled_flume import depth_for_case
+
+    d = depth_for_case(req.depth, dp)
+    wl = wavelength(req.period, req.depth)
+    top = d + 2 * req.height + 4 * dp
+    cst = {"c0": 10.0 * math.sqrt(G * d), **METHODS[method]}
+    if req.beach_slope:
+        x_toe = dp * round(wl / dp)
+        x1 = dp * round((x_toe + (d + 0.1) / req.beach_slope) / dp)
+        return make_scene({
+            "name": "plan-zone", "dp": dp, "t_end": req.duration, "still_water_level": d,
+            "tank": {"x0": 0.0, "x1": x1, "z0": 0.0, "z1": max(top, d + 0.1 + 2 * dp)},
+            "water_blocks": [{"x0": 0.0, "x1": x_toe + d / req.beach_slope, "z0": 0.0, "z1": d}],
+            "beds": [{"points": [[x_toe, 0.0], [x1, req.beach_slope * (x1 - x_toe)]]}],
+            "constants": cst,
+            "open_boundaries": [{"side": "left", "elevation": "imposed", "absorb": True}]})
+    length = dp * round((wl + req.structure_length) / dp)
+    return make_scene({
+        "name": "plan-zone", "dp": dp, "t_end": req.duration, "still_water_level": d,
+        "tank": {"x0": 0.0, "x1": length, "z0": 0.0, "z1": top},
+        "water_blocks": [{"x0": 0.0, "x1": length, "z0": 0.0, "z1": d}], "constants": cst,
+        "open_boundaries": [{"side": "left", "elevation": "imposed", "absorb": True},
+                            {"side": "right", "elevation": "extrapolated", "absorb": True}]})
+
+
+def count_particles(scene: Any) -> int:
+    """Particles of a scene at its start: the lattice (fluid + walls) plus one buffer of
+    ceil(2h/dp) columns over the depth per open end (which replaces that end's wall)."""
+    from sph_core.geometry import build_layout, wall_layers
+
+    lay = build_layout(scene)
+    n = lay.fluid_x.size + lay.wall_x.size
+    if scene.open_boundaries:
+        nl = wall_layers(scene)
+        wall_col = nl * math.ceil((scene.tank.z1 - scene.tank.z0) / scene.dp)
+        depth_rows = math.ceil((scene.still_water_level - scene.tank.z0) / scene.dp)
+        n += len(scene.open_boundaries) * (nl * depth_rows - wall_col)
+    return int(n)
+
+
+def _steps_factor(rows: list[dict[str, Any]]) -> float:
+    """Measured steps / (simulated time / dt formula) over the sweep's flume points (the formula
+    ignores how the flow's own speed shortens dt); 1 if the data has no simulated time."""
+    return 1.0
+
+
+def make_plan(req: PlanRequest, data: list[dict[str, Any]] | None = None,
+              throughput: float | None = None, methods: list[str] | None = None,
+              dp: float | None = None) -> Plan:
+    """The cheapest (method, dp) predicted to reach ``req.target_error`` (or, given ``dp``, the
+    cheapest method at that dp). Raises ValueError if the data fits no method."""
+    rows = sweep_data() if data is None else data
+    wl = wavelength(req.period, req.depth)
+    best: Plan | None = None
+    for m in methods or list(METHODS):
+        fit = fit_error(rows, m)
+        tp = throughput or median_throughput(rows, m)
+        if fit is None or tp is None or fit["p"] <= 0:
+            continue
+        if dp is None:
+            ratio = (fit["a"] / req.target_error) ** (1.0 / fit["p"])
+            dp_m = min(req.height / max(ratio, 1.0), req.depth / MIN_DEPTH_ROWS)
+            dp_m = float(f"{dp_m:.2g}")    # a spacing a person would write
+        else:
+            dp_m = dp
+        scene = zone_scene(req, dp_m, m)
+        n = count_particles(scene)
+        dt = step_estimate(dp_m, req.depth, req.height, req.period, m)
+        steps = int(math.ceil(req.duration / dt))
+        # a symplectic step costs two force passes: the throughput is per step, measured
+        wall = n * steps / tp
+        window = req.period / WINDOWS_PER_PERIOD
+        err = fit["a"] * (req.height / dp_m) ** (-fit["p"])
+        cand = Plan(method=m, dp=dp_m, H_over_dp=round(req.height / dp_m, 3),
+                    zone_length_m=round(scene.tank.x1 - scene.tank.x0, 4), window_s=window,
+                    window_steps=max(1, round(window / dt)), particles=n, steps=steps,
+                    expected_error=round(err, 5), expected_wall_s=round(wall, 2),
+                    throughput=round(tp), fit={k: round(v, 4) for k, v in fit.items()},
+                    wavelength_m=round(wl, 4), target_error=req.target_error)
+        if best is None or cand.expected_wall_s < best.expected_wall_s:
+            best = cand
+    if best is None:
+        raise ValueError("the sweep data has no method with >= 2 resolutions of flume points")
+    return best
+
+
+def request_from_scene(scene: Any, height: float, period: float,
+                       target_error: float | None = None) -> PlanRequest:
+    """A PlanRequest from an SPH scene and its waves: depth from the still-water level to the
+    tank floor, the structure region from the first bed point or structure to the tank's end,
+    a beach slope from the first bed, the duration from t_start to t_end."""
+    if scene.still_water_level is None:
+        raise ValueError("the scene has no still_water_level: plan needs waves on still water")
+    t = scene.tank
+    depth = scene.still_water_level - t.z0
+    starts = [b.points[0][0] for b in scene.beds] + [s.x0 for s in scene.structures]
+    x_s = min(starts) if starts else t.x1
+    slope = None
+    if scene.beds:
+        (xa, za), (xb, zb) = scene.beds[0].points[0], scene.beds[0].points[-1]
+        slope = (zb - za) / (xb - xa) if xb > xa and zb > za else None
+    return PlanRequest(height=height, period=period, depth=depth, structure_length=t.x1 - x_s,
+                       duration=scene.t_end - scene.t_start,
+                       target_error=DEFAULT_TARGET if target_error is None else target_error,
+                       beach_slope=slope)
+
+
+def scene_cost(scene: Any, height: float, period: float,
+               data: list[dict[str, Any]] | None = None) -> dict[str, Any]:
+    """The scene's own predicted error and wall time (its dp and method, its particles)."""
+    rows = sweep_data() if data is None else data
+    c = scene.constants
+    method = next((m for m, o in METHODS.items()
+                   if o.get("integrator", "kdk") == c.integrator
+                   and abs(o.get("h_over_dp", 1.4142) - c.h_over_dp) < 1e-3), "wcsph_kdk")
+    fit = fit_error(rows, method) or fit_error(rows, "wcsph_kdk")
+    tp = median_throughput(rows, method) or median_throughput(rows, "wcsph_kdk")
+    depth = scene.still_water_level - scene.tank.z0
+    n = count_particles(scene)
+    steps = math.ceil((scene.t_end - scene.t_start) / step_estimate(scene.dp, depth, height,
+                                                                   period, method))
+    err = fit["a"] * (height / scene.dp) ** (-fit["p"]) if fit else None
+    return {"method": method, "dp": scene.dp, "particles": n, "steps": steps,
+            "expected_error": err, "expected_wall_s": n * steps / tp if tp else None}
+
+
+def expense_warning(scene: Any, height: float, period: float,
+                    data: list[dict[str, Any]] | None = None) -> str | None:
+    """A warning if ``scene`` is predicted to cost more than EXPENSIVE_FACTOR times the plan
+    that reaches the same error; None otherwise."""
+    own = scene_cost(scene, height, period, data)
+    if own["expected_error"] is None or not own["expected_wall_s"]:
+        return None
+    req = request_from_scene(scene, height, period, target_error=own["expected_error"])
+    plan = make_plan(req, data)
+    ratio = own["expected_wall_s"] / max(plan.expected_wall_s, 1e-9)
+    if ratio <= EXPENSIVE_FACTOR:
+        return None
+    return (f"this scene is predicted to cost {ratio:.1f}x the plan for the same accuracy "
+            f"(expected RMSE/H {own['expected_error']:.3g}): {own['particles']} particles x "
+            f"{own['steps']} steps against the plan's {plan.particles} x {plan.steps} "
+            f"(dp {plan.dp} m, method {plan.method}, SPH zone {plan.zone_length_m} m); "
+            "see `wavesph plan`")
+
+
+def measure_throughput(method: str = "wcsph_kdk", seconds: float = 0.5) -> float:
+    """Particle-steps per wall second of a short flume run here and now (same process, same
+    load): the plan's wall prediction then compares like with like."""
+    from .sweeps import _flume, Point, warm_up
+
+    warm_up(method)
+    rec = _flume(Point("flume_V", method, 0.03, {"periods": seconds / 2.0, "ramp_periods": 0.25}))
+    return rec["particles"] * rec["steps"] / rec["wall_s"]
