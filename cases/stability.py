@@ -43,14 +43,15 @@ from typing import Any, Callable
 
 import numpy as np
 
+from wave_client import G
+
 from .sweeps import METHODS, Point, run_sweep, warm_up
 
 STATUSES = ("stable", "noisy", "unstable", "failed")
 STATUS_COLOURS = {"stable": "#4caf50", "noisy": "#ffb300", "unstable": "#e53935", "failed": "#757575"}
-CSV_COLUMNS = ["scenario", "method", "status", "t_fail", "reason", "measure", "value", "bound",
+STABILITY_COLUMNS = ["scenario", "method", "status", "t_fail", "reason", "measure", "value", "bound",
                "t_end", "wall_s"]
 WINDOW_STEPS = (1, 10, 100, 1000)
-G = 9.81
 
 
 def unchecked(scene: Any, **constants: Any) -> Any:
@@ -315,10 +316,10 @@ def write_stability_csv(rows: list[dict[str, Any]], path: Path, command: str = "
     with open(path, "w", newline="") as fh:
         if command:
             fh.write(f"# made by: {command}\n")
-        w = csv.DictWriter(fh, fieldnames=CSV_COLUMNS, extrasaction="ignore")
+        w = csv.DictWriter(fh, fieldnames=STABILITY_COLUMNS, extrasaction="ignore")
         w.writeheader()
         for r in rows:
-            row = {k: r.get(k) for k in CSV_COLUMNS}
+            row = {k: r.get(k) for k in STABILITY_COLUMNS}
             for k in ("t_fail", "value", "t_end", "wall_s"):
                 if isinstance(row[k], float):
                     row[k] = f"{row[k]:.4g}"

@@ -50,7 +50,7 @@ METHODS: dict[str, dict[str, Any]] = {
 # the coupled case's two ways to compute the same flume
 COUPLED_METHODS = ("coupled", "sph_only")
 
-CSV_COLUMNS = ["case", "method", "dp", "H_over_dp", "error", "wall_s", "particles", "steps",
+ACCURACY_COLUMNS = ["case", "method", "dp", "H_over_dp", "error", "wall_s", "particles", "steps",
                "status", "reason"]
 FLUME_CASES = ("I", "II", "III", "IV", "V")
 
@@ -311,7 +311,7 @@ def run_sweep(points: list[Point], out: Path, scheduler: str | None = None,
         if scheduler is None:
             n = n_workers or max(1, min(len(todo), os.cpu_count() or 1))
             cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                                   dashboard_address=None)
+                                   dashboard_address=":0")   # any free port: no clash with a running cluster
         client = Client(scheduler or cluster)
         try:
             futures = client.map(runner, todo, key=[f"{desc}-{p.key}" for p in todo], pure=False)
@@ -339,15 +339,15 @@ def run_sweep(points: list[Point], out: Path, scheduler: str | None = None,
 
 # ---------------------------------------------------------------------------- outputs
 def write_csv(records: list[dict[str, Any]], path: Path, command: str = "") -> None:
-    """accuracy.csv: CSV_COLUMNS, one row per point (``command`` as a # header line)."""
+    """accuracy.csv: ACCURACY_COLUMNS, one row per point (``command`` as a # header line)."""
     path.parent.mkdir(parents=True, exist_ok=True)
     with open(path, "w", newline="") as fh:
         if command:
             fh.write(f"# made by: {command}\n")
-        w = csv.DictWriter(fh, fieldnames=CSV_COLUMNS, extrasaction="ignore")
+        w = csv.DictWriter(fh, fieldnames=ACCURACY_COLUMNS, extrasaction="ignore")
         w.writeheader()
         for r in records:
-            row = {k: r.get(k) for k in CSV_COLUMNS}
+            row = {k: r.get(k) for k in ACCURACY_COLUMNS}
             for k in ("error", "wall_s", "H_over_dp"):
                 if row[k] is not None:
                     row[k] = f"{row[k]:.6g}"

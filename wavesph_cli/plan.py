@@ -1,5 +1,5 @@
 """`wavesph plan SCENE.toml --height H --period T`: the SPH zone, dp, coupling window and method
-a scene needs, with the error and wall time predicted from the measured sweep (cases/plan.py)."""
+a scene needs, with the error and wall time predicted from the measured sweep (cases/planning.py)."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import json
 import sys
 from pathlib import Path
 
-from cases.plan import DEFAULT_TARGET, make_plan, request_from_scene, scene_cost, sweep_data
+from cases.planning import DEFAULT_TARGET, make_plan, request_from_scene, scene_cost, sweep_data
 from sph_core.scene import SceneError, load_scene
 
 

@@ -51,8 +51,8 @@ def main(args: argparse.Namespace) -> int:
 
 
 def _warn_if_expensive(scene, height: float, period: float) -> None:
-    """The plan's warning (cases.plan.expense_warning) on stderr; the run goes on."""
-    from cases.plan import expense_warning
+    """The plan's warning (cases.planning.expense_warning) on stderr; the run goes on."""
+    from cases.planning import expense_warning
 
     try:
         msg = expense_warning(scene, height, period)

@@ -16,9 +16,9 @@ from pathlib import Path
 
 import pytest
 
-from cases import plan as planning
+from cases import planning
 from cases import stability, sweeps
-from cases.sweeps import CSV_COLUMNS, Point
+from cases.sweeps import ACCURACY_COLUMNS, Point
 
 ROOT = Path(__file__).resolve().parents[2]
 TINY = {"a": 0.1}   # a 0.1 m column: 32 particles at dp = 0.025
@@ -69,7 +69,7 @@ def test_sweep_csv_and_chart(swept, tmp_path):
     sweeps.write_csv(records, path, command="wavesph bench accuracy --test")
     assert path.read_text().startswith("# made by: wavesph bench accuracy --test")
     rows = sweeps.read_csv(path)
-    assert list(rows[0]) == CSV_COLUMNS
+    assert list(rows[0]) == ACCURACY_COLUMNS
     assert [r["status"] for r in rows] == ["ok", "ok", "failed"]
     assert rows[0]["error"] == pytest.approx(records[0]["error"], rel=1e-5)
     png = tmp_path / "accuracy.png"
@@ -122,7 +122,7 @@ def _synthetic(tmp_path: Path, a: float = 0.3, p: float = 1.0, tp: float = 1.0e6
     """A sweep CSV whose flume points lie exactly on error = a (H/dp)^-p at throughput tp."""
     path = tmp_path / "sweep.csv"
     with open(path, "w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=CSV_COLUMNS)
+        w = csv.DictWriter(fh, fieldnames=ACCURACY_COLUMNS)
         w.writeheader()
         for r in (2.0, 4.0, 8.0):
             w.writerow({"case": "flume_V", "method": "wcsph_kdk", "dp": 0.06 / r, "H_over_dp": r,
@@ -180,7 +180,7 @@ def test_run_warns_when_a_scene_costs_far_more_than_the_plan(tmp_path):
 
 def test_shipped_sweep_data_plans_the_demo():
     rows = planning.sweep_data()
-    assert rows and set(CSV_COLUMNS) <= set(rows[0])
+    assert rows and set(ACCURACY_COLUMNS) <= set(rows[0])
     text = (ROOT / "cases" / planning.SWEEP_CSV).read_text()
     assert text.startswith("# made by: wavesph bench accuracy")
     from sph_core.scene import load_scene

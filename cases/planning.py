@@ -15,8 +15,8 @@ What is proposed and why:
   window     T/50 (what `wavesph couple` takes), in SPH steps of dt = cfl h / (c0 + u_orbital),
              c0 = 10 sqrt(g d) as every flume scene.
   wall       particles x steps / throughput: particles counted on the zone's own lattice
-             (sph_core.geometry.build_layout, plus the inlet buffer), steps = duration / dt
-             times the measured steps/formula ratio of the sweep, throughput (particle-steps/s)
+             (sph_core.geometry.build_layout, plus the inlet buffer), steps = duration / dt,
+             throughput (particle-steps/s)
              the median of the sweep's points of that method, or given (calibrated on this
              machine by a short run: ``measure_throughput``).
 
@@ -34,9 +34,10 @@ from typing import Any
 
 import numpy as np
 
+from wave_client import G
+
 from .sweeps import METHODS, read_csv
 
-G = 9.81
 SWEEP_CSV = "data/accuracy_sweep.csv"
 WINDOWS_PER_PERIOD = 50
 MIN_DEPTH_ROWS = 4
@@ -171,12 +172,6 @@ def count_particles(scene: Any) -> int:
     return int(n)
 
 
-def _steps_factor(rows: list[dict[str, Any]]) -> float:
-    """Measured steps / (simulated time / dt formula) over the sweep's flume points (the formula
-    ignores how the flow's own speed shortens dt); 1 if the data has no simulated time."""
-    return 1.0
-
-
 def make_plan(req: PlanRequest, data: list[dict[str, Any]] | None = None,
               throughput: float | None = None, methods: list[str] | None = None,
               dp: float | None = None) -> Plan:
@@ -200,8 +195,7 @@ def make_plan(req: PlanRequest, data: list[dict[str, Any]] | None = None,
         n = count_particles(scene)
         dt = step_estimate(dp_m, req.depth, req.height, req.period, m)
         steps = int(math.ceil(req.duration / dt))
-        # a symplectic step costs two force passes: the throughput is per step, measured
-        wall = n * steps / tp
+        wall = n * steps / tp    # tp is per step of this method: two passes cost in it
         window = req.period / WINDOWS_PER_PERIOD
         err = fit["a"] * (req.height / dp_m) ** (-fit["p"])
         cand = Plan(method=m, dp=dp_m, H_over_dp=round(req.height / dp_m, 3),
@@ -279,7 +273,7 @@ def expense_warning(scene: Any, height: float, period: float,
 def measure_throughput(method: str = "wcsph_kdk", seconds: float = 0.5) -> float:
     """Particle-steps per wall second of a short flume run here and now (same process, same
     load): the plan's wall prediction then compares like with like."""
-    from .sweeps import _flume, Point, warm_up
+    from .sweeps import Point, _flume, warm_up
 
     warm_up(method)
     rec = _flume(Point("flume_V", method, 0.03, {"periods": seconds / 2.0, "ramp_periods": 0.25}))
