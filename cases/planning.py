@@ -9,7 +9,8 @@ What is proposed and why:
              flat bed before it (the inlet's wave settles and its absorber needs room: the demo's
              and the coupled flume's layout); the far field is the wave model's.
   dp, method for each method of the sweep data, error = a (H/dp)^-p fitted (least squares in
-             log-log) to its flume-case points (RMSE/H against theory); the dp reaching
+             log-log, one slope, a per case; a of the case nearest the waves in kd and H/L) to
+             its flume-case points (RMSE/H against theory); the dp reaching
              ``target_error`` (kept to >= 4 rows of the depth), then the method of the smallest
              predicted wall time.
   window     T/50 (what `wavesph couple` takes), in SPH steps of dt = cfl h / (c0 + u_orbital),
@@ -73,7 +74,7 @@ class Plan:
     expected_error: float
     expected_wall_s: float
     throughput: float
-    fit: dict[str, float]
+    fit: dict[str, Any]
     wavelength_m: float
     target_error: float
 
@@ -89,18 +90,55 @@ def sweep_data(path: str | Path | None = None) -> list[dict[str, Any]]:
     return read_csv(Path(path))
 
 
-def fit_error(rows: list[dict[str, Any]], method: str) -> dict[str, float] | None:
-    """error = a (H/dp)^-p over the method's finished flume points: {a, p, n}; None if fewer than
-    two distinct H/dp."""
-    pts = [(r["H_over_dp"], r["error"]) for r in rows
-           if r["method"] == method and r["case"].startswith("flume_") and r["status"] == "ok"
-           and r["error"] and r["H_over_dp"]]
-    if len({x for x, _ in pts}) < 2:
+def fit_error(rows: list[dict[str, Any]], method: str,
+              wave: tuple[float, float, float] | None = None) -> dict[str, float] | None:
+    """error = a (H/dp)^-p over the method's finished flume points: {a, p, n, case}; None if no
+    case has two distinct H/dp. One slope p for all cases (least squares in log-log with one
+    intercept per case: the waves differ in how hard they are, not in how the error converges);
+    a of the case nearest ``wave`` = (H, T, d) in relative depth kd and steepness H/L (else the
+    geometric mean of the cases' a)."""
+    by_case: dict[str, list[tuple[float, float]]] = {}
+    for r in rows:
+        if (r["method"] == method and r["case"].startswith("flume_") and r["status"] == "ok"
+                and r["error"] and r["H_over_dp"]):
+            by_case.setdefault(r["case"], []).append((math.log(r["H_over_dp"]), math.log(r["error"])))
+    by_case = {c: v for c, v in by_case.items() if len({x for x, _ in v}) >= 2}
+    if not by_case:
         return None
-    x = np.log([p[0] for p in pts])
-    y = np.log([p[1] for p in pts])
-    slope, icpt = np.polyfit(x, y, 1)
-    return {"a": float(math.exp(icpt)), "p": float(-slope), "n": len(pts)}
+    # common slope: pooled within-case regression
+    sxy = sxx = 0.0
+    for v in by_case.values():
+        xm = sum(x for x, _ in v) / len(v)
+        ym = sum(y for _, y in v) / len(v)
+        sxy += sum((x - xm) * (y - ym) for x, y in v)
+        sxx += sum((x - xm) ** 2 for x, _ in v)
+    p = -sxy / sxx
+    log_a = {c: sum(y + p * x for x, y in v) / len(v) for c, v in by_case.items()}
+    case = None
+    if wave is not None:
+        case = min(log_a, key=lambda c: _wave_distance(c, wave))
+        la = log_a[case]
+    else:
+        la = sum(log_a.values()) / len(log_a)
+    return {"a": math.exp(la), "p": p, "n": sum(len(v) for v in by_case.values()),
+            **({"case": case} if case else {})}
+
+
+def _wave_distance(case: str, wave: tuple[float, float, float]) -> float:
+    """Distance of a seed 002 flume case from the wave (H, T, d) in (log kd, log H/L)."""
+    from .sweeps import _read_cases
+
+    row = _read_cases().get(case.removeprefix("flume_"))
+    if row is None:
+        return math.inf
+
+    def coords(h: float, t: float, d: float) -> tuple[float, float]:
+        wl = wavelength(t, d)
+        return math.log(2 * math.pi / wl * d), math.log(h / wl)
+
+    a = coords(float(row["H"]), float(row["T"]), float(row["d"]))
+    b = coords(*wave)
+    return math.hypot(a[0] - b[0], a[1] - b[1])
 
 
 def median_throughput(rows: list[dict[str, Any]], method: str) -> float | None:
@@ -181,7 +219,7 @@ def make_plan(req: PlanRequest, data: list[dict[str, Any]] | None = None,
     wl = wavelength(req.period, req.depth)
     best: Plan | None = None
     for m in methods or list(METHODS):
-        fit = fit_error(rows, m)
+        fit = fit_error(rows, m, (req.height, req.period, req.depth))
         tp = throughput or median_throughput(rows, m)
         if fit is None or tp is None or fit["p"] <= 0:
             continue
@@ -202,7 +240,7 @@ def make_plan(req: PlanRequest, data: list[dict[str, Any]] | None = None,
                     zone_length_m=round(scene.tank.x1 - scene.tank.x0, 4), window_s=window,
                     window_steps=max(1, round(window / dt)), particles=n, steps=steps,
                     expected_error=round(err, 5), expected_wall_s=round(wall, 2),
-                    throughput=round(tp), fit={k: round(v, 4) for k, v in fit.items()},
+                    throughput=round(tp), fit={k: (round(v, 4) if isinstance(v, float) else v) for k, v in fit.items()},
                     wavelength_m=round(wl, 4), target_error=req.target_error)
         if best is None or cand.expected_wall_s < best.expected_wall_s:
             best = cand
@@ -240,7 +278,8 @@ def scene_cost(scene: Any, height: float, period: float,
     method = next((m for m, o in METHODS.items()
                    if o.get("integrator", "kdk") == c.integrator
                    and abs(o.get("h_over_dp", 1.4142) - c.h_over_dp) < 1e-3), "wcsph_kdk")
-    fit = fit_error(rows, method) or fit_error(rows, "wcsph_kdk")
+    wave = (height, period, scene.still_water_level - scene.tank.z0)
+    fit = fit_error(rows, method, wave) or fit_error(rows, "wcsph_kdk", wave)
     tp = median_throughput(rows, method) or median_throughput(rows, "wcsph_kdk")
     depth = scene.still_water_level - scene.tank.z0
     n = count_particles(scene)

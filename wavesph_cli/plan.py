@@ -53,7 +53,8 @@ def main(args: argparse.Namespace) -> int:
     for a, b, c in rows:
         print(f"{a:<18} {b:<26} {c}")
     print(f"(fit error = {plan.fit['a']:.3g} (H/dp)^-{plan.fit['p']:.2f} over {plan.fit['n']} "
-          f"points; throughput {plan.throughput:.3g} particle-steps/s)")
+          f"sweep points, level of {plan.fit.get('case', 'all cases')}; throughput "
+          f"{plan.throughput:.3g} particle-steps/s)")
     print(json.dumps(out))
     return 0
 
