@@ -232,22 +232,29 @@ def _koshizuka_oka() -> tuple[Any, Any]:
 
 
 def _coupled(point: Point) -> dict[str, Any]:
+    import contextlib
+    import io
     import tempfile
 
     from .coupled_flume import FlumeCase, reference_run, rmse_over_h, run_coupled, run_sph_only
 
     c = FlumeCase(wavelengths=point.options.get("wavelengths", 2.0),
                   compare_periods=point.options.get("compare_periods", 2.0)).at(point.dp)
+    log = io.StringIO()   # run_coupled reports a failed coupling on stderr: keep it as the reason
     with tempfile.TemporaryDirectory(prefix="wavesph-sweep-") as tmp:
         if point.method == "coupled":
-            res = run_coupled(c, point.dp, Path(tmp), two_way=True)
+            with contextlib.redirect_stderr(log):
+                res = run_coupled(c, point.dp, Path(tmp), two_way=True)
         elif point.method == "sph_only":
             res = run_sph_only(c, point.dp, Path(tmp))
         else:
             raise ValueError(f"coupled case: method must be one of {COUPLED_METHODS}")
     if res["state"] != "finished" or "t" not in res:
-        return {"H_over_dp": c.height / point.dp, "status": "unstable",
-                "reason": f"run ended {res['state']}: {res['status']}", "wall_s": res["wall_s"],
+        failed = res.get("exit_code") == 1 or "unstable" not in str(res["status"])
+        return {"H_over_dp": c.height / point.dp, "status": "failed" if failed else "unstable",
+                "reason": f"run ended {res['state']}: {res['status']}"
+                          + (f"; client: {log.getvalue().strip()[-300:]}" if log.getvalue() else ""),
+                "wall_s": res["wall_s"],
                 "particles": res["particles"], "steps": res["steps"]}
     t, eta = res["t"], res["eta"]["flat"]
     err = rmse_over_h(t, eta, reference_run(c, t)["flat"], c)
