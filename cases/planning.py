@@ -309,11 +309,19 @@ def expense_warning(scene: Any, height: float, period: float,
             "see `wavesph plan`")
 
 
-def measure_throughput(method: str = "wcsph_kdk", seconds: float = 0.5) -> float:
-    """Particle-steps per wall second of a short flume run here and now (same process, same
-    load): the plan's wall prediction then compares like with like."""
-    from .sweeps import Point, _flume, warm_up
+def measure_throughput(method: str = "wcsph_kdk", seconds: float = 1.0) -> float:
+    """Particle-steps per wall second of a short flume run (case V's wave at dp = 0.03 m, the
+    first ``seconds`` simulated) here and now, same process, same load: the plan's wall
+    prediction then compares like with like."""
+    from wave_client.theories import build_theory
+
+    from .sweeps import warm_up
+    from .wave_flume import run_wave_flume, wave_flume_scene
 
     warm_up(method)
-    rec = _flume(Point("flume_V", method, 0.03, {"periods": seconds / 2.0, "ramp_periods": 0.25}))
-    return rec["particles"] * rec["steps"] / rec["wall_s"]
+    model = build_theory("stream", height=0.06, period=2.0, depth=0.3, ramp_time=2.0,
+                         n_fourier=16)
+    scene = wave_flume_scene(depth=0.3, wavelength=float(model.length), height=0.06, dp=0.03,
+                             t_end=seconds, probe_every=2.0 / 40, **METHODS[method])
+    run = run_wave_flume(scene, model, window=2.0 / WINDOWS_PER_PERIOD)
+    return run.particles * run.steps / run.wall_s

@@ -263,3 +263,20 @@ def test_quick_stability_suite_has_no_nan(tmp_path):
     # still water must stay stable with the default method
     still = next(r for r in rows if r["scenario"] == "still_water" and r["method"] == "wcsph_kdk")
     assert still["status"] == "stable", still
+
+
+def test_wavesph_run_wave_option_warns_on_stderr(capsys):
+    """`wavesph run SCENE --wave H T`: the plan's warning (shipped sweep data) for a flume ten
+    wavelengths long all in SPH; nothing for the planned zone itself."""
+    from wavesph_cli.run import _warn_if_expensive
+
+    req = planning.PlanRequest(height=0.06, period=2.0, depth=0.3, duration=5.0)
+    planned = planning.zone_scene(req, 0.03)
+    _warn_if_expensive(planned, 0.06, 2.0)
+    assert "warning" not in capsys.readouterr().err
+    x1 = 10 * planned.tank.x1
+    long = planned.model_copy(update={
+        "tank": planned.tank.model_copy(update={"x1": x1}),
+        "water_blocks": [planned.water_blocks[0].model_copy(update={"x1": x1})]})
+    _warn_if_expensive(long, 0.06, 2.0)
+    assert "warning: this scene is predicted to cost" in capsys.readouterr().err
