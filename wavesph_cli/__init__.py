@@ -21,6 +21,10 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "serve": ("wavesph_cli.serve", "start the SPH coupling server (HTTP + WebSocket + TCP)"),
     "couple": ("wavesph_cli.couple", "couple a wave model to a running server"),
     "waves": ("wavesph_cli.waves", "run the Boussinesq wave model alone"),
+    "bench": ("wavesph_cli.bench", "speed-accuracy sweep and stability suite on dask "
+                                   "(accuracy | stability)"),
+    "plan": ("wavesph_cli.plan", "propose dp, SPH zone, coupling window and method for a scene, "
+                                 "with predicted error and wall time"),
 }
 
 OUR_PACKAGES = {"protocol", "sph_core", "wave_client", "server", "cases"}

@@ -28,6 +28,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--threads", type=int, default=None,
                         help="numba threads (default: NUMBA_NUM_THREADS or all cores)")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar or lines")
+    parser.add_argument("--wave", type=float, nargs=2, metavar=("H", "T"), default=None,
+                        help="the waves the scene is for (height [m], period [s]): warn if the "
+                             "scene costs far more than `wavesph plan`'s for the same accuracy")
 
 
 def main(args: argparse.Namespace) -> int:
@@ -58,6 +61,8 @@ def main(args: argparse.Namespace) -> int:
                   file=sys.stderr)
             return 2
         numba.set_num_threads(args.threads)
+    if args.wave is not None:
+        _warn_if_expensive(scene, *args.wave)
     out = args.out or Path("runs") / f"{scene.name}-{time.strftime('%Y%m%dT%H%M%SZ', time.gmtime())}"
     if refuse_non_empty("run", out):
         return 2
@@ -76,3 +81,16 @@ def main(args: argparse.Namespace) -> int:
               f"({sim.n_particles * sim.steps / max(sim.wall_time, 1e-9) / 1e6:.2f} M particle-steps/s); "
               f"results in {out}", file=sys.stderr)
     return code
+
+
+def _warn_if_expensive(scene, height: float, period: float) -> None:
+    """The plan's warning (cases.planning.expense_warning) on stderr; the run goes on."""
+    from cases.planning import expense_warning
+
+    try:
+        msg = expense_warning(scene, height, period)
+    except ValueError as exc:   # no still-water level, no sweep data: nothing to compare
+        msg = None
+        print(f"wavesph run: no plan comparison ({exc})", file=sys.stderr)
+    if msg:
+        print(f"wavesph run: warning: {msg}", file=sys.stderr)
