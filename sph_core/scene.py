@@ -82,6 +82,16 @@ class Constants(_Model):
     alpha: float = Field(0.01, ge=0, description="Monaghan artificial viscosity coefficient")
     nu: float = Field(1.0e-6, ge=0, description="laminar kinematic viscosity [m^2/s]")
     delta: float = Field(0.1, ge=0, description="delta-SPH density diffusion coefficient")
+    alpha_wall_factor: float = Field(1.0, ge=0, description=(
+        "artificial viscosity against walls = this x alpha (DualSPHysics' ViscoBoundFactor); "
+        "applies with no_slip walls only"))
+    shifting: Literal["none", "fickian"] = Field("none", description=(
+        "particle shifting after each step: fickian = Lind et al. 2012, tangential only near "
+        "the free surface (sph_core.shifting)"))
+    shift_a: float = Field(2.0, gt=0, description="shifting coefficient A: D = A h |v| dt")
+    shift_fs_div: float = Field(1.8, gt=0, lt=2, description=(
+        "position divergence below which a particle counts as near the free surface (2D: 2 "
+        "inside the fluid) and shifts only tangentially"))
     wall_slip: Literal["no_slip", "free_slip"] = "no_slip"
     density_band: tuple[float, float] = Field((0.7, 1.3), description="sane rho/rho0 band")
     # A drop thrown off the surface (splash, run-up on a staircase bed) keeps few neighbours: its
