@@ -3,7 +3,7 @@
     python bench/wave_decay.py [--H 0.04 --T 1.4 --d 0.24] [--dp 0.02 0.01 0.005] [--periods 4]
         [--h-over-dp 2.0] [--alpha 0.01] [--slip no_slip|free_slip] [--c0-factor 10] [--delta 0.1]
         [--cfl 0.25] [--nu 1e-6] [--alpha-wall 1.0] [--shifting none|fickian] [--shift-a 2.0]
-        [--shift-fs-div 1.8]
+        [--shift-fs-div 1.8] [--flume-wavelengths 1]
 
 A flume one wavelength long with open ends driven by second-order Stokes theory (the wave of the
 coupled flume, server/coupled_flume.py, by default), gauges from 2h past the inlet to 3/4 of the
@@ -20,6 +20,9 @@ convergence order of the decay between successive dp, log(decay_1/decay_2)/log(d
 separated_decay_per_m, separated_k_over_k_theory (SPH's wavenumber: phase-speed error),
 separated_reflection: an incident and a reflected wave with one decay rate and wavenumber
 fitted to the complex amplitudes (sph_core.wave_decay.separated_decay).
+ratio_first_half / ratio_second_half: the ratio over each half of the window (a loss that
+grows in time rather than along x shows here); mean_eta_error_mm: time-mean SPH minus theory
+elevation per gauge; level_drift_mm: change of the flume's mean level from its fluid count.
 """
 
 from __future__ import annotations
@@ -34,16 +37,8 @@ from pathlib import Path
 os.environ.setdefault("OMP_WAIT_POLICY", "passive")  # before numba: shared, loaded cores
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from sph_core.wave_decay import amplitude_profile, separated_decay  # noqa: E402
+from sph_core.wave_decay import amplitude_profile, convergence_orders, separated_decay  # noqa: E402
 from wave_client.theories import build_theory  # noqa: E402
-
-
-def convergence_orders(dps: list[float], decays: list[float]) -> list[float | None]:
-    """Observed order of the decay between successive resolutions (None where a decay is <= 0)."""
-    out: list[float | None] = []
-    for (d1, k1), (d2, k2) in zip(zip(dps, decays), zip(dps[1:], decays[1:])):
-        out.append(round(math.log(k1 / k2) / math.log(d1 / d2), 3) if k1 > 0 and k2 > 0 else None)
-    return out
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -53,6 +48,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--d", type=float, default=0.24, help="still-water depth [m]")
     ap.add_argument("--dp", type=float, nargs="+", default=[0.02], help="particle spacing(s) [m]")
     ap.add_argument("--periods", type=float, default=4.0, help="periods analysed")
+    ap.add_argument("--flume-wavelengths", type=float, default=1.0,
+                    help="flume length in wavelengths (gauges stay within 3/4 of the first)")
     ap.add_argument("--h-over-dp", type=float, help="smoothing length / dp (scene default if unset)")
     ap.add_argument("--alpha", type=float, help="artificial viscosity coefficient")
     ap.add_argument("--slip", choices=["no_slip", "free_slip"], help="wall (bed) condition")
@@ -74,12 +71,14 @@ def main(argv: list[str] | None = None) -> int:
     for dp in a.dp:
         model = build_theory("stokes", height=a.H, period=a.T, depth=a.d, ramp_time=a.T, order=2)
         prof = amplitude_profile(model, ramp=a.T, height=a.H, period=a.T, depth=a.d, dp=dp,
-                                 periods=a.periods, c0=c0, **cst)
+                                 periods=a.periods, flume_wavelengths=a.flume_wavelengths,
+                                 c0=c0, **cst)
         length = float(model.length)
         decays.append(prof.decay_per_m)
         sep_decay, sep_k, sep_kr = separated_decay(prof.x, prof.amp, prof.k)
         print(json.dumps({"H": a.H, "T": a.T, "d": a.d, "dp": dp, "H_over_dp": round(a.H / dp, 3),
                           "constants": cst, "c0_factor": a.c0_factor,
+                          "flume_wavelengths": a.flume_wavelengths,
                           "wavelength_m": round(length, 4),
                           "x": prof.x.tolist(),
                           "amplitude_ratio": [round(float(r), 4) for r in prof.ratio],
@@ -88,6 +87,10 @@ def main(argv: list[str] | None = None) -> int:
                           "separated_decay_per_m": round(sep_decay, 4),
                           "separated_k_over_k_theory": round(sep_k / prof.k, 4),
                           "separated_reflection": round(sep_kr, 4),
+                          "ratio_first_half": [round(float(r), 4) for r in prof.ratio_first_half],
+                          "ratio_second_half": [round(float(r), 4) for r in prof.ratio_second_half],
+                          "mean_eta_error_mm": [round(1e3 * float(e), 2) for e in prof.mean_eta_error],
+                          "level_drift_mm": round(1e3 * prof.level_drift_m, 2),
                           "amplitude_at_0_8m": round(prof.ratio_at(0.8), 4),
                           "wall_s": round(prof.wall_s, 1), "particles": prof.particles,
                           "steps": prof.steps,

@@ -38,6 +38,12 @@ class AmplitudeProfile:
     steps: int = 0
     amp: np.ndarray | None = None   # complex first-harmonic amplitudes of SPH at x [m]
     k: float = 0.0                  # the theory's wavenumber [1/m]
+    # diagnostics: first and second half of the window's ratio; time-mean eta of SPH minus
+    # theory [m] per gauge; the flume's mean level change [m] from its fluid particle count
+    ratio_first_half: np.ndarray | None = None
+    ratio_second_half: np.ndarray | None = None
+    mean_eta_error: np.ndarray | None = None
+    level_drift_m: float = 0.0
 
     def ratio_at(self, x: float) -> float:
         """The fitted ratio at ``x`` [m] (the outlet's small reflection ripples the profile)."""
@@ -46,15 +52,17 @@ class AmplitudeProfile:
 
 def amplitude_profile(model: Any, *, ramp: float, height: float, period: float, depth: float,
                       dp: float, periods: float = 4.0, n_gauges: int = 12,
-                      **constants: Any) -> AmplitudeProfile:
+                      flume_wavelengths: float = 1.0, **constants: Any) -> AmplitudeProfile:
     """Run the flume driven by ``model`` (its start-up ramp lasting ``ramp`` s) and measure
-    the amplitude ratio along it (``constants`` override the scene's, e.g. alpha)."""
+    the amplitude ratio along it (``constants`` override the scene's, e.g. alpha). The flume is
+    ``flume_wavelengths`` long; the gauges stay within 3/4 of a wavelength of the inlet."""
     length = float(model.length)
     xs = np.round(np.linspace(2.0 * math.sqrt(2.0) * dp, 0.75 * length, n_gauges), 4)
     # the ramped front and one period past the last gauge
     t0 = ramp + xs[-1] / group_velocity(length, period, depth) + period
     scene = wave_flume_scene(depth=depth, wavelength=length, height=height, dp=dp,
-                             t_end=t0 + periods * period, length=length, absorb=(True, True),
+                             t_end=t0 + periods * period, length=flume_wavelengths * length,
+                             absorb=(True, True),
                              right_elevation="extrapolated", probe_every=period / 40,
                              name="wave_decay", **constants)
     probes = [ElevationProbe(kind="elevation", name=f"g{i}", x=float(x)) for i, x in enumerate(xs)]
@@ -67,8 +75,20 @@ def amplitude_profile(model: Any, *, ramp: float, height: float, period: float, 
     ratio = np.array([abs(a) / abs(harmonic_amplitude(res.t[sel], res.theory[p.name][sel], omega))
                       for a, p in zip(amp, probes)])
     slope, icpt = np.polyfit(xs, np.log(ratio), 1)
+
+    def half_ratio(part: np.ndarray) -> np.ndarray:
+        return np.array([abs(harmonic_amplitude(res.t[part], res.eta[p.name][part], omega))
+                         / abs(harmonic_amplitude(res.t[part], res.theory[p.name][part], omega))
+                         for p in probes])
+
+    nh = sel.size // 2
+    mean_err = np.array([np.mean(res.eta[p.name][sel]) - np.mean(res.theory[p.name][sel])
+                         for p in probes])
+    nf = res.n_fluid
+    drift = float((nf[-1, 1] - nf[0, 1]) * dp * dp / scene.tank.x1)
     return AmplitudeProfile(xs, ratio, float(-slope), float(icpt), res.wall_s, res.particles,
-                            res.steps, amp, 2.0 * math.pi / length)
+                            res.steps, amp, 2.0 * math.pi / length, half_ratio(sel[:nh]),
+                            half_ratio(sel[nh:]), mean_err, drift)
 
 
 def separated_decay(x: np.ndarray, amp: np.ndarray, k: float) -> tuple[float, float, float]:
@@ -93,3 +113,12 @@ def separated_decay(x: np.ndarray, amp: np.ndarray, k: float) -> tuple[float, fl
     a = np.stack([np.exp(-(1j * kk + dl) * xc), np.exp((1j * kk + dl) * xc)], axis=1)
     (a_i, a_r), *_ = np.linalg.lstsq(a, amp, rcond=None)
     return float(dl), float(kk), float(abs(a_r) / abs(a_i))
+
+
+def convergence_orders(dps: list[float], decays: list[float]) -> list[float | None]:
+    """Observed order of the decay between successive resolutions,
+    log(decay_1 / decay_2) / log(dp_1 / dp_2) (None where a decay is <= 0)."""
+    out: list[float | None] = []
+    for (d1, k1), (d2, k2) in zip(zip(dps, decays), zip(dps[1:], decays[1:])):
+        out.append(round(math.log(k1 / k2) / math.log(d1 / d2), 3) if k1 > 0 and k2 > 0 else None)
+    return out
