@@ -15,7 +15,7 @@ parallel to dr_i and could not split it. The
 shifted particle's velocity and density are carried to its new position to first order (Lind
 et al. 2012, eq. 26), rho_i += dr_i . grad rho_i, v_i += dr_i . grad v_i with
 grad phi_i = sum_j V_j (phi_j - phi_i) grad_i W_ij: without it a vertical shift would carry the
-hydrostatic density of its old height. |dr_i| is capped at ``max_frac`` dp.
+hydrostatic density of its old height. |dr_i| is capped at 0.05 h.
 
 The displacement and the carried increments are gathered into the scratch rows XN, ZN, VXN,
 VZN, RHON (kdk does not use them; symplectic_pc rewrites them at its next predictor) and applied in a second loop, so no particle
@@ -29,32 +29,40 @@ import math
 from numba import njit, prange
 
 from .kernels import f_of_q
-from .particles import FLUID, M, OUTLET, RHO, RHON, VX, VXN, VZ, VZN, WALL, XN, ZN, X, Z
-
-# the tangential-only band: a full support gives div r = 2 (2D); one row of particles below a
-# flat surface on a square lattice at h/dp 1.4-2 has div r ~ 1.0-1.2, the second ~ 1.6-1.8
-FS_DIV_DEFAULT = 1.8
-
+from .particles import FLUID, OUTLET, WALL
 
 @njit(parallel=True, cache=True)
-def shift_particles(f, kind, cell, cell_start, n: int, ncx: int, ncz: int, h: float,
-                    alpha_f: float, dt: float, coef: float, fs_div: float, max_shift: float) -> None:
-    """Shift every fluid particle (see the module docstring); positions stay inside their cell
-    neighbourhood (|dr| <= max_shift << cell size), so the cell lists stay valid."""
-    x = f[X]
-    z = f[Z]
-    vx = f[VX]
-    vz = f[VZ]
-    rho = f[RHO]
-    m = f[M]
+def shift_particles(ps, n, cells, prm, dt):
+    """Shift every fluid particle of the sorted state ``ps`` by A = ``prm.shift_a`` (see the
+    module docstring); |dr| <= 0.05 h << the cell size, so the cell lists stay valid."""
+    x = ps.x
+    z = ps.z
+    vx = ps.vx
+    vz = ps.vz
+    rho = ps.rho
+    m = ps.m
+    kind = ps.kind
+    cell = ps.cell
+    cell_start = cells.start
+    ncx = cells.ncx
+    h = prm.h
+    alpha_f = prm.alpha_f
+    coef = prm.shift_a
+    fs_div = prm.shift_fs_div
+    max_shift = 0.05 * h
     s2 = 4.0 * h * h
     inv_h = 1.0 / h
+    sxr = ps.xn    # scratch rows (see the module docstring)
+    szr = ps.zn
+    srho = ps.rhon
+    svx = ps.vxn
+    svz = ps.vzn
     for i in prange(n):
-        f[XN, i] = 0.0
-        f[ZN, i] = 0.0
-        f[RHON, i] = 0.0
-        f[VXN, i] = 0.0
-        f[VZN, i] = 0.0
+        sxr[i] = 0.0
+        szr[i] = 0.0
+        srho[i] = 0.0
+        svx[i] = 0.0
+        svz[i] = 0.0
         if kind[i] != FLUID:
             continue
         xi = x[i]
@@ -69,7 +77,7 @@ def shift_particles(f, kind, cell, cell_start, n: int, ncx: int, ncz: int, h: fl
         cx = c - cz * ncx
         cxl = cx - 1 if cx > 0 else 0
         cxh = cx + 1 if cx < ncx - 1 else ncx - 1
-        for zz in range(max(cz - 1, 0), min(cz + 2, ncz)):
+        for zz in range(max(cz - 1, 0), min(cz + 2, cells.ncz)):
             row = zz * ncx
             for j in range(cell_start[row + cxl], cell_start[row + cxh + 1]):
                 kj = kind[j]
@@ -121,16 +129,16 @@ def shift_particles(f, kind, cell, cell_start, n: int, ncx: int, ncz: int, h: fl
         if s > max_shift:
             sx *= max_shift / s
             sz *= max_shift / s
-        f[XN, i] = sx
-        f[ZN, i] = sz
+        sxr[i] = sx
+        szr[i] = sz
         # first-order carry of rho and v to the new position
-        f[RHON, i] = sx * grx + sz * grz
-        f[VXN, i] = sx * gux + sz * guz
-        f[VZN, i] = sx * gwx + sz * gwz
+        srho[i] = sx * grx + sz * grz
+        svx[i] = sx * gux + sz * guz
+        svz[i] = sx * gwx + sz * gwz
     for i in prange(n):
         if kind[i] == FLUID:
-            x[i] += f[XN, i]
-            z[i] += f[ZN, i]
-            rho[i] += f[RHON, i]
-            vx[i] += f[VXN, i]
-            vz[i] += f[VZN, i]
+            x[i] += sxr[i]
+            z[i] += szr[i]
+            rho[i] += srho[i]
+            vx[i] += svx[i]
+            vz[i] += svz[i]

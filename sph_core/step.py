@@ -53,6 +53,7 @@ from numba import njit
 from .neighbours import sort_by_cell
 from .open_boundary import extrapolate_buffers, measure_boundaries, update_buffers
 from .particles import N_SORTED_KDK, N_SORTED_PC
+from .shifting import shift_particles
 from .wcsph import (KDK, ST_CAPACITY, ST_DENSITY, ST_LEFT_DOMAIN, ST_NONFINITE, ST_REACHED_T,
                     ST_STEP_LIMIT, fluid_pass, kdk_kick, kdk_kick_drift, pc_correct, pc_predict,
                     stable_dt, update_pressure, wall_pass)
@@ -91,6 +92,8 @@ def _step_kdk(ps, ps2, cells, prm, ends, n, t, dt):
     extrapolate_buffers(ps2, n, cells, ends, prm)
     _forces(ps2, n, cells, prm)
     n_bad, n_band, v2max, a2max, rmax = kdk_kick(ps2, n, dt, prm)
+    if prm.shift_a > 0.0:
+        shift_particles(ps2, n, cells, prm, dt)
     measure_boundaries(ps2, cells, ends, prm)
     return _verdict(n, n_bad, n_band, 0, v2max, a2max, rmax)
 
@@ -105,6 +108,8 @@ def _step_pc(ps, ps2, cells, prm, ends, n, t, dt):
     pc_predict(ps2, n, dt, prm)
     _forces(ps2, n, cells, prm)
     n_bad, n_band, n_out, v2max, a2max, rmax = pc_correct(ps2, n, dt, prm)
+    if prm.shift_a > 0.0:
+        shift_particles(ps2, n, cells, prm, dt)
     if n_bad == 0 and n_out == 0:
         n_new = update_buffers(ps2, n, t + dt, dt, ends, prm)
         if n_new < 0:

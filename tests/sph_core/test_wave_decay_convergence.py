@@ -2,7 +2,8 @@
 
 The closed-tank standing wave of sph_core.standing_wave (the wave of bench/wave_decay.py without
 inlet, outlet or gauge; docs/wave_decay_study.md) at three resolutions, scene defaults
-(h/dp 2, alpha 0.01, no artificial viscosity against the walls). Measured on the study's machine
+(h/dp 2, alpha 0.01) without artificial viscosity against the walls (alpha_wall_factor 0: with
+it the loss does not converge, 6.09 -> 4.73 %/m). Measured on the study's machine
 (6 periods): equivalent decay 1.80 %/m at dp 0.02 and 1.24 %/m at dp 0.01, order 0.54 -- far
 from the issue's target of 1.5: the remaining loss converges slowly (see the study). The
 assertions hold what was measured as achievable, with margin for round-off and load only.
@@ -20,7 +21,7 @@ DPS = [0.025, 0.02, 0.01]   # tank 1.0 m long: whole numbers of spacings (no gap
 
 @pytest.mark.slow
 def test_standing_wave_loss_converges_with_resolution():
-    runs = [standing_wave_decay(dp=dp, periods=6.0) for dp in DPS]
+    runs = [standing_wave_decay(dp=dp, periods=6.0, alpha_wall_factor=0.0) for dp in DPS]
     decays = [r.equiv_decay_per_m for r in runs]
     for r in runs:
         # particle-scale noise stays a small share of the wave's kinetic energy
