@@ -45,13 +45,15 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--slip", choices=["no_slip", "free_slip"])
     ap.add_argument("--delta", type=float)
     ap.add_argument("--cfl", type=float)
+    ap.add_argument("--integrator", choices=["kdk", "symplectic_pc"])
     ap.add_argument("--nu", type=float)
     ap.add_argument("--shifting", choices=["none", "fickian"])
     ap.add_argument("--shift-a", type=float)
     ap.add_argument("--shift-fs-div", type=float)
     a = ap.parse_args(argv)
     cst = {k: v for k, v in {"h_over_dp": a.h_over_dp, "alpha": a.alpha, "wall_slip": a.slip,
-                             "delta": a.delta, "cfl": a.cfl, "nu": a.nu, "shifting": a.shifting,
+                             "delta": a.delta, "cfl": a.cfl, "nu": a.nu,
+                             "integrator": a.integrator, "shifting": a.shifting,
                              "shift_a": a.shift_a, "shift_fs_div": a.shift_fs_div,
                              "alpha_wall_factor": a.alpha_wall}.items() if v is not None}
     decays = []

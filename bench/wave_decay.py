@@ -2,7 +2,8 @@
 
     python bench/wave_decay.py [--H 0.04 --T 1.4 --d 0.24] [--dp 0.02 0.01 0.005] [--periods 4]
         [--h-over-dp 2.0] [--alpha 0.01] [--slip no_slip|free_slip] [--c0-factor 10] [--delta 0.1]
-        [--cfl 0.25] [--nu 1e-6] [--alpha-wall 1.0] [--shifting none|fickian] [--shift-a 2.0]
+        [--cfl 0.25] [--integrator kdk|symplectic_pc] [--nu 1e-6] [--alpha-wall 1.0]
+        [--shifting none|fickian] [--shift-a 2.0]
         [--shift-fs-div 1.8] [--flume-wavelengths 1]
 
 A flume one wavelength long with open ends driven by second-order Stokes theory (the wave of the
@@ -10,7 +11,6 @@ coupled flume, server/coupled_flume.py, by default), gauges from 2h past the inl
 flume (sph_core/wave_decay.py). No coupling and no wave model but the theory: the SPH wave's own
 loss, the floor under any coupled flume's error at that dp. Every option left out keeps the
 scene's default (sph_core.scene.Constants); c0 = c0_factor sqrt(g d) (the flume's default 10).
-The open flume runs the kdk integrator only (OpenFlume refuses symplectic_pc).
 
 Prints one JSON line per dp: H, T, d, dp, H_over_dp, the options, x, amplitude_ratio (SPH /
 theory, first harmonic), decay_per_m (least squares of the log), loss_per_wavelength
@@ -56,6 +56,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--c0-factor", type=float, default=10.0, help="c0 = factor * sqrt(g d)")
     ap.add_argument("--delta", type=float, help="delta-SPH density diffusion coefficient")
     ap.add_argument("--cfl", type=float, help="Courant number")
+    ap.add_argument("--integrator", choices=["kdk", "symplectic_pc"])
     ap.add_argument("--nu", type=float, help="laminar kinematic viscosity [m^2/s]")
     ap.add_argument("--shifting", choices=["none", "fickian"], help="particle shifting")
     ap.add_argument("--shift-a", type=float, help="shifting coefficient A (Lind et al. 2012)")
@@ -63,7 +64,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--alpha-wall", type=float, help="artificial viscosity factor against walls")
     a = ap.parse_args(argv)
     cst = {k: v for k, v in {"h_over_dp": a.h_over_dp, "alpha": a.alpha, "wall_slip": a.slip,
-                             "delta": a.delta, "cfl": a.cfl, "nu": a.nu, "shifting": a.shifting,
+                             "delta": a.delta, "cfl": a.cfl, "nu": a.nu,
+                             "integrator": a.integrator, "shifting": a.shifting,
                              "shift_a": a.shift_a, "shift_fs_div": a.shift_fs_div,
                              "alpha_wall_factor": a.alpha_wall}.items() if v is not None}
     c0 = a.c0_factor * math.sqrt(9.81 * a.d)

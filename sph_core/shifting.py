@@ -1,25 +1,26 @@
 """Fickian particle shifting with free-surface detection (Lind et al. 2012; Skillen et al. 2013).
 
 After each step every fluid particle i moves by
-    dr_i = -D_i grad C_i,   D_i = A h |v_i| dt,   grad C_i = sum_j V_j grad_i W_ij = -sum_j V_j F_ij r_ij
+    dr_i = -D_i grad C_i,   D_i = A h |v_i| dt   (A = Constants.shift_a),
+    grad C_i = sum_j V_j grad_i W_ij = -sum_j V_j F_ij r_ij
 (j: fluid, wall and active buffer neighbours; V_j = m_j / rho_j), towards lower particle
 concentration: a disordered lattice relaxes back to a regular one, which keeps the kernel sums
 (and so the pressure gradient's zeroth-order error) small. Near the free surface the
-concentration falls because fluid ends, not because of disorder: a particle whose position
+concentration falls because the fluid ends, not because of disorder: a particle whose position
 divergence
-    div r_i = sum_j V_j F_ij |r_ij|^2       (= 2 in 2D with a full support)
-is below ``fs_div`` keeps only the component of dr_i tangent to the surface (Lind et al. 2012: no
-shifting normal to the surface), whose normal is the renormalised n_i = -B_i^-1 grad C_i / |.|,
-B_i = sum_j V_j F_ij r_ij r_ij^T (Marrone et al. 2010; div r_i = trace B_i); grad C_i alone is
-parallel to dr_i and could not split it. The
-shifted particle's velocity and density are carried to its new position to first order (Lind
-et al. 2012, eq. 26), rho_i += dr_i . grad rho_i, v_i += dr_i . grad v_i with
-grad phi_i = sum_j V_j (phi_j - phi_i) grad_i W_ij: without it a vertical shift would carry the
-hydrostatic density of its old height. |dr_i| is capped at 0.05 h.
+    div r_i = trace B_i,   B_i = sum_j V_j F_ij r_ij r_ij^T    (div r = 2 in 2D, full support)
+is below ``shift_fs_div`` keeps only the component of dr_i tangent to the surface (Lind et al.
+2012: no shifting normal to the surface). The normal is the renormalised
+n_i = -B_i^-1 grad C_i / |B_i^-1 grad C_i| (Marrone et al. 2010; Sun et al. 2017): grad C_i itself
+is parallel to dr_i and could not split it. The shifted particle's density and velocity are
+carried to its new position to first order (Lind et al. 2012), rho_i += dr_i . grad rho_i,
+v_i += dr_i . grad v_i, grad phi_i = sum_j V_j (phi_j - phi_i) grad_i W_ij: without it a vertical
+shift would keep the hydrostatic density of its old height. |dr_i| is capped at 0.05 h.
 
-The displacement and the carried increments are gathered into the scratch rows XN, ZN, VXN,
-VZN, RHON (kdk does not use them; symplectic_pc rewrites them at its next predictor) and applied in a second loop, so no particle
-reads a neighbour that has already moved.
+The displacement and the carried increments are gathered into the scratch rows xn, zn, vxn,
+vzn, rhon (kdk does not use them; symplectic_pc rewrites them at its next predictor) and applied
+in a second loop, so no particle reads a neighbour that has already moved. Measured effect on
+the wave of bench/wave_decay.py: none for the better at h/dp 2 (docs/wave_decay_study.md).
 """
 
 from __future__ import annotations
