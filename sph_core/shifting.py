@@ -30,6 +30,7 @@ import math
 from numba import njit, prange
 
 from .kernels import f_of_q
+from .neighbours import block_of
 from .particles import FLUID, OUTLET, WALL
 
 @njit(parallel=True, cache=True)
@@ -73,12 +74,8 @@ def shift_particles(ps, n, cells, prm, dt):
         bxx = bxz = bzz = 0.0
         # velocity and density gradients (for the first-order carry of v and rho)
         gux = guz = gwx = gwz = grx = grz = 0.0
-        c = cell[i]
-        cz = c // ncx
-        cx = c - cz * ncx
-        cxl = cx - 1 if cx > 0 else 0
-        cxh = cx + 1 if cx < ncx - 1 else ncx - 1
-        for zz in range(max(cz - 1, 0), min(cz + 2, cells.ncz)):
+        cxl, cxh, czl, czh = block_of(cell[i], cells)
+        for zz in range(czl, czh + 1):
             row = zz * ncx
             for j in range(cell_start[row + cxl], cell_start[row + cxh + 1]):
                 kj = kind[j]
