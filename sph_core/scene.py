@@ -76,11 +76,11 @@ class Constants(_Model):
     g: float = Field(9.81, gt=0, description="gravity [m/s^2], acting in -z")
     c0: float | None = Field(None, gt=0, description="speed of sound [m/s]; default c0_factor*sqrt(2 g H)")
     c0_factor: float = Field(10.0, gt=0, description="c0 = c0_factor * sqrt(2 g H), H = water height")
-    # h/dp 2 (about 50 neighbours) against sqrt(2) (about 25): a progressive wave loses 6.2
-    # instead of 14 %/m at H/dp 2, its phase speed error falls from -3.6 % to -0.3 %, the
-    # particle-scale kinetic energy 25x (docs/wave_decay_study.md); ~1.4x the cost per
-    # simulated second (twice the pairs, 0.7x the steps)
-    h_over_dp: float = Field(2.0, ge=1.0, le=2.0, description="smoothing length h / dp")
+    # h/dp 2 measures far better for waves (14 -> 6.2 %/m at H/dp 2, docs/wave_decay_study.md)
+    # but as the default it makes tests/sph_core/test_open_boundary.py's still open flume lose
+    # one fluid particle: not made the default until that is understood
+    h_over_dp: float = Field(1.4142, ge=1.0, le=2.0,
+                             description="smoothing length h / dp; sqrt(2) keeps the lattice gradient moment within 1%")
     cfl: float = Field(0.25, gt=0, le=0.5, description="Courant number of the adaptive time step")
     alpha: float = Field(0.01, ge=0, description="Monaghan artificial viscosity coefficient")
     nu: float = Field(1.0e-6, ge=0, description="laminar kinematic viscosity [m^2/s]")

@@ -1,8 +1,8 @@
 """The SPH wave's own loss falls with resolution (slow: about 10 min on one loaded core).
 
 The closed-tank standing wave of sph_core.standing_wave (the wave of bench/wave_decay.py without
-inlet, outlet or gauge; docs/wave_decay_study.md) at three resolutions, scene defaults
-(h/dp 2, alpha 0.01) without artificial viscosity against the walls (alpha_wall_factor 0: with
+inlet, outlet or gauge; docs/wave_decay_study.md) at three resolutions, h/dp 2, alpha 0.01
+(scene default) without artificial viscosity against the walls (alpha_wall_factor 0: with
 it the loss does not converge, 6.09 -> 4.73 %/m). Measured on the study's machine
 (6 periods): equivalent decay 2.28, 1.80 and 1.24 %/m at dp 0.025, 0.02 and 0.01 (order 0.67
 overall, 0.54 over the last halving), noise <= 0.23 % of the wave's kinetic energy -- far from
@@ -22,7 +22,7 @@ DPS = [0.025, 0.02, 0.01]   # tank 1.0 m long: whole numbers of spacings (no gap
 
 @pytest.mark.slow
 def test_standing_wave_loss_converges_with_resolution():
-    runs = [standing_wave_decay(dp=dp, periods=6.0, alpha_wall_factor=0.0) for dp in DPS]
+    runs = [standing_wave_decay(dp=dp, periods=6.0, h_over_dp=2.0, alpha_wall_factor=0.0) for dp in DPS]
     decays = [r.equiv_decay_per_m for r in runs]
     for r in runs:
         # particle-scale noise stays a small share of the wave's kinetic energy
