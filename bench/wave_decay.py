@@ -1,20 +1,35 @@
 """How much does the SPH flume damp a progressive wave over distance, at a given resolution?
 
-    python bench/wave_decay.py [--H 0.04 --T 1.4 --d 0.24] [--dp 0.02] [--alpha 0.01] [--periods 4]
+    python bench/wave_decay.py [--H 0.04 --T 1.4 --d 0.24] [--dp 0.02 0.01 0.005] [--periods 4]
+        [--h-over-dp 2.0] [--alpha 0.01] [--slip no_slip|free_slip] [--c0-factor 10] [--delta 0.1]
+        [--cfl 0.25] [--integrator kdk|symplectic_pc] [--nu 1e-6] [--alpha-wall 1.0]
+        [--shifting none|fickian] [--shift-a 2.0]
+        [--shift-fs-div 1.8] [--flume-wavelengths 1]
 
 A flume one wavelength long with open ends driven by second-order Stokes theory (the wave of the
 coupled flume, cases/coupled_flume.py, by default), gauges from 2h past the inlet to 3/4 of the
 flume (cases/wave_decay.py). No coupling and no wave model but the theory: the SPH wave's own
-loss, the floor under any coupled flume's error at that dp.
-Prints one JSON line: H, T, d, dp, H_over_dp, alpha, x, amplitude_ratio (SPH / theory, first
-harmonic), decay_per_m (least squares of the log), amplitude_at_0_8m (that fit 0.8 m past the
-inlet: the coupled flume's gauge), wall_s, particles.
+loss, the floor under any coupled flume's error at that dp. Every option left out keeps the
+scene's default (sph_core.scene.Constants); c0 = c0_factor sqrt(g d) (the flume's default 10).
+
+Prints one JSON line per dp: H, T, d, dp, H_over_dp, the options, x, amplitude_ratio (SPH /
+theory, first harmonic), decay_per_m (least squares of the log), loss_per_wavelength
+(1 - exp(-decay L)), amplitude_at_0_8m (that fit 0.8 m past the inlet: the coupled flume's
+gauge), wall_s, particles, steps, particle_steps_per_s; then, given several dp, one line with the
+convergence order of the decay between successive dp, log(decay_1/decay_2)/log(dp_1/dp_2).
+separated_decay_per_m, separated_k_over_k_theory (SPH's wavenumber: phase-speed error),
+separated_reflection: an incident and a reflected wave with one decay rate and wavenumber
+fitted to the complex amplitudes (cases.wave_decay.separated_decay).
+ratio_first_half / ratio_second_half: the ratio over each half of the window (a loss that
+grows in time rather than along x shows here); mean_eta_error_mm: time-mean SPH minus theory
+elevation per gauge; level_drift_mm: change of the flume's mean level from its fluid count.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import math
 import os
 import sys
 from pathlib import Path
@@ -22,7 +37,7 @@ from pathlib import Path
 os.environ.setdefault("OMP_WAIT_POLICY", "passive")  # before numba: shared, loaded cores
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from cases.wave_decay import amplitude_profile  # noqa: E402
+from cases.wave_decay import amplitude_profile, convergence_orders, separated_decay  # noqa: E402
 from wave_client.theories import build_theory  # noqa: E402
 
 
@@ -31,19 +46,61 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--H", type=float, default=0.04, help="wave height [m]")
     ap.add_argument("--T", type=float, default=1.4, help="period [s]")
     ap.add_argument("--d", type=float, default=0.24, help="still-water depth [m]")
-    ap.add_argument("--dp", type=float, default=0.02, help="particle spacing [m]")
-    ap.add_argument("--alpha", type=float, default=0.01, help="artificial viscosity coefficient")
+    ap.add_argument("--dp", type=float, nargs="+", default=[0.02], help="particle spacing(s) [m]")
     ap.add_argument("--periods", type=float, default=4.0, help="periods analysed")
+    ap.add_argument("--flume-wavelengths", type=float, default=1.0,
+                    help="flume length in wavelengths (gauges stay within 3/4 of the first)")
+    ap.add_argument("--h-over-dp", type=float, help="smoothing length / dp (scene default if unset)")
+    ap.add_argument("--alpha", type=float, help="artificial viscosity coefficient")
+    ap.add_argument("--slip", choices=["no_slip", "free_slip"], help="wall (bed) condition")
+    ap.add_argument("--c0-factor", type=float, default=10.0, help="c0 = factor * sqrt(g d)")
+    ap.add_argument("--delta", type=float, help="delta-SPH density diffusion coefficient")
+    ap.add_argument("--cfl", type=float, help="Courant number")
+    ap.add_argument("--integrator", choices=["kdk", "symplectic_pc"])
+    ap.add_argument("--nu", type=float, help="laminar kinematic viscosity [m^2/s]")
+    ap.add_argument("--shifting", choices=["none", "fickian"], help="particle shifting")
+    ap.add_argument("--shift-a", type=float, help="shifting coefficient A (Lind et al. 2012)")
+    ap.add_argument("--shift-fs-div", type=float, help="free-surface position-divergence limit")
+    ap.add_argument("--alpha-wall", type=float, help="artificial viscosity factor against walls")
     a = ap.parse_args(argv)
-    model = build_theory("stokes", height=a.H, period=a.T, depth=a.d, ramp_time=a.T, order=2)
-    prof = amplitude_profile(model, ramp=a.T, height=a.H, period=a.T, depth=a.d, dp=a.dp,
-                             periods=a.periods, alpha=a.alpha)
-    print(json.dumps({"H": a.H, "T": a.T, "d": a.d, "dp": a.dp, "H_over_dp": round(a.H / a.dp, 3),
-                      "alpha": a.alpha, "wavelength_m": round(float(model.length), 4),
-                      "x": prof.x.tolist(), "amplitude_ratio": [round(float(r), 4) for r in prof.ratio],
-                      "decay_per_m": round(prof.decay_per_m, 4),
-                      "amplitude_at_0_8m": round(prof.ratio_at(0.8), 4),
-                      "wall_s": round(prof.wall_s, 1), "particles": prof.particles}), flush=True)
+    cst = {k: v for k, v in {"h_over_dp": a.h_over_dp, "alpha": a.alpha, "wall_slip": a.slip,
+                             "delta": a.delta, "cfl": a.cfl, "nu": a.nu,
+                             "integrator": a.integrator, "shifting": a.shifting,
+                             "shift_a": a.shift_a, "shift_fs_div": a.shift_fs_div,
+                             "alpha_wall_factor": a.alpha_wall}.items() if v is not None}
+    c0 = a.c0_factor * math.sqrt(9.81 * a.d)
+    decays = []
+    for dp in a.dp:
+        model = build_theory("stokes", height=a.H, period=a.T, depth=a.d, ramp_time=a.T, order=2)
+        prof = amplitude_profile(model, ramp=a.T, height=a.H, period=a.T, depth=a.d, dp=dp,
+                                 periods=a.periods, flume_wavelengths=a.flume_wavelengths,
+                                 c0=c0, **cst)
+        length = float(model.length)
+        decays.append(prof.decay_per_m)
+        sep_decay, sep_k, sep_kr = separated_decay(prof.x, prof.amp, prof.k)
+        print(json.dumps({"H": a.H, "T": a.T, "d": a.d, "dp": dp, "H_over_dp": round(a.H / dp, 3),
+                          "constants": cst, "c0_factor": a.c0_factor,
+                          "flume_wavelengths": a.flume_wavelengths,
+                          "wavelength_m": round(length, 4),
+                          "x": prof.x.tolist(),
+                          "amplitude_ratio": [round(float(r), 4) for r in prof.ratio],
+                          "decay_per_m": round(prof.decay_per_m, 4),
+                          "loss_per_wavelength": round(1.0 - math.exp(-prof.decay_per_m * length), 4),
+                          "separated_decay_per_m": round(sep_decay, 4),
+                          "separated_k_over_k_theory": round(sep_k / prof.k, 4),
+                          "separated_reflection": round(sep_kr, 4),
+                          "ratio_first_half": [round(float(r), 4) for r in prof.ratio_first_half],
+                          "ratio_second_half": [round(float(r), 4) for r in prof.ratio_second_half],
+                          "mean_eta_error_mm": [round(1e3 * float(e), 2) for e in prof.mean_eta_error],
+                          "level_drift_mm": round(1e3 * prof.level_drift_m, 2),
+                          "amplitude_at_0_8m": round(prof.ratio_at(0.8), 4),
+                          "wall_s": round(prof.wall_s, 1), "particles": prof.particles,
+                          "steps": prof.steps,
+                          "particle_steps_per_s": round(prof.particles * prof.steps
+                                                        / max(prof.wall_s, 1e-9))}), flush=True)
+    if len(a.dp) > 1:
+        print(json.dumps({"dp": a.dp, "decay_per_m": [round(k, 4) for k in decays],
+                          "convergence_order": convergence_orders(a.dp, decays)}), flush=True)
     return 0
 
 

@@ -18,6 +18,7 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+from scipy.optimize import minimize
 
 from sph_core.scene import ElevationProbe
 
@@ -35,6 +36,15 @@ class AmplitudeProfile:
     intercept: float        # ln(ratio) of that fit at x = 0
     wall_s: float
     particles: int
+    steps: int = 0
+    amp: np.ndarray | None = None   # complex first-harmonic amplitudes of SPH at x [m]
+    k: float = 0.0                  # the theory's wavenumber [1/m]
+    # diagnostics: first and second half of the window's ratio; time-mean eta of SPH minus
+    # theory [m] per gauge; the flume's mean level change [m] from its fluid particle count
+    ratio_first_half: np.ndarray | None = None
+    ratio_second_half: np.ndarray | None = None
+    mean_eta_error: np.ndarray | None = None
+    level_drift_m: float = 0.0
 
     def ratio_at(self, x: float) -> float:
         """The fitted ratio at ``x`` [m] (the outlet's small reflection ripples the profile)."""
@@ -43,15 +53,17 @@ class AmplitudeProfile:
 
 def amplitude_profile(model: Any, *, ramp: float, height: float, period: float, depth: float,
                       dp: float, periods: float = 4.0, n_gauges: int = 12,
-                      **constants: Any) -> AmplitudeProfile:
+                      flume_wavelengths: float = 1.0, **constants: Any) -> AmplitudeProfile:
     """Run the flume driven by ``model`` (its start-up ramp lasting ``ramp`` s) and measure
-    the amplitude ratio along it (``constants`` override the scene's, e.g. alpha)."""
+    the amplitude ratio along it (``constants`` override the scene's, e.g. alpha). The flume is
+    ``flume_wavelengths`` long; the gauges stay within 3/4 of a wavelength of the inlet."""
     length = float(model.length)
     xs = np.round(np.linspace(2.0 * math.sqrt(2.0) * dp, 0.75 * length, n_gauges), 4)
     # the ramped front and one period past the last gauge
     t0 = ramp + xs[-1] / group_velocity(length, period, depth) + period
     scene = wave_flume_scene(depth=depth, wavelength=length, height=height, dp=dp,
-                             t_end=t0 + periods * period, length=length, absorb=(True, True),
+                             t_end=t0 + periods * period, length=flume_wavelengths * length,
+                             absorb=(True, True),
                              right_elevation="extrapolated", probe_every=period / 40,
                              name="wave_decay", **constants)
     probes = [ElevationProbe(kind="elevation", name=f"g{i}", x=float(x)) for i, x in enumerate(xs)]
@@ -60,8 +72,54 @@ def amplitude_profile(model: Any, *, ramp: float, height: float, period: float, 
     sel = np.nonzero(res.t >= t0 - 1e-9)[0]
     sel = sel[: int(round(periods * period / (res.t[1] - res.t[0])))]
     omega = 2.0 * math.pi / period
-    ratio = np.array([abs(harmonic_amplitude(res.t[sel], res.eta[p.name][sel], omega))
-                      / abs(harmonic_amplitude(res.t[sel], res.theory[p.name][sel], omega))
-                      for p in probes])
+    amp = np.array([harmonic_amplitude(res.t[sel], res.eta[p.name][sel], omega) for p in probes])
+    ratio = np.array([abs(a) / abs(harmonic_amplitude(res.t[sel], res.theory[p.name][sel], omega))
+                      for a, p in zip(amp, probes)])
     slope, icpt = np.polyfit(xs, np.log(ratio), 1)
-    return AmplitudeProfile(xs, ratio, float(-slope), float(icpt), res.wall_s, res.particles)
+
+    def half_ratio(part: np.ndarray) -> np.ndarray:
+        return np.array([abs(harmonic_amplitude(res.t[part], res.eta[p.name][part], omega))
+                         / abs(harmonic_amplitude(res.t[part], res.theory[p.name][part], omega))
+                         for p in probes])
+
+    nh = sel.size // 2
+    mean_err = np.array([np.mean(res.eta[p.name][sel]) - np.mean(res.theory[p.name][sel])
+                         for p in probes])
+    nf = res.n_fluid
+    drift = float((nf[-1, 1] - nf[0, 1]) * dp * dp / scene.tank.x1)
+    return AmplitudeProfile(xs, ratio, float(-slope), float(icpt), res.wall_s, res.particles,
+                            res.steps, amp, 2.0 * math.pi / length, half_ratio(sel[:nh]),
+                            half_ratio(sel[nh:]), mean_err, drift)
+
+
+def separated_decay(x: np.ndarray, amp: np.ndarray, k: float) -> tuple[float, float, float]:
+    """(decay [1/m], wavenumber [1/m], |a_R|/|a_I|) of complex amplitudes ``amp`` at ``x`` fitted
+    by an incident and a reflected wave decaying along their travel at one rate,
+        A_j = a_I exp(-(i k' + delta) x_j) + a_R exp((i k' + delta) x_j),
+    delta and k' (started at the theory's k) by least squares: the outlet's reflection ripples
+    |A_j| with period L/2, which the plain log fit of the profile reads partly as decay.
+    TODO(lead): move onto helper D's Mansard-Funke separation in wave_analysis once it lands."""
+    xc = x - 0.5 * (x.min() + x.max())
+
+    def resid(par: np.ndarray) -> float:
+        dl, kk = par
+        a = np.stack([np.exp(-(1j * kk + dl) * xc), np.exp((1j * kk + dl) * xc)], axis=1)
+        c, *_ = np.linalg.lstsq(a, amp, rcond=None)
+        return float(np.linalg.norm(a @ c - amp))
+
+    best = min((minimize(resid, np.array([d0, k]), method="Nelder-Mead",
+                         options={"xatol": 1e-6, "fatol": 1e-12}) for d0 in (0.0, 0.05, 0.15)),
+               key=lambda r: r.fun)
+    dl, kk = best.x
+    a = np.stack([np.exp(-(1j * kk + dl) * xc), np.exp((1j * kk + dl) * xc)], axis=1)
+    (a_i, a_r), *_ = np.linalg.lstsq(a, amp, rcond=None)
+    return float(dl), float(kk), float(abs(a_r) / abs(a_i))
+
+
+def convergence_orders(dps: list[float], decays: list[float]) -> list[float | None]:
+    """Observed order of the decay between successive resolutions,
+    log(decay_1 / decay_2) / log(dp_1 / dp_2) (None where a decay is <= 0)."""
+    out: list[float | None] = []
+    for (d1, k1), (d2, k2) in zip(zip(dps, decays), zip(dps[1:], decays[1:])):
+        out.append(round(math.log(k1 / k2) / math.log(d1 / d2), 3) if k1 > 0 and k2 > 0 else None)
+    return out

@@ -107,7 +107,9 @@ class Simulation:
                           b=self.b, gamma=7.0, gx=0.0, gz=-c.g, alpha=c.alpha, nu=c.nu,
                           delta=c.delta, cfl=c.cfl, rho_lo=lo, rho_hi=hi,
                           noslip=c.wall_slip == "no_slip", fx0=fx0, fx1=fx1,
-                          fz0=t.z0 - 0.5 * dp, fz1=t.z1)
+                          fz0=t.z0 - 0.5 * dp, fz1=t.z1, alpha_wall=c.alpha_wall_factor,
+                          shift_a=c.shift_a if c.shifting == "fickian" else 0.0,
+                          shift_fs_div=c.shift_fs_div)
         self.integrator = wcsph.INTEGRATORS[c.integrator]
         self.passes_per_step = wcsph.PASSES_PER_STEP[c.integrator]
         self._counts = np.zeros(ps.capacity, dtype=np.int64)

@@ -96,6 +96,9 @@ class Params(NamedTuple):
     fx1: float
     fz0: float
     fz1: float
+    alpha_wall: float    # artificial viscosity against walls = alpha_wall * alpha
+    shift_a: float       # particle shifting coefficient A (0: off; shifting.py)
+    shift_fs_div: float  # position divergence below which shifting is tangential only
 
 
 class OpenEnds(NamedTuple):

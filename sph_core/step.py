@@ -60,6 +60,7 @@ from .bodies import (bodies_correct, bodies_kick, bodies_kick_drift, bodies_pred
 from .neighbours import sort_by_cell
 from .open_boundary import extrapolate_buffers, measure_boundaries, update_buffers
 from .particles import N_SORTED_KDK, N_SORTED_PC
+from .shifting import shift_particles
 from .wcsph import (KDK, ST_CAPACITY, ST_DENSITY, ST_LEFT_DOMAIN, ST_NONFINITE, ST_REACHED_T,
                     ST_STEP_LIMIT, fluid_pass, kdk_kick, kdk_kick_drift, pc_correct, pc_predict,
                     stable_dt, update_pressure, wall_pass)
@@ -104,6 +105,8 @@ def _step_kdk(ps, ps2, cells, prm, ends, bd, n, t, dt):
     n_bad, n_band, v2max, a2max, rmax = kdk_kick(ps2, n, dt, prm)
     bodies_kick(bd, t, dt)
     place_bodies(ps2, n, bd)
+    if prm.shift_a > 0.0:
+        shift_particles(ps2, n, cells, prm, dt)
     measure_boundaries(ps2, cells, ends, prm)
     return _verdict(n, n_bad, n_band, n_out, v2max, a2max, rmax)
 
@@ -122,6 +125,8 @@ def _step_pc(ps, ps2, cells, prm, ends, bd, n, t, dt):
     n_bad, n_band, n_out, v2max, a2max, rmax = pc_correct(ps2, n, dt, prm)
     bodies_correct(bd, t, dt)
     place_bodies(ps2, n, bd)
+    if prm.shift_a > 0.0:
+        shift_particles(ps2, n, cells, prm, dt)
     if n_bad == 0 and n_out == 0:
         n_new = update_buffers(ps2, n, t + dt, dt, ends, prm)
         if n_new < 0:

@@ -165,6 +165,10 @@ def fluid_pass(ps, n, cells, prm):
     gdir_z = gz / g if g > 0 else 0.0
     gdir_x = gx / g if g > 0 else 0.0
     av = prm.alpha * c0 * h
+    # artificial viscosity against walls (DualSPHysics' ViscoBoundFactor): the bed's boundary
+    # layer is far thinner than dp, and alpha c0 h over a shear across dp dissipates the same
+    # wave energy at every dp (docs/wave_decay_study.md)
+    av_wall = prm.alpha_wall * av
     nu4 = 4.0 * prm.nu
     ddiff = 2.0 * prm.delta * h * c0
     noslip = prm.noslip
@@ -220,7 +224,7 @@ def fluid_pass(ps, n, cells, prm):
                         vr = dvx * dx + dvz * dz
                         mden = mj / ((rhoi + rhoj) * (r2 + eta2))
                         if vr < 0.0:
-                            pf -= 2.0 * av * vr * mden
+                            pf -= 2.0 * (av_wall if kj == WALL else av) * vr * mden
                         lam = nu4 * r2 * mden
                         fx -= lam * fij * dvx
                         fz -= lam * fij * dvz

@@ -1,0 +1,83 @@
+"""Where does the SPH wave's energy go? A standing wave in a closed tank, no open boundaries.
+
+    python bench/standing_wave_decay.py [--dp 0.02 0.01] [--h-over-dp 2] [--alpha 0.01]
+        [--alpha-wall 1] [--slip no_slip|free_slip] [--delta 0.1] [--c0-factor 10] [--periods 6]
+        [--cfl 0.25] [--nu 1e-6] [--shifting none|fickian] [--shift-a 2] [--shift-fs-div 1.8]
+
+The first sloshing mode of a tank half a wavelength long, the wave of bench/wave_decay.py
+(cases.standing_wave). Its amplitude decay rate in time over the group velocity is the decay
+over distance a progressive wave would have from the same losses: comparable with
+bench/wave_decay.py's decay_per_m, without inlet, outlet or gauge.
+Prints one JSON line per dp: omega_error, beta_per_s, equiv_decay_per_m,
+equiv_loss_per_wavelength, beta_gauge_per_s, gauge_over_velocity_amplitude (the gauge's bias),
+ke_noise_over_ke0 (kinetic energy outside the first three modes over the initial, mean over the
+second half, and max), particles, steps, wall_s (jitted loop), particle_steps_per_s; then, given
+several dp, the convergence order of equiv_decay_per_m.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import sys
+from pathlib import Path
+
+os.environ.setdefault("OMP_WAIT_POLICY", "passive")
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from cases.standing_wave import standing_wave_decay  # noqa: E402
+from cases.wave_decay import convergence_orders  # noqa: E402
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--dp", type=float, nargs="+", default=[0.02])
+    ap.add_argument("--d", type=float, default=0.24, help="still-water depth [m]")
+    ap.add_argument("--length", type=float, default=1.0, help="tank length = half wavelength [m]")
+    ap.add_argument("--a", type=float, default=0.02, help="standing-wave amplitude [m]")
+    ap.add_argument("--periods", type=float, default=6.0)
+    ap.add_argument("--c0-factor", type=float, default=10.0, help="c0 = factor * sqrt(g d)")
+    ap.add_argument("--h-over-dp", type=float)
+    ap.add_argument("--alpha", type=float)
+    ap.add_argument("--alpha-wall", type=float)
+    ap.add_argument("--slip", choices=["no_slip", "free_slip"])
+    ap.add_argument("--delta", type=float)
+    ap.add_argument("--cfl", type=float)
+    ap.add_argument("--integrator", choices=["kdk", "symplectic_pc"])
+    ap.add_argument("--nu", type=float)
+    ap.add_argument("--shifting", choices=["none", "fickian"])
+    ap.add_argument("--shift-a", type=float)
+    ap.add_argument("--shift-fs-div", type=float)
+    a = ap.parse_args(argv)
+    cst = {k: v for k, v in {"h_over_dp": a.h_over_dp, "alpha": a.alpha, "wall_slip": a.slip,
+                             "delta": a.delta, "cfl": a.cfl, "nu": a.nu,
+                             "integrator": a.integrator, "shifting": a.shifting,
+                             "shift_a": a.shift_a, "shift_fs_div": a.shift_fs_div,
+                             "alpha_wall_factor": a.alpha_wall}.items() if v is not None}
+    decays = []
+    for dp in a.dp:
+        r = standing_wave_decay(dp=dp, depth=a.d, length=a.length, amplitude=a.a,
+                                periods=a.periods, c0_factor=a.c0_factor, **cst)
+        decays.append(r.equiv_decay_per_m)
+        print(json.dumps({
+            "dp": dp, "a_over_dp": round(a.a / dp, 3), "constants": cst, "c0_factor": a.c0_factor,
+            "omega_error": round(r.omega_error, 5), "beta_per_s": round(r.beta_per_s, 5),
+            "equiv_decay_per_m": round(r.equiv_decay_per_m, 4),
+            "equiv_loss_per_wavelength": round(r.loss_per_wavelength(2.0 * a.length), 4),
+            "beta_gauge_per_s": round(r.beta_gauge_per_s, 5),
+            "gauge_over_velocity_amplitude": round(r.gauge_over_velocity, 4),
+            "ke_noise_over_ke0_mean_2nd_half": round(r.noise_ke_fraction, 5),
+            "ke_noise_over_ke0_max": round(r.noise_ke_fraction_max, 5),
+            "particles": r.particles, "steps": r.steps, "wall_s": round(r.wall_s, 1),
+            "particle_steps_per_s": round(r.particles * r.steps / max(r.wall_s, 1e-9))}),
+            flush=True)
+    if len(a.dp) > 1:
+        print(json.dumps({"dp": a.dp, "equiv_decay_per_m": [round(k, 4) for k in decays],
+                          "convergence_order": convergence_orders(a.dp, decays)}), flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
