@@ -143,6 +143,7 @@ def flume_case(model: Any, *, height: float, period: float, depth: float, wavele
     # the ramp starts the model everywhere at once, SPH's wave front travels from the inlet:
     # compare once the fully ramped wave has reached mid-flume at the (linear) group velocity
     k = 2.0 * math.pi / wavelength
+    kd = k * depth
     t_start = ramp + (0.0 if standing else 0.5 * length / group_velocity(wavelength, period, depth))
     scene = wave_flume_scene(depth=depth, wavelength=wavelength, height=height, dp=dp,
                              t_end=t_start + periods * period, length=length, absorb=absorb,

@@ -50,6 +50,7 @@ import numpy as np
 from numba import njit, prange
 
 from .kernels import f_of_q
+from .neighbours import block_of
 from .particles import FLUID, WALL, ParticleSet
 from .scene import Body, Scene
 
@@ -280,7 +281,6 @@ def _particle_loads(ps, n, cells, prm, bd):
     cell = ps.cell
     cell_start = cells.start
     ncx = cells.ncx
-    ncz = cells.ncz
     h = prm.h
     inv_h = 1.0 / h
     s2 = 4.0 * h * h
@@ -308,12 +308,8 @@ def _particle_loads(ps, n, cells, prm, bd):
             wz = vwz[j]
             fx = 0.0
             fz = 0.0
-            c = cell[j]
-            cz = c // ncx
-            cx = c - cz * ncx
-            cxl = cx - 1 if cx > 0 else 0
-            cxh = cx + 1 if cx < ncx - 1 else ncx - 1
-            for zz in range(max(cz - 1, 0), min(cz + 2, ncz)):
+            cxl, cxh, czl, czh = block_of(cell[j], cells)
+            for zz in range(czl, czh + 1):
                 row = zz * ncx
                 for i in range(cell_start[row + cxl], cell_start[row + cxh + 1]):
                     if kind[i] == FLUID:
