@@ -88,7 +88,7 @@ def welcome_for(run: Run, engine: CouplingEngine,
                 idle_timeout: float) -> tuple[Welcome, Nodes, Gauges]:
     """WELCOME (the scene summary), NODES and, for 1.1 clients, GAUGES of a run's engine."""
     s, nodes = engine.summary, engine.nodes()
-    welcome = Welcome(int(Capability.GOBACK), bytes.fromhex(run.info.scene_hash), g=s.g, depth=s.depth,
+    welcome = Welcome(int(Capability.GOBACK | Capability.KEEPALIVE), bytes.fromhex(run.info.scene_hash), g=s.g, depth=s.depth,
                       still_water_level=s.still_water_level, z_ref=s.z_ref, t_start=s.t_start,
                       t_end=s.t_end, dt_sph=s.dt_sph, window_max=run.request.coupling.window_max,
                       idle_timeout=idle_timeout, n_nodes=nodes.x.size, n_gauges=nodes.gauge_x.size,
@@ -148,8 +148,9 @@ async def serve_client(manager: RunManager, run: Run, transport: DoorTransport,
                 if max(recent) < INLINE_SOLVE_S:
                     measured = _solve(engine, run, window, goback)
                 else:
-                    measured = await loop.run_in_executor(manager.executor, _solve, engine, run,
-                                                          window, goback)
+                    measured = await _working(session, transport, settings.keepalive_every,
+                                              loop.run_in_executor(manager.executor, _solve, engine,
+                                                                   run, window, goback))
                 at_boundary = True
                 took = time.perf_counter() - tic
                 recent.append(took)
@@ -164,12 +165,14 @@ async def serve_client(manager: RunManager, run: Run, transport: DoorTransport,
                     await _save_state(manager, run)  # by wall time and by simulated progress
                     saved_at, saved_t = time.monotonic(), engine.t
             elif isinstance(action, Measure):
-                measured = await loop.run_in_executor(manager.executor, engine.measure)
+                measured = await _working(session, transport, settings.keepalive_every,
+                                          loop.run_in_executor(manager.executor, engine.measure))
                 await transport.send(session.result(action, _result(measured)))
             elif isinstance(action, Restore):
                 window = None
                 at_boundary = False
-                measured = await loop.run_in_executor(manager.executor, _goback, engine)
+                measured = await _working(session, transport, settings.keepalive_every,
+                                          loop.run_in_executor(manager.executor, _goback, engine))
                 at_boundary = True
                 run.gauges.rewind()
                 run.info.windows = max(run.info.windows - 1, 0)
@@ -262,6 +265,22 @@ class _Reader:
 
     def close(self) -> None:
         self.watcher.cancel()
+
+
+async def _working(session: SphSession, transport: DoorTransport, every: float,
+                   job: asyncio.Future) -> Measurement:
+    """``job``'s result; meanwhile a WORKING frame every ``every`` seconds if the client asked
+    for KEEPALIVE (1.1): the first window waits for the solver's JIT compile."""
+    if session.working_frame(0.0) is None:
+        return await job
+    tic = time.perf_counter()
+    while True:
+        done, _ = await asyncio.wait({job}, timeout=every)
+        if done:
+            return job.result()
+        frame = session.working_frame(time.perf_counter() - tic)
+        assert frame is not None
+        await transport.send(frame)
 
 
 def _solve(engine: CouplingEngine, run: Run, window: SetWindow, checkpoint: bool) -> Measurement:

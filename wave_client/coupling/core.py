@@ -156,9 +156,10 @@ class CouplingCore:
 
     # --- handshake ------------------------------------------------------------------------
     def hello(self) -> bytes:
-        # GAUGE_INFO (1.1): a 1.0 server ignores the bit and the client goes on without names
-        return self.session.request(Hello(int(Capability.GAUGE_INFO), self.scene_hash, self.run_id,
-                                          self.client_name))
+        # 1.1: GAUGE_INFO (gauge names) and KEEPALIVE (WORKING frames while the first window
+        # waits for the solver's compile); a 1.0 server ignores both bits
+        caps = Capability.GAUGE_INFO | Capability.KEEPALIVE
+        return self.session.request(Hello(int(caps), self.scene_hash, self.run_id, self.client_name))
 
     def on_welcome(self, seq: int, msg: Message) -> bytes:
         """Check the offer against the model; the GETNODES frame to send."""

@@ -167,7 +167,7 @@ async def run_coupling(url: str, model: ModelSource, options: CouplingOptions | 
             frames = core.next_window()
             t_b = time.perf_counter()
             await transport.send(frames)
-            reply = await transport.recv(timeout)
+            reply = await _reply(transport, core, timeout)
             t_c = time.perf_counter()
             record = core.on_result(*reply)
             report.records.append(record)
@@ -208,6 +208,15 @@ async def run_coupling(url: str, model: ModelSource, options: CouplingOptions | 
             log.close()
         await _close_quietly(transport)
     return report
+
+
+async def _reply(transport, core: CouplingCore, timeout: float):
+    """The next reply; WORKING frames (1.1 KEEPALIVE) restart the wait: ``timeout`` then bounds
+    the silence of the server, not the solve of a window."""
+    while True:
+        reply = await transport.recv(timeout)
+        if not core.session.keepalive(*reply):
+            return reply
 
 
 async def _await_welcome(transport, limit: float, progress: bool):
