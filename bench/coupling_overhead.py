@@ -15,8 +15,9 @@ Definitions (per window i, windows 2..N; window 1 carries the numba cache load a
     client_i  client wall time from sending SET+SOLVE to holding the decoded RESULT
               (the wave model's own time, sampling the boundary, is not included)
     solve_i   the engine's solve_window() time inside the server (timed by a thin wrapper)
-    rtt_i     = client_i - solve_i: framing, validation, session, the worker-thread hop, the gauge
-              row written to disk, both socket trips
+    rtt_i     = client_i - solve_i: framing, validation, session, the worker-thread hop (none
+              for windows solved in under 1 ms: they run on the event loop), the gauge row
+              written to disk, both socket trips
     overhead_share = sum(rtt_i) / sum(client_i)
 `server_overhead_share` is the server's own figure (GET /runs/{id}: 1 - solve time / wall time
 since the client connected, handshake and window 1 included).

@@ -29,7 +29,7 @@ from .client import ClientSession, RemoteError
 from .errors import ErrorCode, ProtocolError
 from .framing import FrameDecoder, decode_frame, encode_frame
 from .messages import (Bye, Error, Gauges, Get, GetGauges, GetNodes, GoBack, Hello, Message, Nodes,
-                       Result, Set, Solve, Welcome)
+                       Result, Set, Solve, Welcome, Working)
 from .session import SphSession
 from .wire import (HEADER_SIZE, MAGIC, MAX_COUNT, MAX_PAYLOAD, MAX_TEXT, NO_SCENE_HASH, VERSION,
                    NO_GAUGE, Capability, GaugeKind, MessageType, Side)
@@ -45,5 +45,5 @@ __all__ = [
     "Get", "GetGauges", "GetNodes", "NO_GAUGE",
     "GoBack", "HEADER_SIZE", "Hello", "MAGIC", "MAX_COUNT", "MAX_PAYLOAD", "MAX_TEXT", "Message",
     "MessageType", "NO_SCENE_HASH", "Nodes", "ProtocolError", "RemoteError", "Result", "Set", "Side",
-    "Solve", "SphSession", "VERSION", "Welcome", "decode_frame", "encode_frame", "scene_hash",
+    "Solve", "SphSession", "VERSION", "Welcome", "Working", "decode_frame", "encode_frame", "scene_hash",
 ]

@@ -14,7 +14,7 @@ from typing import TypeVar
 
 from .errors import ErrorCode, ProtocolError
 from .framing import encode_frame
-from .messages import Bye, Error, Gauges, Message, Nodes, Result, Welcome
+from .messages import Bye, Error, Gauges, Message, Nodes, Result, Welcome, Working
 
 M = TypeVar("M", bound=Message)
 
@@ -32,6 +32,10 @@ class ClientSession:
         """The frame for ``msg`` with the next sequence number."""
         self.seq += 1
         return encode_frame(msg, self.seq)
+
+    def keepalive(self, seq: int, msg: Message) -> bool:
+        """True for a WORKING frame about the last request (1.1 KEEPALIVE): keep waiting."""
+        return isinstance(msg, Working) and seq == self.seq
 
     def reply(self, seq: int, msg: Message, expect: type[M]) -> M:
         """Check a received frame answers the last request with a ``expect`` message."""

@@ -373,7 +373,17 @@ class Gauges(Message):
         self.kind, self.eta_gauge = _u32s(self.kind), _u32s(self.eta_gauge)
 
 
+@dataclass(eq=False)
+class Working(Message):
+    """Server -> client (1.1, KEEPALIVE in force): the reply to the request with this frame's seq
+    is still being computed, ``elapsed`` seconds so far. Not a reply: the client keeps waiting."""
+
+    TYPE = MessageType.WORKING
+    LAYOUT = (("elapsed", "f64"),)
+    elapsed: float = 0.0
+
+
 MESSAGE_CLASSES: dict[MessageType, type[Message]] = {
     cls.TYPE: cls for cls in (Hello, Welcome, GetNodes, Nodes, Set, Solve, Get, Result, GoBack, Error,
-                              Bye, GetGauges, Gauges)
+                              Bye, GetGauges, Gauges, Working)
 }

@@ -24,7 +24,7 @@ import numpy as np
 from .errors import ErrorCode, ProtocolError
 from .framing import encode_frame
 from .messages import (Bye, Error, Gauges, Get, GetGauges, GetNodes, GoBack, Hello, Message, Nodes,
-                       Result, Set, Solve, Welcome)
+                       Result, Set, Solve, Welcome, Working)
 from .wire import MAX_TEXT, NO_SCENE_HASH, Capability
 
 TIME_RTOL = 1e-9  # relative tolerance when matching window times to the SPH clock
@@ -230,6 +230,12 @@ class SphSession:
             self.window = None
             self.state = State.READY
         return self._frame(replace(result, t=self.t))
+
+    def working_frame(self, elapsed: float) -> bytes | None:
+        """WORKING for the request being answered (1.1), None unless KEEPALIVE is in force."""
+        if not self.capabilities & Capability.KEEPALIVE:
+            return None
+        return self._frame(Working(float(elapsed)))
 
     def error_frame(self, exc: ProtocolError | Exception) -> bytes:
         """ERROR frame for ``exc`` (the door closes after sending it)."""

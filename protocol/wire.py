@@ -37,6 +37,7 @@ class MessageType(IntEnum):
     BYE = 11
     GETGAUGES = 12   # 1.1, with the GAUGE_INFO capability
     GAUGES = 13      # 1.1, with the GAUGE_INFO capability
+    WORKING = 14     # 1.1, with the KEEPALIVE capability
 
 
 class Capability(IntEnum):
@@ -44,6 +45,7 @@ class Capability(IntEnum):
 
     GOBACK = 1 << 0       # client may send GOBACK (implicit / iterated coupling)
     GAUGE_INFO = 1 << 1   # protocol 1.1: GETGAUGES -> GAUGES (names, kinds, the SPH-side eta gauges)
+    KEEPALIVE = 1 << 2    # protocol 1.1: WORKING frames while a reply takes long (the JIT compile)
 
 
 class Side(IntEnum):

@@ -1,8 +1,10 @@
 """The coupling door logic shared by the WebSocket and TCP endpoints.
 
 A transport (transports.DoorTransport) gives ``recv()`` and ``send(bytes)``; ``serve_client`` runs the protocol session (protocol.SphSession) against the
-run's engine. Engine calls go to the worker pool; every read has a timeout; the run's state
-says how the session ended, and the gauge rows of every solved window are on disk already.
+run's engine. Engine calls go to the worker pool, except windows the engine solves in under
+``INLINE_SOLVE_S`` (a null or tiny engine), which run on the loop: the thread hop and the GIL
+hand-over back cost more than such a window. Every read has a timeout; the run's state says how
+the session ended, and the gauge rows of every solved window are on disk already.
 """
 
 from __future__ import annotations
@@ -10,6 +12,8 @@ from __future__ import annotations
 import asyncio
 import logging
 import time
+from collections import deque
+
 import numpy as np
 
 from protocol import (NO_SCENE_HASH, Capability, ErrorCode, GaugeKind, Gauges, Nodes, ProtocolError,
@@ -25,6 +29,8 @@ from .transports import DoorTransport, PeerGone
 log = logging.getLogger("wavesph.server")
 
 SERVER_NAME = "wavesph-server 0.1 (protocol 1.1)"
+INLINE_SOLVE_S = 1e-3   # [s] windows this quick (the last INLINE_HISTORY of them) run on the loop
+INLINE_HISTORY = 8
 
 
 class _SessionEnd(Exception):
@@ -72,6 +78,8 @@ async def claim_run(manager: RunManager, run_id: str, hello: Hello,
     finally:
         for task in (attach, recv):
             task.cancel()
+        # the cancelled read must be over before the session reads (a stream has one reader)
+        await asyncio.gather(recv, return_exceptions=True)
         if not run.attached.is_set():
             manager.unreserve(run)
 
@@ -80,7 +88,7 @@ def welcome_for(run: Run, engine: CouplingEngine,
                 idle_timeout: float) -> tuple[Welcome, Nodes, Gauges]:
     """WELCOME (the scene summary), NODES and, for 1.1 clients, GAUGES of a run's engine."""
     s, nodes = engine.summary, engine.nodes()
-    welcome = Welcome(int(Capability.GOBACK), bytes.fromhex(run.info.scene_hash), g=s.g, depth=s.depth,
+    welcome = Welcome(int(Capability.GOBACK | Capability.KEEPALIVE), bytes.fromhex(run.info.scene_hash), g=s.g, depth=s.depth,
                       still_water_level=s.still_water_level, z_ref=s.z_ref, t_start=s.t_start,
                       t_end=s.t_end, dt_sph=s.dt_sph, window_max=run.request.coupling.window_max,
                       idle_timeout=idle_timeout, n_nodes=nodes.x.size, n_gauges=nodes.gauge_x.size,
@@ -108,6 +116,8 @@ async def serve_client(manager: RunManager, run: Run, transport: DoorTransport,
     window: SetWindow | None = None
     at_boundary = True          # engine state is a window boundary (safe to save for resuming)
     saved_at, saved_t = time.monotonic(), engine.t
+    recent: deque[float] = deque([float("inf")], maxlen=INLINE_HISTORY)  # solve times [s]
+    reader = _Reader(transport, run)
     end: _SessionEnd
 
     def sync_limits() -> None:
@@ -117,7 +127,7 @@ async def serve_client(manager: RunManager, run: Run, transport: DoorTransport,
     try:
         while True:
             if not pending:
-                pending = await _recv(transport, timeout, run)
+                pending = await reader.recv(timeout)
             seq, msg = pending.pop(0)
             action = session.receive(seq, msg)
             sync_limits()
@@ -134,10 +144,17 @@ async def serve_client(manager: RunManager, run: Run, transport: DoorTransport,
             elif isinstance(action, SolveWindow):
                 tic = time.perf_counter()
                 at_boundary = False
-                measured = await loop.run_in_executor(manager.executor, _solve, engine, run, window,
-                                                      bool(session.capabilities & Capability.GOBACK))
+                goback = bool(session.capabilities & Capability.GOBACK)
+                if max(recent) < INLINE_SOLVE_S:
+                    measured = _solve(engine, run, window, goback)
+                else:
+                    measured = await _working(session, transport, settings.keepalive_every,
+                                              loop.run_in_executor(manager.executor, _solve, engine,
+                                                                   run, window, goback))
                 at_boundary = True
-                solve_time += time.perf_counter() - tic
+                took = time.perf_counter() - tic
+                recent.append(took)
+                solve_time += took
                 reply = session.result(action, _result(measured))
                 values = _gauge_values(names, measured)
                 run.gauges.row(engine.t, measured.steps, values)
@@ -148,12 +165,14 @@ async def serve_client(manager: RunManager, run: Run, transport: DoorTransport,
                     await _save_state(manager, run)  # by wall time and by simulated progress
                     saved_at, saved_t = time.monotonic(), engine.t
             elif isinstance(action, Measure):
-                measured = await loop.run_in_executor(manager.executor, engine.measure)
+                measured = await _working(session, transport, settings.keepalive_every,
+                                          loop.run_in_executor(manager.executor, engine.measure))
                 await transport.send(session.result(action, _result(measured)))
             elif isinstance(action, Restore):
                 window = None
                 at_boundary = False
-                measured = await loop.run_in_executor(manager.executor, _goback, engine)
+                measured = await _working(session, transport, settings.keepalive_every,
+                                          loop.run_in_executor(manager.executor, _goback, engine))
                 at_boundary = True
                 run.gauges.rewind()
                 run.info.windows = max(run.info.windows - 1, 0)
@@ -186,6 +205,7 @@ async def serve_client(manager: RunManager, run: Run, transport: DoorTransport,
         else:
             log.exception("run %s: coupling failed", run.info.id)
             end = _SessionEnd(FAILED, f"{type(exc).__name__}: {exc}", session.error_frame(exc))
+    reader.close()
     if end.frame is not None:
         try:
             await asyncio.wait_for(transport.send(end.frame), 5.0)
@@ -210,23 +230,57 @@ class _Cancel(Exception):
     pass
 
 
-async def _recv(transport: DoorTransport, timeout: float, run: Run) -> list[tuple[int, Message]]:
-    """Next frames, or _Gone / TimeoutError / _Cancel; ProtocolError passes through."""
-    recv = asyncio.ensure_future(transport.recv())
-    cancel = asyncio.ensure_future(run.cancelled.wait())
-    try:
-        done, _ = await asyncio.wait({recv, cancel}, timeout=timeout, return_when=asyncio.FIRST_COMPLETED)
-    finally:
-        cancel.cancel()
-    if recv in done:
-        frames = recv.result()
+class _Reader:
+    """The session's reads: next frames, or _Gone / TimeoutError / _Cancel; ProtocolError passes
+    through. One watcher per session ends a read when the run is cancelled (no task per read:
+    two tasks and an asyncio.wait per frame were a fifth of a null window)."""
+
+    def __init__(self, transport: DoorTransport, run: Run) -> None:
+        self.transport, self.run = transport, run
+        self.task = asyncio.current_task()
+        self.reading = False
+        self.watcher = asyncio.ensure_future(run.cancelled.wait())
+        self.watcher.add_done_callback(self._on_cancel)
+
+    def _on_cancel(self, _: object) -> None:
+        if self.reading and self.task is not None and not self.watcher.cancelled():
+            self.task.cancel()
+
+    async def recv(self, timeout: float) -> list[tuple[int, Message]]:
+        if self.run.cancelled.is_set():
+            raise _Cancel()
+        self.reading = True
+        try:
+            async with asyncio.timeout(timeout):
+                frames = await self.transport.recv()
+        except asyncio.CancelledError:
+            if self.run.cancelled.is_set() and self.task is not None and self.task.uncancel() == 0:
+                raise _Cancel() from None
+            raise
+        finally:
+            self.reading = False
         if frames is None:
             raise _Gone()
         return frames
-    recv.cancel()
-    if cancel in done:
-        raise _Cancel()
-    raise TimeoutError()
+
+    def close(self) -> None:
+        self.watcher.cancel()
+
+
+async def _working(session: SphSession, transport: DoorTransport, every: float,
+                   job: asyncio.Future) -> Measurement:
+    """``job``'s result; meanwhile a WORKING frame every ``every`` seconds if the client asked
+    for KEEPALIVE (1.1): the first window waits for the solver's JIT compile."""
+    if session.working_frame(0.0) is None:
+        return await job
+    tic = time.perf_counter()
+    while True:
+        done, _ = await asyncio.wait({job}, timeout=every)
+        if done:
+            return job.result()
+        frame = session.working_frame(time.perf_counter() - tic)
+        assert frame is not None
+        await transport.send(frame)
 
 
 def _solve(engine: CouplingEngine, run: Run, window: SetWindow, checkpoint: bool) -> Measurement:
@@ -283,5 +337,6 @@ def _progress(manager: RunManager, run: Run, engine: CouplingEngine,
     if solve_time > 0:
         info.particle_steps_per_s = engine.n_particles * engine.steps / solve_time
     info.coupling_overhead_share = max(0.0, 1.0 - solve_time / wall) if wall > 0 else None
-    info.stability = {**info.stability, **engine.stability()}
-    manager.save(run, force=values is None)
+    if manager.save_due(run, force=values is None):  # stability figures cost a pass over the
+        info.stability = {**info.stability, **engine.stability()}  # particles: as often as meta.json
+        manager.save(run)

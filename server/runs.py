@@ -177,10 +177,13 @@ class RunManager:
             log.warning("run %s: state.pkl does not match its seal: not resumable", run.info.id)
         return False
 
+    def save_due(self, run: Run, force: bool = False) -> bool:
+        """meta.json is rewritten at most every ``meta_interval`` unless forced."""
+        return force or time.monotonic() - run._saved_at >= self.settings.meta_interval
+
     def save(self, run: Run, force: bool = True) -> None:
-        now = time.monotonic()
-        if force or now - run._saved_at >= self.settings.meta_interval:
-            run._saved_at = now
+        if self.save_due(run, force):
+            run._saved_at = time.monotonic()
             self.store.save(run.info)
 
     def _set_state(self, run: Run, state: str, reason: str | None = None) -> None:

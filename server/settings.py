@@ -30,6 +30,8 @@ class Settings(BaseModel):
                            description="largest coupling frame payload [bytes]")
     hello_timeout: float = Field(30.0, gt=0, description="[s] for the first frame after connect")
     idle_timeout: float = Field(600.0, gt=0, description="[s] between client frames")
+    keepalive_every: float = Field(5.0, gt=0, description="[s] between WORKING frames while a "
+                                   "reply takes long (clients with the KEEPALIVE capability)")
     client_wait_timeout: float = Field(3600.0, gt=0, description="[s] a coupled run waits for its client")
     meta_interval: float = Field(0.5, ge=0, description="[s] least time between meta.json rewrites")
     checkpoint_every: float = Field(60.0, gt=0, description="[s] wall time between saved states of "

@@ -56,3 +56,22 @@ def test_wavesph_couple_waits_while_its_run_is_queued(tmp_path, factory, capsys,
         assert srv.wait_state(run["id"], "finished")["windows"] == 2
     err = capsys.readouterr().err
     assert "the run is not started yet" in err
+
+
+def test_wave_client_names_its_log_columns_from_gauges(srv, engines, tmp_path):
+    """Issue 15 / protocol 1.1: the client asks GETGAUGES when the server grants GAUGE_INFO and
+    its gauges.csv names the columns after the server's gauges, not their indices."""
+    run = srv.create(t_end=0.1)
+    srv.wait_state(run["id"], "waiting_for_client")
+    log = tmp_path / "client_gauges.csv"
+    report = couple(f"tcp://127.0.0.1:{srv.tcp_port}", AiryWave(height=0.02, period=1.0, depth=0.3),
+                    CouplingOptions(window=0.05), run_id=run["id"], timeout=20.0, progress=False,
+                    log_path=log)
+    assert len(report.records) == 2
+    names = list(srv.http.get(f"/runs/{run['id']}/gauges", params={"format": "json"})
+                 .json()["rows"][0])
+    server_gauges = sorted({c[: -len("_eta")] for c in names if c.endswith("_eta")})
+    text = log.read_text()
+    header = next(ln for ln in text.splitlines() if not ln.startswith("#")).split(",")
+    assert sorted(c[len("eta_model_"):] for c in header if c.startswith("eta_model_")) == server_gauges
+    assert "eta_0" not in header and "# gauges: " in text

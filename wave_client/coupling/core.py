@@ -45,8 +45,9 @@ from typing import TypeVar
 
 import numpy as np
 
-from protocol import (NO_SCENE_HASH, Bye, ClientSession, Error, ErrorCode, GetNodes, Hello, Message,
-                      Nodes, ProtocolError, Result, Set, Side, Solve, Welcome)
+from protocol import (NO_SCENE_HASH, Bye, Capability, ClientSession, Error, ErrorCode, Gauges,
+                      GetGauges, GetNodes, Hello, Message, Nodes, ProtocolError, Result, Set, Side,
+                      Solve, Welcome)
 from protocol.session import TIME_RTOL  # the server matches window times with the same tolerance
 from wave_client.model import WaveModel
 
@@ -149,6 +150,7 @@ class CouplingCore:
         self.session = ClientSession()
         self.welcome: Welcome | None = None
         self.nodes: Nodes | None = None
+        self.gauge_info: Gauges | None = None  # 1.1 servers: what each gauge is (GETGAUGES)
         self.times: np.ndarray = np.zeros(0)   # window ends t_1 .. t_n, t_0 = t_start
         self.window = 0.0                      # s, coupling window (the last may be shorter)
         self.window_index = 0                  # windows solved so far
@@ -161,7 +163,10 @@ class CouplingCore:
 
     # --- handshake ------------------------------------------------------------------------
     def hello(self) -> bytes:
-        return self.session.request(Hello(0, self.scene_hash, self.run_id, self.client_name))
+        # 1.1: GAUGE_INFO (gauge names) and KEEPALIVE (WORKING frames while the first window
+        # waits for the solver's compile); a 1.0 server ignores both bits
+        caps = Capability.GAUGE_INFO | Capability.KEEPALIVE
+        return self.session.request(Hello(int(caps), self.scene_hash, self.run_id, self.client_name))
 
     def on_welcome(self, seq: int, msg: Message) -> bytes:
         """Check the offer against the model; the GETNODES frame to send."""
@@ -238,6 +243,28 @@ class CouplingCore:
         elif x_couple is not None and self.x_inlet is not None:
             self.x_offset = float(x_couple) - self.x_inlet
 
+    def gauges_request(self) -> bytes | None:
+        """GETGAUGES if the server granted GAUGE_INFO (1.1), else None (a 1.0 server)."""
+        assert self.welcome is not None
+        if not self.welcome.capabilities & Capability.GAUGE_INFO:
+            return None
+        return self.session.request(GetGauges())
+
+    def on_gauges(self, seq: int, msg: Message) -> None:
+        info = self._reply(seq, msg, Gauges)
+        assert self.welcome is not None
+        if len(info.names) != self.welcome.n_gauges or info.kind.size != self.welcome.n_gauges:
+            raise ProtocolError(ErrorCode.SHAPE_MISMATCH, f"GAUGES has {len(info.names)} names and "
+                                f"{info.kind.size} kinds, WELCOME {self.welcome.n_gauges} gauges")
+        self.gauge_info = info
+
+    def gauge_labels(self) -> list[str]:
+        """One label per gauge for logs: the server's names (1.1), else the gauge index."""
+        assert self.nodes is not None
+        if self.gauge_info is not None:
+            return list(self.gauge_info.names)
+        return [str(i) for i in range(self.nodes.gauge_x.size)]
+
     def _nearest_gauge(self, side: Side) -> int | None:
         assert self.nodes is not None
         gx = self.nodes.gauge_x
@@ -261,6 +288,8 @@ class CouplingCore:
             f"(absolute SPH z); z_ref = {w.z_ref} m (up from still water)",
             f"windows: {self.times.size} of {self.window} s from t = {w.t_start} s to {self.times[-1]} s",
             f"gauge_x [m]: {' '.join(f'{x:.6g}' for x in n.gauge_x)}",
+            f"gauges: {' '.join(self.gauge_labels())}"
+            + ("" if self.gauge_info is not None else " (indices: a 1.0 server names none)"),
             f"client-side correction (seed 002): "
             f"{f'on, low-pass tau = {self.filter_tau:.4g} s' if self.options.absorb else 'off'}, "
             f"gauges {self.gauges}; "

@@ -70,8 +70,9 @@ class CouplingReport:
 class GaugeLog:
     """CSV of the gauge series, one row per window, flushed as it comes (nothing lost on a crash).
 
-    Columns: t [s], steps, then per gauge i: eta_i [m] (measured), wet_i, u_ref_i, w_ref_i [m/s],
-    eta_model_i [m]; finally du_inlet, du_outlet [m/s] (the seed 002 corrections applied).
+    Columns: t [s], steps, then per gauge i (its name from a 1.1 server, else its index):
+    eta_i [m] (measured), wet_i, u_ref_i, w_ref_i [m/s], eta_model_i [m]; finally du_inlet,
+    du_outlet [m/s] (the seed 002 corrections applied).
     """
 
     def __init__(self, path: Path, header: str) -> None:
@@ -85,6 +86,7 @@ class GaugeLog:
         for line in header.splitlines():
             self._f.write(f"# {line}\n")
         self._columns_written = False
+        self.labels: list[str] | None = None  # gauge names (1.1 server) or indices, per column
 
     def note(self, line: str) -> None:
         """A '# ' comment line (run metadata), before the first row."""
@@ -95,8 +97,9 @@ class GaugeLog:
         n = r.eta.size
         if not self._columns_written:
             cols = ["t", "steps"]
-            for i in range(n):
-                cols += [f"eta_{i}", f"wet_{i}", f"u_ref_{i}", f"w_ref_{i}", f"eta_model_{i}"]
+            for label in (self.labels or [str(i) for i in range(n)]):
+                cols += [f"eta_{label}", f"wet_{label}", f"u_ref_{label}", f"w_ref_{label}",
+                         f"eta_model_{label}"]
             self._f.write(",".join(cols + ["du_inlet", "du_outlet"]) + "\n")
             self._columns_written = True
         row = [f"{r.t1:.9g}", str(r.steps)]
@@ -150,8 +153,13 @@ async def run_coupling(url: str, model: ModelSource, options: CouplingOptions | 
         stage, timeout = "handshake", waited
         await transport.send([core.on_welcome(*welcome)])
         core.on_nodes(*await transport.recv(timeout))
+        ask = core.gauges_request()
+        if ask is not None:
+            await transport.send([ask])
+            core.on_gauges(*await transport.recv(timeout))
         report.welcome, report.gauges = core.welcome, core.gauges
         if log is not None:
+            log.labels = core.gauge_labels()
             for line in core.describe():
                 log.note(line)
         bar = tqdm(total=core.windows_left, unit="window", desc="coupling", disable=not progress,
@@ -162,7 +170,7 @@ async def run_coupling(url: str, model: ModelSource, options: CouplingOptions | 
             frames = core.next_window()
             t_b = time.perf_counter()
             await transport.send(frames)
-            reply = await transport.recv(timeout)
+            reply = await _reply(transport, core, timeout)
             t_c = time.perf_counter()
             record = core.on_result(*reply)
             report.records.append(record)
@@ -203,6 +211,15 @@ async def run_coupling(url: str, model: ModelSource, options: CouplingOptions | 
             log.close()
         await _close_quietly(transport)
     return report
+
+
+async def _reply(transport, core: CouplingCore, timeout: float):
+    """The next reply; WORKING frames (1.1 KEEPALIVE) restart the wait: ``timeout`` then bounds
+    the silence of the server, not the solve of a window."""
+    while True:
+        reply = await transport.recv(timeout)
+        if not core.session.keepalive(*reply):
+            return reply
 
 
 async def _await_welcome(transport, limit: float, progress: bool):

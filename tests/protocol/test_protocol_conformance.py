@@ -1,0 +1,94 @@
+"""The conformance kit's scripted server (``python -m protocol.conformance --serve PORT``) checks
+a client: our C example client passes every check; a client that breaks the protocol fails the
+check named for what it broke (and the kit exits 1)."""
+
+from __future__ import annotations
+
+import socket
+import subprocess
+import sys
+import threading
+from pathlib import Path
+
+import numpy as np
+
+from protocol import FrameDecoder, GetNodes, Hello, Set, Solve, encode_frame
+from protocol.conformance import Report, main, check_client
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def test_the_c_client_passes_the_scripted_server(c_client):
+    kit = subprocess.Popen([sys.executable, "-m", "protocol.conformance", "--serve", "0",
+                            "--t-end", "0.2"], cwd=ROOT, stdout=subprocess.PIPE, text=True)
+    try:
+        port = int(kit.stdout.readline().split()[-1])
+        out = subprocess.run([str(c_client), "127.0.0.1", str(port), "conformance", "4",
+                              "0.02", "1.0", "0.05"], capture_output=True, text=True, timeout=60)
+        lines = kit.stdout.read().splitlines()
+        assert kit.wait(timeout=30) == 0, lines
+    finally:
+        kit.kill()
+    assert out.returncode == 0, out.stderr
+    assert lines[-1] == "ALL PASSED" and "PASS BYE at the end -- after 4 windows, t = 0.2 s" in lines
+
+
+def _scripted(run_client) -> Report:
+    """The scripted server on an ephemeral port, ``run_client(port)`` in a thread."""
+    rep = Report(echo=False)
+    with socket.create_server(("127.0.0.1", 0)) as srv:
+        port = srv.getsockname()[1]
+        th = threading.Thread(target=run_client, args=(port,), daemon=True)
+        th.start()
+        sock, _ = srv.accept()
+        with sock:
+            check_client(sock, rep)
+        th.join(timeout=10)
+    return rep
+
+
+def _handshake(sock: socket.socket, dec: FrameDecoder) -> int:
+    """HELLO, GETNODES; returns N."""
+    sock.sendall(encode_frame(Hello(0, bytes(32), "x", "broken"), 1))
+    welcome = dec.feed(sock.recv(1 << 16))[0][1]
+    sock.sendall(encode_frame(GetNodes(), 2))
+    dec.feed(sock.recv(1 << 16))
+    return welcome.n_nodes
+
+
+def test_a_client_with_a_gap_in_its_seq_fails_the_seq_check():
+    def broken(port: int) -> None:
+        with socket.create_connection(("127.0.0.1", port)) as sock:
+            dec = FrameDecoder()
+            n = _handshake(sock, dec)
+            z = np.zeros(n)
+            sock.sendall(encode_frame(Set(0.0, 0.05, z, z, z), 3) + encode_frame(Solve(), 5))
+            sock.recv(1 << 16)
+
+    rep = _scripted(broken)
+    assert not rep.ok
+    assert rep.failed()[0] == "message order and seq 1, 2, 3, ..."
+
+
+def test_a_client_that_leaves_without_bye_fails_the_bye_check():
+    def no_bye(port: int) -> None:
+        with socket.create_connection(("127.0.0.1", port)) as sock:
+            dec = FrameDecoder()
+            n = _handshake(sock, dec)
+            z = np.zeros(n)
+            sock.sendall(encode_frame(Set(0.0, 0.05, z, z, z), 3) + encode_frame(Solve(), 4))
+            dec.feed(sock.recv(1 << 16))
+
+    rep = _scripted(no_bye)
+    assert rep.failed() == ["BYE at the end"]
+    assert ("PASS", "at least one window solved", "1 windows") in rep.lines
+
+
+def test_the_kit_exits_1_when_a_server_check_fails(capsys):
+    # nothing listens on the port: the kit says which checks failed and exits 1 (never 0)
+    with socket.create_server(("127.0.0.1", 0)) as s:
+        port = s.getsockname()[1]
+    assert main([f"tcp://127.0.0.1:{port}", "--run-id", "r", "--timeout", "2"]) == 1
+    out = capsys.readouterr().out.splitlines()
+    assert out[0].startswith("FAIL malformed frame -> MALFORMED -- cannot connect")
+    assert out[-1].startswith("FAILED: malformed frame -> MALFORMED, ")
