@@ -40,12 +40,18 @@ from typing import Any, Callable, Iterable
 
 # name -> sph_core.scene.Constants overrides. The solver's schemes and options today: delta-SPH
 # WCSPH with the leapfrog (kdk, one force pass per step) or the DualSPHysics-style symplectic
-# predictor-corrector (two passes), and the smoothing length h/dp (sqrt 2, the default, or 2).
+# predictor-corrector (two passes), the smoothing length h/dp (sqrt 2, the default, or 2), the
+# wall artificial viscosity and particle shifting. A new scheme or option is one line here.
 METHODS: dict[str, dict[str, Any]] = {
     "wcsph_kdk": {},
     "wcsph_symplectic": {"integrator": "symplectic_pc"},
     "wcsph_kdk_h2": {"h_over_dp": 2.0},
     "wcsph_symplectic_h2": {"integrator": "symplectic_pc", "h_over_dp": 2.0},
+    # no artificial viscosity against walls: the wave-decay study's main finding
+    # (docs/wave_decay_study.md), and particle shifting on top of it
+    "wcsph_kdk_h2_wallav0": {"h_over_dp": 2.0, "alpha_wall_factor": 0.0},
+    "wcsph_kdk_h2_wallav0_shift": {"h_over_dp": 2.0, "alpha_wall_factor": 0.0,
+                                   "shifting": "fickian"},
 }
 # the coupled case's two ways to compute the same flume
 COUPLED_METHODS = ("coupled", "sph_only")
@@ -311,14 +317,22 @@ def run_sweep(points: list[Point], out: Path, scheduler: str | None = None,
     if todo:
         from dask.distributed import Client, LocalCluster, as_completed
 
-        # one numba/OpenMP thread per worker process: the workers are the parallelism
-        for var in ("NUMBA_NUM_THREADS", "OMP_NUM_THREADS"):
-            os.environ.setdefault(var, "1")
         cluster = None
         if scheduler is None:
             n = n_workers or max(1, min(len(todo), os.cpu_count() or 1))
-            cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                                   dashboard_address=":0")   # any free port: no clash with a running cluster
+            # one numba/OpenMP thread per worker process (the workers are the parallelism); set
+            # only while the workers spawn: numba in this process refuses a changed thread count
+            saved = {v: os.environ.get(v) for v in ("NUMBA_NUM_THREADS", "OMP_NUM_THREADS")}
+            os.environ.update({v: "1" for v in saved})
+            try:
+                cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                                       dashboard_address=":0")   # any free port: no clash
+            finally:
+                for v, old in saved.items():
+                    if old is None:
+                        os.environ.pop(v, None)
+                    else:
+                        os.environ[v] = old
         client = Client(scheduler or cluster)
         try:
             futures = client.map(runner, todo, key=[f"{desc}-{p.key}" for p in todo], pure=False)
