@@ -34,7 +34,6 @@ Scenarios (T_s: the run's simulated seconds; quick / full):
 
 from __future__ import annotations
 
-import csv
 import math
 import time
 import traceback
@@ -45,7 +44,7 @@ import numpy as np
 
 from wave_client import G
 
-from .sweeps import METHODS, Point, run_sweep, warm_up_method
+from .sweeps import METHODS, Point, run_sweep, warm_up_method, write_table
 
 STATUSES = ("stable", "noisy", "unstable", "failed")
 STATUS_COLOURS = {"stable": "#4caf50", "noisy": "#ffb300", "unstable": "#e53935", "failed": "#757575"}
@@ -312,18 +311,8 @@ def run_stability(points: list[Point], out: Path, **kw: Any) -> list[dict[str, A
 
 
 def write_stability_csv(rows: list[dict[str, Any]], path: Path, command: str = "") -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    with open(path, "w", newline="") as fh:
-        if command:
-            fh.write(f"# made by: {command}\n")
-        w = csv.DictWriter(fh, fieldnames=STABILITY_COLUMNS, extrasaction="ignore")
-        w.writeheader()
-        for r in rows:
-            row = {k: r.get(k) for k in STABILITY_COLUMNS}
-            for k in ("t_fail", "value", "t_end", "wall_s"):
-                if isinstance(row[k], float):
-                    row[k] = f"{row[k]:.4g}"
-            w.writerow(row)
+    write_table(rows, path, STABILITY_COLUMNS,
+                {k: ".4g" for k in ("t_fail", "value", "t_end", "wall_s")}, command)
 
 
 def plot_stability(rows: list[dict[str, Any]], path: Path, title: str = "") -> None:

@@ -359,20 +359,28 @@ def run_sweep(points: list[Point], out: Path, scheduler: str | None = None,
 
 
 # ---------------------------------------------------------------------------- outputs
-def write_csv(records: list[dict[str, Any]], path: Path, command: str = "") -> None:
-    """accuracy.csv: ACCURACY_COLUMNS, one row per point (``command`` as a # header line)."""
+def write_table(rows: list[dict[str, Any]], path: Path, columns: list[str],
+                formats: dict[str, str], command: str = "") -> None:
+    """A CSV of ``columns``, one row per record; numbers in ``formats`` columns written with that
+    format spec (``command`` as a # header line). accuracy.csv and stability.csv both."""
     path.parent.mkdir(parents=True, exist_ok=True)
     with open(path, "w", newline="") as fh:
         if command:
             fh.write(f"# made by: {command}\n")
-        w = csv.DictWriter(fh, fieldnames=ACCURACY_COLUMNS, extrasaction="ignore")
+        w = csv.DictWriter(fh, fieldnames=columns, extrasaction="ignore")
         w.writeheader()
-        for r in records:
-            row = {k: r.get(k) for k in ACCURACY_COLUMNS}
-            for k in ("error", "wall_s", "H_over_dp"):
-                if row[k] is not None:
-                    row[k] = f"{row[k]:.6g}"
+        for r in rows:
+            row = {k: r.get(k) for k in columns}
+            for k, spec in formats.items():
+                if isinstance(row[k], (int, float)) and not isinstance(row[k], bool):
+                    row[k] = format(row[k], spec)
             w.writerow(row)
+
+
+def write_csv(records: list[dict[str, Any]], path: Path, command: str = "") -> None:
+    """accuracy.csv: ACCURACY_COLUMNS, one row per point (``command`` as a # header line)."""
+    write_table(records, path, ACCURACY_COLUMNS,
+                {"error": ".6g", "wall_s": ".6g", "H_over_dp": ".6g"}, command)
 
 
 def read_csv(path: Path) -> list[dict[str, Any]]:
