@@ -190,6 +190,13 @@ class Constants(_Model):
         return self
 
 
+class Scheme(_Model):
+    """Which SPH scheme solves the fluid (issue 13 adds "isph" and "riemann" here)."""
+
+    kind: Literal["wcsph"] = Field("wcsph", description=(
+        "wcsph: weakly compressible, delta-SPH density diffusion, Monaghan viscosity"))
+
+
 class PointProbe(_Model):
     """Kernel-interpolated velocity (u, w) and pressure p at a point."""
 
@@ -313,6 +320,7 @@ class Scene(_Model):
     beds: list[Bed] = []
     structures: list[Structure] = []
     constants: Constants = Constants()
+    scheme: Scheme = Scheme()
     output: Output = Output()
     probes: list[Probe] = []
     open_boundaries: list[OpenBoundary] = []
