@@ -4,13 +4,16 @@ Runs the demo beach flume (examples/scenes/demo_beach_flume.toml, closed at both
 at rest and reports, every ``--every`` s, the fastest fluid particle (speed, x, z, height above
 the bed, fluid neighbours) and the lowest fluid pressure, one factor changed per variant:
 
-    base        the scene as shipped (free-slip walls), closed inlet
+    base        the scene as shipped (free-slip walls), closed inlet; the layout of
+                sph_core.geometry: lattice points above a bed's polyline fluid, below it dummies
+    band_half   fluid kept only at >= dp/2 from the bed polyline (the layout before the fix)
+    band_dp     fluid kept only at >= dp from the bed polyline
+    face        dummies only at >= dp/2 below the polyline (fluid as base)
     no_slip     wall_slip = "no_slip"
-    gap_dp      fluid kept only at >= dp (not dp/2) from the bed polyline
     flat        no beach: the same depth on a flat bed (the lattice meets only flat walls)
     wedge2      the wedge filled only where it holds >= 2 rows (cases/coupled_flume.SHORE_ROWS)
 
-    NUMBA_NUM_THREADS=1 python bench/shoreline_at_rest.py --dp 0.02 --t-end 1.5
+    NUMBA_NUM_THREADS=1 python bench/shoreline_at_rest.py --dp 0.02 --t-end 1.5 --variants base,band_half
 
 One JSON object per line (variant, t, v_max, x, z, above_bed, p_min).
 """
@@ -25,6 +28,7 @@ from pathlib import Path
 import numpy as np
 
 import sph_core.geometry as geometry
+import sph_core.simulation as simulation
 from sph_core.particles import FLUID, P, VX, VZ, X, Z
 from sph_core.scene import make_scene
 from sph_core.simulation import Simulation
@@ -48,16 +52,26 @@ def variant_scene(name: str, dp: float, t_end: float) -> dict:
 
 def run_variant(name: str, dp: float, t_end: float, every: float) -> None:
     scene = make_scene(variant_scene(name, dp, t_end))
-    orig = geometry._polyline_distance
-    if name == "gap_dp":  # shift the kept fluid: distance to the polyline >= dp instead of dp/2
-        def shifted(bed, x, z):
-            dist, below = orig(bed, x, z)
-            return dist + 0.5 * dp * (dist < dp), below
-        geometry._polyline_distance = shifted
+    orig = simulation.build_layout
+    band = {"band_half": 0.5 * dp, "band_dp": dp}.get(name)
+    if band is not None or name == "face":
+        def layout(sc):  # the shipped layout, then one band around each bed's polyline emptied
+            lay = orig(sc)
+            for bed in sc.beds:
+                if band is not None:   # fluid only at >= band from the polyline (the old layout: dp/2)
+                    d, _ = geometry._polyline_distance(bed, lay.fluid_x, lay.fluid_z)
+                    k = d >= band * (1 - 1e-6)
+                    lay.fluid_x, lay.fluid_z, lay.fluid_surface = lay.fluid_x[k], lay.fluid_z[k], lay.fluid_surface[k]
+                else:                  # dummies only at >= dp/2 below the polyline
+                    d, below = geometry._polyline_distance(bed, lay.wall_x, lay.wall_z)
+                    k = ~(below & (d < 0.5 * dp))
+                    lay.wall_x, lay.wall_z = lay.wall_x[k], lay.wall_z[k]
+            return lay
+        simulation.build_layout = layout
     try:
         sim = Simulation(scene)
     finally:
-        geometry._polyline_distance = orig
+        simulation.build_layout = orig
     bed = scene.beds[0].points if scene.beds else [(0.0, 0.0), (scene.tank.x1, 0.0)]
     bx, bz = np.array(bed).T
     t = 0.0
@@ -83,7 +97,7 @@ def main() -> None:
     ap.add_argument("--dp", type=float, default=0.02)
     ap.add_argument("--t-end", type=float, default=1.5)
     ap.add_argument("--every", type=float, default=0.25)
-    ap.add_argument("--variants", default="base,no_slip,gap_dp,flat")
+    ap.add_argument("--variants", default="base,band_half,band_dp,face,flat")
     a = ap.parse_args()
     for name in a.variants.split(","):
         run_variant(name, a.dp, a.t_end, a.every)

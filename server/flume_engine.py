@@ -14,8 +14,6 @@ Protocol view of the flume (PROTOCOL.md):
 from __future__ import annotations
 
 import math
-import os
-import pickle
 from dataclasses import replace
 from pathlib import Path
 
@@ -23,6 +21,7 @@ import numpy as np
 
 from protocol import NO_GAUGE, ErrorCode, GaugeKind, ProtocolError
 from sph_core.boundary_data import BoundaryDataError, BoundarySample
+from sph_core.checkpoint_file import load_checkpoint, save_checkpoint
 from sph_core.open_ends import SIDES
 from sph_core.scene import PointProbe, Scene
 from sph_core.simulation import Simulation
@@ -161,17 +160,11 @@ class FlumeEngine:
                 "fluid_mass_ratio": f.fluid_mass() / mass0 if mass0 else 1.0}
 
     def save_state(self, path: Path) -> None:
-        # our own file, read back only by load_state: pickle of plain dataclasses and arrays
-        tmp = Path(path).with_name(Path(path).name + ".tmp")
-        with open(tmp, "wb") as f:
-            pickle.dump(self.flume.checkpoint(), f, protocol=pickle.HIGHEST_PROTOCOL)
-            f.flush()
-            os.fsync(f.fileno())
-        os.replace(tmp, path)
+        # a portable npz (arrays + a JSON tree), never a pickle: sph_core.checkpoint_file
+        save_checkpoint(path, self.flume.checkpoint())
 
     def load_state(self, path: Path) -> None:
-        with open(path, "rb") as f:
-            self.flume.restore(pickle.load(f))
+        self.flume.restore(load_checkpoint(path))
         self.summary = replace(self.summary, t_start=self.flume.t)
 
     def close(self) -> None:

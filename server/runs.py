@@ -69,7 +69,7 @@ class Run:
 
     @property
     def state_file(self) -> Path:
-        return self.dir / "state.pkl"
+        return self.dir / "state.npz"
 
     def reset_live_parts(self) -> None:
         """Fresh events and engine slots for a resumed session."""
@@ -174,7 +174,7 @@ class RunManager:
             run.info.reason = f"{run.info.reason or run.info.state}; its saved state is damaged"
             if run.info.state in (FAILED, UNSTABLE):
                 run.info.status = f"{run.info.state}: {run.info.reason}"
-            log.warning("run %s: state.pkl does not match its seal: not resumable", run.info.id)
+            log.warning("run %s: state.npz does not match its seal: not resumable", run.info.id)
         return False
 
     def save_due(self, run: Run, force: bool = False) -> bool:

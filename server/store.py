@@ -5,8 +5,9 @@
         scene.json     the canonical scene bytes (the protocol's scene hash is their SHA-256)
         meta.json      RunInfo: status, progress, speed, stability, last gauges (atomic rewrite)
         gauges.csv     coupled runs: one row per solved window, flushed at once
-        state.pkl      coupled runs: the engine state at a window boundary (to resume the run)
-        state.pkl.sha256  its seal: a state that does not match it is not resumed
+        state.npz      coupled runs: the engine state at a window boundary (to resume the run;
+                       sph_core.checkpoint_file: numpy arrays + a JSON tree, no pickle)
+        state.npz.sha256  its seal: a state that does not match it is not resumed
         sph/           standalone runs: sph_core's own outputs (probes.csv, meta.json, snapshots/)
 """
 
@@ -21,7 +22,7 @@ import re
 from pathlib import Path
 from typing import Any, Callable
 
-from sph_core.output import write_json_atomic
+from sph_core.output import format_time, write_json_atomic
 
 from .schemas import RunInfo
 
@@ -109,7 +110,7 @@ def is_sealed(path: Path) -> bool:
 
 
 class GaugeWriter:
-    """gauges.csv of a coupled run: t, steps, then eta / u_ref / w_ref per gauge ('dry' if dry).
+    """gauges.csv of a coupled run: t, steps, then eta / u_ref / w_ref per gauge (empty if dry).
 
     Each row is flushed as written. ``mark()`` before a window and ``rewind()`` on GOBACK drop
     the rows of a window that is being redone, so the file always holds one row per window."""
@@ -132,8 +133,8 @@ class GaugeWriter:
         self._mark = self._f.tell()
 
     def row(self, t: float, steps: int, values: dict[str, float | None]) -> None:
-        self._csv.writerow([repr(float(t)), steps] +
-                           ["dry" if values.get(c) is None else repr(float(values[c]))
+        self._csv.writerow([format_time(t), steps] +
+                           ["" if values.get(c) is None else repr(float(values[c]))
                             for c in self.columns[2:]])
         self._f.flush()
 
@@ -150,10 +151,11 @@ class GaugeWriter:
 
 
 def read_gauges(path: Path) -> tuple[list[str], list[dict[str, float | None]]]:
-    """A gauge CSV as columns and rows; 'dry' becomes None."""
+    """A gauge CSV as columns and rows; a dry gauge (empty, or 'dry' in older files) is None."""
     with open(path, newline="") as f:
         rows = list(csv.reader(f))
     if not rows:
         return [], []
     cols = rows[0]
-    return cols, [{c: (None if v == "dry" else float(v)) for c, v in zip(cols, r)} for r in rows[1:]]
+    return cols, [{c: (None if v in ("", "dry") else float(v)) for c, v in zip(cols, r)}
+                  for r in rows[1:] if r]

@@ -126,9 +126,14 @@ def build_layout(scene: Scene) -> Layout:
         surf[cover] = np.maximum(surf[cover], b.z1)
     half = 0.5 * dp * (1 - 1e-6)
     keep = (fluid_x > t.x0 + half) & (fluid_x < t.x1 - half) & (fluid_z > t.z0 + half)
+    # a bed splits the lattice: every point below its polyline (within the wall thickness) is a
+    # dummy, every point above it fluid, with no gap band, so each lattice column meets the bed
+    # at the flat floor's fluid-to-dummy spacing dp. (A band of dp/2 left a one-particle void in
+    # about half of the columns along a slope: the shoreline wedge went into tension and burst,
+    # docs/SHORELINE_JET.md.)
     for bed in scene.beds:
-        d, below = _polyline_distance(bed, fluid_x, fluid_z)
-        keep &= ~below & (d >= half)
+        _, below = _polyline_distance(bed, fluid_x, fluid_z)
+        keep &= ~below
     for s in scene.structures:
         inside = ((fluid_x > s.x0 - half) & (fluid_x < s.x1 + half)
                   & (fluid_z > s.z0 - half) & (fluid_z < s.z1 + half))

@@ -35,9 +35,9 @@ def format_time(t: float) -> str:
 
 def load_gauges(path: str | Path) -> dict[str, np.ndarray]:
     """Any wavesph gauge CSV (a run's probes.csv, the server's gauges.csv, a coupling client's
-    log, `wavesph waves` output) as {column: float array}: ``#`` lines are skipped, a dry gauge
-    (``dry`` or an empty field) is NaN. Returns numpy arrays (pandas is not a dependency;
-    ``pandas.DataFrame(load_gauges(p))`` gives a frame)."""
+    log, `wavesph waves` output) as {column: float array}: a dry gauge (an empty field) is NaN.
+    Files of earlier versions are read too (``#`` lines skipped, the word ``dry`` is NaN).
+    ``wavesph.read_gauges`` gives the same as a pandas DataFrame."""
     with open(path, newline="") as fh:
         rows = list(csv.reader(line for line in fh if line.strip() and not line.startswith("#")))
     if not rows:
@@ -80,12 +80,12 @@ class RunWriter:
         write_json_atomic(self.dir / "meta.json", self.meta)
 
     def probe_row(self, t: float, step: int, values: dict[str, float | None]) -> None:
-        """One CSV row; a dry gauge is written as the word ``dry``, never as NaN (the server's
-        gauge reader, server/store.py, expects that word). Times are printed short."""
+        """One CSV row; a dry gauge is an empty field (NaN to pandas.read_csv), never a word in a
+        numeric column. Times are printed short."""
         row: list[Any] = [format_time(t), step]
         for c in self.columns[2:]:
             v = values.get(c)
-            row.append("dry" if v is None else repr(float(v)))
+            row.append("" if v is None else repr(float(v)))
         self._csv.writerow(row)
         self._csv_file.flush()
 

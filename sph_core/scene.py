@@ -341,6 +341,16 @@ class Scene(_Model):
                 raise ValueError(f"water_blocks.{i}: must lie inside the tank")
             if min(b.x1 - b.x0, b.z1 - b.z0) < self.dp:
                 raise ValueError(f"water_blocks.{i}: must be at least dp wide and high")
+        swl = self.still_water_level
+        if swl is not None:
+            if not t.z0 < swl < t.z1:
+                raise ValueError(f"still_water_level: {swl} m must lie between the tank's floor "
+                                 f"z0 = {t.z0} m and top z1 = {t.z1} m (with freeboard for the waves)")
+            tops = [b.z1 for b in self.water_blocks]
+            if tops and abs(max(tops) - swl) > 0.5 * self.dp:
+                raise ValueError(f"still_water_level: {swl} m, but the highest water block's top "
+                                 f"is {max(tops)} m: the blocks hold the still water, so they "
+                                 "should meet it (within dp/2)")
         dup = {n for n, k in Counter(p.name for p in self.probes).items() if k > 1}  # O(n)
         if dup:
             raise ValueError(f"probes: duplicate names {sorted(dup)}")

@@ -10,7 +10,8 @@ from pathlib import Path
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("scene", type=Path, help="TOML scene (grid, bathymetry, wave, sponge, gauges)")
     parser.add_argument("-o", "--out", dest="output", type=Path, default=None,
-                        help="gauge CSV path (default: output.csv of the scene)")
+                        help="gauge CSV path, must not exist; its metadata goes to <stem>.meta.json "
+                             "(default: output.csv of the scene)")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
 
 
@@ -22,6 +23,11 @@ def main(args: argparse.Namespace) -> int:
     try:
         scene = load_wave_scene(args.scene)
         csv_path = args.output or Path(scene.output.csv)
+        for p in (csv_path, csv_path.with_suffix(".meta.json")):
+            if p.exists():
+                print(f"wavesph waves: {p} exists: choose a new --out (a run never overwrites "
+                      "another's data)", file=sys.stderr)
+                return 2
         summary = run_wave_scene(scene, csv_path, base_dir=args.scene.parent, progress=not args.no_progress)
     except (WaveSceneError, ValueError) as exc:
         print(f"wavesph waves: {exc}", file=sys.stderr)

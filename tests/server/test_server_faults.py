@@ -369,7 +369,7 @@ def test_damaged_saved_state_is_not_resumable(tmp_path, factory):
         run_windows(c, welcome, nodes, 2)
         c.close()
         assert srv.wait_state(run["id"], "failed")["resumable"]
-        state = tmp_path / "runs" / run["id"] / "state.pkl"
+        state = tmp_path / "runs" / run["id"] / "state.npz"
         good = state.read_bytes()
         state.write_bytes(good[:-3] + b"xyz")  # damaged under a live server: resume refuses
         r = srv.http.post(f"/runs/{run['id']}/resume")

@@ -56,3 +56,17 @@ def test_toml_errors(tmp_path):
                     '[[water_blocks]]\nx0=0\nx1=1\nz0=0\nz1=0.5\nheigth=2\n')
     with pytest.raises(SceneError, match=r"water_blocks\.0\.heigth: Extra inputs"):
         load_scene(typo)
+
+
+@pytest.mark.parametrize("swl,top,message", [
+    (0.5, 0.5, "between the tank's floor"),     # still water at the tank top: no freeboard
+    (0.3, 0.2, "highest water block's top"),    # the blocks do not fill to the declared level
+])
+def test_still_water_level_is_checked_against_the_tank_and_the_water_blocks(swl, top, message):
+    scene = {"dp": 0.02, "t_end": 1.0, "still_water_level": swl,
+             "tank": {"x0": 0.0, "x1": 1.0, "z0": 0.0, "z1": 0.5},
+             "water_blocks": [{"x0": 0.0, "x1": 1.0, "z0": 0.0, "z1": top}]}
+    with pytest.raises(SceneError, match=message):
+        make_scene(scene)
+    make_scene({**scene, "still_water_level": 0.2, "water_blocks": [
+        {"x0": 0.0, "x1": 1.0, "z0": 0.0, "z1": 0.2}]})   # consistent: accepted

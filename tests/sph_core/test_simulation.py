@@ -163,7 +163,9 @@ def test_dry_gauge_reports_dry(tmp_path):
     assert v["wet_z_surface"] == pytest.approx(0.1, abs=0.25 * scene.dp)
     sim.close()
     row = list(csv.DictReader((tmp_path / "probes.csv").open()))[0]
-    assert row["dry_z_surface"] == "dry" and row["air_u"] == "dry"
+    assert row["dry_z_surface"] == "" and row["air_u"] == ""   # empty: NaN to pandas, no word
+    frame = __import__("wavesph").read_gauges(tmp_path / "probes.csv")
+    assert frame["dry_eta"].isna().all() and frame["wet_z_surface"].notna().all()
 
 
 def test_cli_run(tmp_path, capsys):

@@ -3,9 +3,11 @@
 from __future__ import annotations
 
 import argparse
+import json
 from pathlib import Path
 
 import numpy as np
+import pandas
 import pytest
 
 from wave_client.boussinesq import nwogu_wavenumber
@@ -79,7 +81,14 @@ def test_cli_writes_gauge_csv_and_reports_bad_scene(tmp_path, capsys):
     waves_cli.add_arguments(parser)
     assert waves_cli.main(parser.parse_args([str(scene), "-o", str(out), "--no-progress"])) == 0
     t, eta, header = read_csv(out)
-    assert header == ["time_s", "eta_5m", "eta_10m"]
+    assert header == ["t", "eta_5m", "eta_10m"]
+    frame = pandas.read_csv(out)   # the README's dialect: no comment lines, every column numeric
+    assert list(frame.columns) == header and all(frame.dtypes == float)
+    meta = json.loads(out.with_suffix(".meta.json").read_text())
+    assert meta["status"] == "completed" and "eta_5m" in meta["columns"]
+    # never overwrites: the same --out again is refused
+    assert waves_cli.main(parser.parse_args([str(scene), "-o", str(out), "--no-progress"])) == 2
+    assert "exists" in capsys.readouterr().err
     assert t[0] == 0.0 and t[-1] == pytest.approx(4.0, abs=0.05) and eta.shape == (t.size, 2)
     assert np.all(np.isfinite(eta)) and np.abs(eta).max() > 0
     scene.write_text("[grid]\nx_start = 0\n")
@@ -143,17 +152,18 @@ def test_build_model_from_example_scene():
 
 def test_unstable_run_is_reported_and_writes_no_nan(tmp_path, capsys):
     """A time step far beyond stability: the CLI exits 1 naming the step, and the CSV keeps
-    only finite rows plus a line saying where the run stopped."""
+    only finite rows; its .meta.json says where the run stopped. (dx = 0.25 m: 16 points per
+    wavelength, so the scene passes the resolution check and fails on the time step.)"""
     scene = tmp_path / "unstable.toml"
     scene.write_text(FLAT.format(wave='kind = "regular"\nheight = 0.05\nperiod = 2.0\nx_source = 0.0')
-                     .replace("dx = 0.05", "dx = 0.5\ndt = 0.5").replace("every = 0.05", "every = 0.5"))
+                     .replace("dx = 0.05", "dx = 0.25\ndt = 0.5").replace("every = 0.05", "every = 0.5"))
     out = tmp_path / "g.csv"
     parser = argparse.ArgumentParser()
     waves_cli.add_arguments(parser)
     assert waves_cli.main(parser.parse_args([str(scene), "-o", str(out), "--no-progress"])) == 1
     assert "unstable at step" in capsys.readouterr().err
-    text = out.read_text()
-    assert "# run stopped: unstable" in text
+    assert "#" not in out.read_text()
+    assert json.loads(out.with_suffix(".meta.json").read_text())["status"].startswith("unstable at t")
     _, eta, _ = read_csv(out)
     assert np.all(np.isfinite(eta))
 
@@ -195,3 +205,17 @@ def test_dingemans_bar_against_measurements():
     assert np.all(np.abs(np.angle(np.exp(1j * rel_phase))) < 0.3)
     bar = (xs > 20) & (xs < 31)
     np.testing.assert_allclose(np.abs(model[bar, 1]), np.abs(measured[bar, 1]), rtol=0.15)
+
+
+@pytest.mark.parametrize("wave,depth,dx,message", [
+    ("height = 0.5\nperiod = 2.0", 0.4, 0.05, "breaking limit"),           # H/d = 1.25
+    ("height = 0.15\nperiod = 0.8", 0.5, 0.02, "steepness limit"),         # H/L = 0.15
+    ("height = 0.01\nperiod = 0.3", 2.0, 0.005, "kd = 89"),                # deep water, kd ~ 90
+    ("height = 0.01\nperiod = 2.0", 0.5, 0.5, "points per wavelength"),    # 8 points
+])
+def test_a_wave_that_does_not_fit_its_depth_or_grid_is_one_clear_error(tmp_path, wave, depth, dx, message):
+    p = tmp_path / "w.toml"
+    p.write_text(FLAT.format(wave=f'kind = "regular"\n{wave}\nx_source = 0.0')
+                 .replace("depth = [0.5]", f"depth = [{depth}]").replace("dx = 0.05", f"dx = {dx}"))
+    with pytest.raises(WaveSceneError, match=message):
+        load_wave_scene(p)

@@ -1,11 +1,14 @@
 """Run a `wavesph waves` scene alone and write the gauge elevation series to CSV.
 
-The CSV has '#' comment lines (what, units, grid), a header row `time_s,<gauge columns>` and one
-row per sample; rows are flushed as the run goes, so an interrupted run keeps what it computed.
+The CSV is the README's dialect: one header row `t,<gauge columns>` (t [s], each gauge's
+elevation eta [m] above still water), one row per sample, no comment lines; rows are flushed as
+the run goes, so an interrupted run keeps what it computed. What the run was (model, gauges,
+grid, how it ended) is in `<stem>.meta.json` beside it.
 """
 
 from __future__ import annotations
 
+import json
 import time
 from pathlib import Path
 
@@ -31,18 +34,21 @@ def run_wave_scene(scene: WaveScene, csv_path: Path, base_dir: Path | None = Non
     n_total = int(round(scene.grid.t_end / model.dt))
     csv_path.parent.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
+    meta = {"model": "wavesph waves: Nwogu extended Boussinesq (z_alpha = -0.531 h), 1D",
+            "columns": {"t": "time [s]", **{c: f"surface elevation eta [m] above still water at x = {x:g} m"
+                                            for c, x in zip(scene.gauges.columns(), xs)}},
+            "grid": {"x0": model.x0, "x1": model.x1, "dx": model.dx, "dt": model.dt,
+                     "nodes": model.n_nodes},
+            "status": "running"}
+    meta_path = csv_path.with_suffix(".meta.json")
+    meta_path.write_text(json.dumps(meta, indent=1))
     with open(csv_path, "w", encoding="utf-8") as out, \
             tqdm(total=n_total, disable=not progress, unit="step", desc="waves",
                  mininterval=TQDM_INTERVAL) as bar:
-        out.write("# wavesph waves: Nwogu extended Boussinesq (z_alpha = -0.531 h), 1D\n")
-        out.write(f"# surface elevation eta [m] above still water at gauges x = "
-                  f"{', '.join(f'{x:g}' for x in xs)} m; time [s]\n")
-        out.write(f"# grid {model.x0:g}..{model.x1:g} m, dx = {model.dx:.6g} m, dt = {model.dt:.6g} s, "
-                  f"{model.n_nodes} nodes\n")
-        out.write("time_s," + ",".join(scene.gauges.columns()) + "\n")
+        out.write("t," + ",".join(scene.gauges.columns()) + "\n")
 
         def write_row() -> None:
-            out.write(f"{model.t:.6f}," + ",".join(f"{v:.8e}" for v in model.elevation(xs)) + "\n")
+            out.write(f"{model.t:.12g}," + ",".join(f"{v:.8e}" for v in model.elevation(xs)) + "\n")
 
         write_row()
         done = 0
@@ -58,8 +64,11 @@ def run_wave_scene(scene: WaveScene, csv_path: Path, base_dir: Path | None = Non
                 bar.update(block)
                 out.flush()
         except BoussinesqUnstableError:
-            out.write(f"# run stopped: unstable at t = {model.t:.6g} s\n")
+            meta["status"] = f"unstable at t = {model.t:.6g} s"
+            meta_path.write_text(json.dumps(meta, indent=1))
             raise
+    meta["status"] = "completed"
+    meta_path.write_text(json.dumps(meta, indent=1))
     wall = time.perf_counter() - t0
     stats = model.corrector_stats
     return {"steps": float(n_total), "nodes": float(model.n_nodes), "dt": model.dt, "wall_s": wall,

@@ -13,7 +13,14 @@ from typing import Annotated, Literal
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
+from wave_client.theories.linear import wavenumber
+
 from .solver import BoussinesqModel
+
+BREAKING_H_OVER_D = 0.78       # McCowan's solitary-wave limit: a higher wave breaks before it gets there
+MICHE = 0.142                  # Miche's steepness limit H/L = 0.142 tanh(kd)
+KD_MAX = 3.0                   # Nwogu (z_alpha = -0.531 h): phase speed within 0.5 % of Airy to kd = 3 (2.7 % at 4)
+MIN_POINTS_PER_WAVELENGTH = 10  # grid nodes per wavelength of the primary wave, at the shallowest depth
 
 
 class _Strict(BaseModel):
@@ -138,7 +145,34 @@ class WaveScene(_Strict):
             raise ValueError(f"coupling.x ({xc}) lies outside the grid")
         if self.sponge.left + self.sponge.right >= g.x_end - g.x_start:
             raise ValueError("sponge.left + sponge.right must be shorter than the grid")
+        if isinstance(self.wave, RegularWave):
+            self._wave_fits()
         return self
+
+    def _wave_fits(self) -> None:
+        """Cross-field checks of a regular wave against the depth and the grid, before a run:
+        one clear error instead of a run that blows up or silently leaves the model's range."""
+        w, b = self.wave, self.bathymetry
+        d = float(np.interp(w.x_source, b.x, b.depth))
+        k = float(wavenumber(2 * np.pi / w.period, d))
+        if w.height / d > BREAKING_H_OVER_D:
+            raise ValueError(f"wave.height: H/d = {w.height / d:.2f} at the source (d = {d:g} m) is "
+                             f"above the breaking limit {BREAKING_H_OVER_D} (McCowan 1894): the wave "
+                             "cannot exist there")
+        steep = MICHE * np.tanh(k * d)
+        if w.height * k / (2 * np.pi) > steep:
+            raise ValueError(f"wave.height: H/L = {w.height * k / (2 * np.pi):.3f} at the source is "
+                             f"above the steepness limit 0.142 tanh(kd) = {steep:.3f} (Miche 1944)")
+        if k * d > KD_MAX:
+            raise ValueError(f"wave.period: kd = {k * d:.2f} at the source (d = {d:g} m) is outside "
+                             f"the model's range kd <= {KD_MAX} (Nwogu's extended equations): use a "
+                             "longer period or a shallower source")
+        d_min = min(b.depth)
+        per_wavelength = 2 * np.pi / float(wavenumber(2 * np.pi / w.period, d_min)) / self.grid.dx
+        if per_wavelength < MIN_POINTS_PER_WAVELENGTH:
+            raise ValueError(f"grid.dx: {per_wavelength:.1f} points per wavelength where the water "
+                             f"is shallowest (d = {d_min:g} m); at least {MIN_POINTS_PER_WAVELENGTH} "
+                             "are needed")
 
 
 class WaveSceneError(ValueError):
@@ -155,8 +189,10 @@ def load_wave_scene(path: str | Path) -> WaveScene:
     try:
         return WaveScene.model_validate(data)
     except ValidationError as exc:
-        lines = [f"{'.'.join(str(p) for p in e['loc'])}: {e['msg']}" for e in exc.errors()]
-        raise WaveSceneError(f"{path}: invalid scene\n  " + "\n  ".join(lines)) from exc
+        lines = [": ".join(filter(None, (".".join(str(p) for p in e["loc"]),
+                                         e["msg"].removeprefix("Value error, "))))
+                 for e in exc.errors()]
+        raise WaveSceneError(f"{path}: invalid scene: " + "; ".join(lines)) from exc
 
 
 def read_series(path: Path) -> tuple[np.ndarray, np.ndarray]:

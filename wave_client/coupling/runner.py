@@ -15,6 +15,8 @@ to the CSV log and flushed as it arrives, so a failed run keeps what it measured
 from __future__ import annotations
 
 import asyncio
+import json
+import os
 import sys
 import time
 from dataclasses import dataclass, field
@@ -72,26 +74,34 @@ class GaugeLog:
 
     Columns: t [s], steps, then per gauge i (its name from a 1.1 server, else its index):
     eta_i [m] (measured), wet_i, u_ref_i, w_ref_i [m/s], eta_model_i [m]; finally du_inlet,
-    du_outlet [m/s] (the seed 002 corrections applied).
+    du_outlet [m/s] (the seed 002 corrections applied). One header row, no comment lines (the
+    README's CSV dialect): the run's metadata goes to ``<stem>.meta.json`` beside it.
     """
 
     def __init__(self, path: Path, header: str) -> None:
         self.path = Path(path)
-        if self.path.exists():
-            raise ValueError(f"log_path {self.path} exists: refusing to overwrite a run's data")
+        self.meta_path = self.path.with_suffix(".meta.json")
+        for p in (self.path, self.meta_path):
+            if p.exists():
+                raise ValueError(f"log_path {p} exists: refusing to overwrite a run's data")
         try:
             self._f: TextIO = self.path.open("x", encoding="utf-8")
         except OSError as exc:
             raise ValueError(f"log_path {self.path}: cannot create it ({exc.strerror})") from exc
-        for line in header.splitlines():
-            self._f.write(f"# {line}\n")
+        self.notes: list[str] = header.splitlines()
+        self._write_meta()
         self._columns_written = False
         self.labels: list[str] | None = None  # gauge names (1.1 server) or indices, per column
 
+    def _write_meta(self) -> None:
+        tmp = self.meta_path.with_name(self.meta_path.name + ".tmp")
+        tmp.write_text(json.dumps({"csv": self.path.name, "notes": self.notes}, indent=1))
+        os.replace(tmp, self.meta_path)
+
     def note(self, line: str) -> None:
-        """A '# ' comment line (run metadata), before the first row."""
-        self._f.write(f"# {line}\n")
-        self._f.flush()
+        """One line of run metadata (into ``<stem>.meta.json``)."""
+        self.notes.append(line)
+        self._write_meta()
 
     def write(self, r: WindowRecord) -> None:
         n = r.eta.size
@@ -102,7 +112,7 @@ class GaugeLog:
                          f"eta_model_{label}"]
             self._f.write(",".join(cols + ["du_inlet", "du_outlet"]) + "\n")
             self._columns_written = True
-        row = [f"{r.t1:.9g}", str(r.steps)]
+        row = [f"{r.t1:.12g}", str(r.steps)]
         for i in range(n):
             row += [f"{r.eta[i]:.9g}", str(int(r.wet[i])), f"{r.u_ref[i]:.9g}", f"{r.w_ref[i]:.9g}",
                     f"{r.eta_model[i]:.9g}"]
