@@ -30,14 +30,14 @@ import numpy as np
 import sph_core.geometry as geometry
 import sph_core.simulation as simulation
 from sph_core.particles import FLUID, P, VX, VZ, X, Z
-from sph_core.scene import make_scene
+from sph_core.scene import make_scene, split_scene_file
 from sph_core.simulation import Simulation
 
 SCENE = Path(__file__).resolve().parents[1] / "examples/scenes/demo_beach_flume.toml"
 
 
 def variant_scene(name: str, dp: float, t_end: float) -> dict:
-    d = tomllib.loads(SCENE.read_text())
+    d, _ = split_scene_file(tomllib.loads(SCENE.read_text()))
     d.pop("open_boundaries")
     d.update(dp=dp, t_end=t_end, probes=[])
     if name == "no_slip":

@@ -9,9 +9,12 @@ from __future__ import annotations
 
 import json
 import math
+import tomllib
 from typing import Any
 
 from pydantic import ValidationError
+
+from sph_core.scene import split_scene_file
 
 from .schemas import RunRequest, estimate_particles
 from .settings import Settings
@@ -58,12 +61,22 @@ def _non_finite(value: Any, loc: list[str | int], out: list[dict[str, Any]]) -> 
             stack.extend((x, [*where, i]) for i, x in reversed(list(enumerate(v))))
 
 
-def parse_run_request(raw: bytes, settings: Settings) -> RunRequest:
-    """The validated request, or BodyNotJson / RequestInvalid naming what is wrong."""
+def request_from_scene_file(data: dict[str, Any]) -> dict[str, Any]:
+    """A parsed scene file (TOML) as a RunRequest body: its `mode`, `[coupling]` and `[source]`
+    (sph_core.scene.RUN_TABLES) beside the scene. Without a `mode`: standalone if it has a
+    source or no open end, else coupled."""
+    scene, run = split_scene_file(data)
+    mode = "standalone" if "source" in run or not scene.get("open_boundaries") else "coupled"
+    return {"scene": scene, "mode": mode, **run}
+
+
+def parse_run_request(raw: bytes, settings: Settings, toml: bool = False) -> RunRequest:
+    """The validated request, or BodyNotJson / RequestInvalid naming what is wrong. ``toml``: the
+    body is a scene file (request_from_scene_file), not a JSON RunRequest."""
     try:
-        data = json.loads(raw)
-    except (ValueError, RecursionError) as exc:
-        raise BodyNotJson(f"the body is not JSON: {str(exc)[:200]}") from None
+        data = request_from_scene_file(tomllib.loads(raw.decode())) if toml else json.loads(raw)
+    except (ValueError, RecursionError) as exc:  # TOMLDecodeError and UnicodeDecodeError too
+        raise BodyNotJson(f"the body is not {'TOML' if toml else 'JSON'}: {str(exc)[:200]}") from None
     errors: list[dict[str, Any]] = []
     _non_finite(data, [], errors)
     if errors:

@@ -114,3 +114,26 @@ class RunWriter:
     def close(self) -> None:
         if not self._csv_file.closed:
             self._csv_file.close()
+
+
+def write_geometry_vtk(scene: Any, path: Path) -> Path:
+    """The scene's outlines as VTK polylines (``path`` without suffix; returns the .vtu): the
+    tank's inner faces, each bed's polyline, each structure's rectangle, each open end's face.
+    Cell data ``part``: 0 tank, 1 bed, 2 structure, 3 open end."""
+    from pyevtk.hl import polyLinesToVTK
+
+    t = scene.tank
+    lines: list[tuple[list[tuple[float, float]], int]] = [
+        ([(t.x0, t.z1), (t.x0, t.z0), (t.x1, t.z0), (t.x1, t.z1)], 0)]
+    lines += [([tuple(p) for p in bed.points], 1) for bed in scene.beds]
+    lines += [([(s.x0, s.z0), (s.x1, s.z0), (s.x1, s.z1), (s.x0, s.z1), (s.x0, s.z0)], 2)
+              for s in scene.structures]
+    top = scene.still_water_level if scene.still_water_level is not None else t.z1
+    lines += [([(x, t.z0), (x, top)], 3)
+              for x in (t.x0 if o.side == "left" else t.x1 for o in scene.open_boundaries)]
+    x = np.array([p[0] for pts, _ in lines for p in pts], dtype=float)
+    z = np.array([p[1] for pts, _ in lines for p in pts], dtype=float)
+    counts = np.array([len(pts) for pts, _ in lines], dtype=np.int64)
+    out = polyLinesToVTK(str(path), x, np.zeros_like(x), z, pointsPerLine=counts,
+                         cellData={"part": np.array([k for _, k in lines], dtype=np.int32)})
+    return Path(out)

@@ -403,6 +403,18 @@ def _format_errors(exc: ValidationError) -> str:
     return "; ".join(lines)
 
 
+# A scene file may also say how a server runs it (`wavesph submit`, `wavesph couple --scene`,
+# POST /runs with a TOML body): `mode`, `[coupling]` (window_max, z_ref), `[source]` (a built-in
+# theory). They are not part of the Scene; `wavesph run` ignores them.
+RUN_TABLES = ("mode", "coupling", "source")
+
+
+def split_scene_file(data: dict) -> tuple[dict, dict]:
+    """A parsed scene file as (scene fields, run settings: the RUN_TABLES it has)."""
+    return ({k: v for k, v in data.items() if k not in RUN_TABLES},
+            {k: data[k] for k in RUN_TABLES if k in data})
+
+
 def make_scene(data: dict) -> Scene:
     """Validate a plain dict (e.g. parsed TOML) into a Scene; raise SceneError naming the fields."""
     try:
@@ -421,6 +433,6 @@ def load_scene(path: str | Path) -> Scene:
     except tomllib.TOMLDecodeError as exc:
         raise SceneError(f"{path}: not valid TOML ({exc})") from None
     try:
-        return make_scene(data)
+        return make_scene(split_scene_file(data)[0])
     except SceneError as exc:
         raise SceneError(f"{path}: {exc}") from None

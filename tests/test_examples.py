@@ -16,7 +16,7 @@ from pathlib import Path
 import pytest
 
 import wavesph_cli
-from sph_core.scene import load_scene, make_scene
+from sph_core.scene import load_scene, make_scene, split_scene_file
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENES = ROOT / "examples" / "scenes"
@@ -53,7 +53,7 @@ def _theory_run(scene_file: Path, dp: float, theory: str, **opts):
     from cases.wave_flume import run_wave_flume
     from wave_client.theories import build_theory
 
-    data = tomllib.loads(scene_file.read_text())
+    data, _ = split_scene_file(tomllib.loads(scene_file.read_text()))
     scene = make_scene({**data, "dp": dp})
     model = build_theory(theory, depth=scene.still_water_level, **opts)
     run = run_wave_flume(scene, model, window=opts["period"] / 50, keep_flume=True)
@@ -102,3 +102,22 @@ def test_coupled_examples_run_to_their_end(tmp_path, two_way):
 
     res = run_coupled(FlumeCase(), 0.04, tmp_path, two_way=two_way)
     assert res["exit_code"] == 0 and res["state"] == "finished", res["status"]
+
+
+@pytest.mark.parametrize("name", sorted(p.name for p in SCENES.glob("*.toml")))
+def test_every_example_previews_without_solving(tmp_path, name):
+    """`wavesph run SCENE --preview`: the initial particles and the outlines as VTK, no step."""
+    import re
+
+    def piece(path: Path, what: str) -> int:  # from the XML header (the data are appended binary)
+        head = path.read_bytes().split(b"<AppendedData")[0].decode()
+        return int(re.search(rf'{what}="(\d+)"', head).group(1))
+
+    out = tmp_path / "preview"
+    assert wavesph_cli.main(["run", str(SCENES / name), "--preview", "-o", str(out)]) == 0
+    meta = _meta(out)
+    assert meta["status"] == "preview" and meta["steps"] == 0
+    assert piece(out / "snapshots" / "particles_00000.vtu", "NumberOfPoints") == meta["n_particles"]
+    scene = load_scene(SCENES / name)
+    assert piece(out / "geometry.vtu", "NumberOfCells") == (
+        1 + len(scene.beds) + len(scene.structures) + len(scene.open_boundaries))

@@ -19,7 +19,9 @@ COMMANDS: dict[str, tuple[str, str]] = {
                                  "(--dambreak: the standalone dam break)"),
     "run": ("wavesph_cli.run", "run an SPH scene (TOML) standalone"),
     "serve": ("wavesph_cli.serve", "start the SPH coupling server (HTTP + WebSocket + TCP)"),
-    "couple": ("wavesph_cli.couple", "couple a wave model to a running server"),
+    "submit": ("wavesph_cli.submit", "create a run on a server from a scene file (TOML)"),
+    "couple": ("wavesph_cli.couple", "couple a wave model to a run on a server (--scene: "
+                                     "create it from a scene file first)"),
     "waves": ("wavesph_cli.waves", "run the Boussinesq wave model alone"),
     "bench": ("wavesph_cli.bench", "speed-accuracy sweep and stability suite on dask "
                                    "(accuracy | stability)"),

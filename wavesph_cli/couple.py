@@ -3,6 +3,9 @@
     wavesph couple --url ws://127.0.0.1:8000/runs/r1/couple --model stokes --H 0.08 --T 2
     wavesph couple --url tcp://127.0.0.1:8766 --run-id r1 --model irregular --H 0.15 --T 2 \
                    --out gauges.csv
+    wavesph couple --scene examples/scenes/demo_beach_flume.toml --model stokes --H 0.04 --T 1.4
+        (creates the coupled run from the scene file on the server at --url, default
+        http://127.0.0.1:8765, then couples to it)
 
 The still-water depth defaults to the scene's (sent by the server in WELCOME); --d is checked
 against it. Exit status: 0 done, 1 the coupled run failed (reason on stderr), 2 bad arguments.
@@ -23,8 +26,14 @@ THEORY_MODELS = ("linear", "stokes", "stream", "standing", "irregular")
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     p = parser
-    p.add_argument("--url", required=True,
-                   help="ws://HOST:PORT/runs/ID/couple or tcp://HOST:PORT (then give --run-id)")
+    p.add_argument("--url", default=None,
+                   help="ws://HOST:PORT/runs/ID/couple or tcp://HOST:PORT (then give --run-id); "
+                        "with --scene: the server, http://HOST:PORT (default http://127.0.0.1:8765)")
+    p.add_argument("--scene", type=Path, default=None,
+                   help="scene file (TOML) to create the coupled run from first (its [coupling] "
+                        "table: window_max, z_ref)")
+    p.add_argument("--token", default=None,
+                   help="API token for --scene (default: WAVESPH_TOKEN)")
     p.add_argument("--model", required=True, choices=THEORY_MODELS + ("boussinesq",),
                    help="wave model driving the SPH inlet")
     p.add_argument("--H", type=float, help="wave height [m] (irregular: significant height Hs)")
@@ -116,6 +125,30 @@ def _boussinesq_factory(args: argparse.Namespace) -> tuple[Callable[[Welcome], A
     return (lambda welcome: build_model(scene, base_dir=config.parent)), getattr(scene.wave, "period", None)
 
 
+def _create_run(args: argparse.Namespace) -> str:
+    """POST the scene file as a coupled run; the WebSocket url to couple to."""
+    import os
+
+    from wave_client.coupling.server_runs import DEFAULT_SERVER, SubmitError, http_base, submit_scene_file
+
+    server = args.url or DEFAULT_SERVER
+    if server.startswith("tcp://") or "/runs/" in server:
+        raise ValueError("with --scene, --url is the server (http://HOST:PORT), not a run")
+    try:
+        info = submit_scene_file(server, args.scene, mode="coupled",
+                                 token=args.token or os.environ.get("WAVESPH_TOKEN"))
+    except SubmitError as exc:
+        raise CoupleSetupError(str(exc)) from None
+    base = http_base(server)
+    print(f"wavesph couple: created run {info['id']} from {args.scene} ({base}/runs/{info['id']})",
+          file=sys.stderr)
+    return base.replace("http", "ws", 1) + f"/runs/{info['id']}/couple"
+
+
+class CoupleSetupError(Exception):
+    """The server refused to create the run (exit 1, like a failed coupling)."""
+
+
 def main(args: argparse.Namespace) -> int:
     from wave_client.coupling import CouplingError, CouplingOptions, couple
 
@@ -136,15 +169,20 @@ def main(args: argparse.Namespace) -> int:
                                   absorb_cutoff=args.absorb_cutoff, absorb_wave=args.absorb_wave,
                                   x_offset=args.x_offset, inlet_gauge=args.inlet_gauge,
                                   outlet_gauge=args.outlet_gauge)
-        if args.url.startswith("tcp://") and not args.run_id:
+        url = args.url
+        if args.scene is not None:
+            url = _create_run(args)
+        elif url is None:
+            raise ValueError("give --url (a run on a server) or --scene (create the run first)")
+        if url.startswith("tcp://") and not args.run_id:
             raise ValueError("--run-id is required with a tcp:// url (the HELLO names the run)")
-        report = couple(args.url, factory, options, run_id=args.run_id, scene_hash=scene_hash,
+        report = couple(url, factory, options, run_id=args.run_id, scene_hash=scene_hash,
                         timeout=args.timeout, queue_timeout=args.queue_timeout,
                         log_path=args.output, progress=not args.no_progress)
     except ValueError as exc:
         print(f"wavesph couple: {exc}", file=sys.stderr)
         return 2
-    except CouplingError as exc:
+    except (CouplingError, CoupleSetupError) as exc:
         print(f"wavesph couple: {exc}", file=sys.stderr)
         return 1
     except KeyboardInterrupt:

@@ -28,6 +28,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--threads", type=int, default=None,
                         help="numba threads (default: NUMBA_NUM_THREADS or all cores)")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar or lines")
+    parser.add_argument("--preview", action="store_true",
+                        help="write the initial particles (snapshots/particles_00000.vtu) and the "
+                             "geometry (geometry.vtu) and stop, without solving (as GenCase)")
     parser.add_argument("--wave", type=float, nargs=2, metavar=("H", "T"), default=None,
                         help="the waves the scene is for (height [m], period [s]): warn if the "
                              "scene costs far more than `wavesph plan`'s for the same accuracy")
@@ -70,6 +73,8 @@ def main(args: argparse.Namespace) -> int:
     sim = Simulation(scene, run_dir=out)
     print(f"{sim.n_fluid} fluid + {sim.n_particles - sim.n_fluid} wall particles, c0 = {sim.c0:.2f} m/s, "
           f"h = {sim.h:.4g} m; output in {out}", file=sys.stderr)
+    if args.preview:
+        return _preview(sim, out)
     try:
         code = advance_with_progress(sim, scene.t_end, scene.name, show=not args.no_progress)
     except KeyboardInterrupt:
@@ -81,6 +86,19 @@ def main(args: argparse.Namespace) -> int:
               f"({sim.n_particles * sim.steps / max(sim.wall_time, 1e-9) / 1e6:.2f} M particle-steps/s); "
               f"results in {out}", file=sys.stderr)
     return code
+
+
+def _preview(sim: Simulation, out: Path) -> int:
+    """Initial particles and geometry as VTK, no time step (meta.json status "preview")."""
+    from sph_core.output import write_geometry_vtk
+
+    sim.write_snapshot()
+    geometry = write_geometry_vtk(sim.scene, out / "geometry")
+    sim.close()
+    sim.writer.update_meta(status="preview")   # after close, which writes the run's own status
+    print(f"preview (no time step taken): particles in {out / 'snapshots'}, outlines in "
+          f"{geometry}; open {out / 'run.pvd'} and {geometry.name} in ParaView", file=sys.stderr)
+    return 0
 
 
 def _warn_if_expensive(scene, height: float, period: float) -> None:

@@ -49,8 +49,12 @@ async def _read_body(request: Request, limit: int) -> bytes:
 
 
 @router.post("", status_code=201, response_model=RunInfo, openapi_extra={"requestBody": {
-    "required": True, "content": {"application/json": {"schema": {"$ref": "#/components/schemas/RunRequest"}}}}},
-             responses={400: _detail("the body is not JSON"),
+    "required": True, "content": {
+        "application/json": {"schema": {"$ref": "#/components/schemas/RunRequest"}},
+        # a scene file as it is: its mode, [coupling] and [source] tables beside the scene
+        "application/toml": {"schema": {"type": "string"}}}}},
+             responses={400: _detail("the body is not JSON (or not TOML, with Content-Type "
+                                     "application/toml)"),
                         413: _detail("the body exceeds max_body"),
                         422: _detail("a field, or a rule across fields, is not met: `detail` lists "
                                      "loc, msg, type (never the input); numbers must be finite; "
@@ -60,12 +64,16 @@ async def _read_body(request: Request, limit: int) -> bytes:
                                      "coupling.z_ref in the water column; windows at most 1e7"),
                         429: _detail("the queue is full (max_queued); see Retry-After")})
 async def create_run(request: Request, manager: Manager) -> RunInfo:
-    """Create a run from a scene (body: RunRequest). Coupled runs wait for a client on
+    """Create a run from a scene (body: RunRequest as JSON, or a scene file as TOML with
+    Content-Type application/toml: its mode, [coupling] and [source] tables beside the
+    scene; without a mode it is standalone if it has a source or no open end). Coupled runs
+    wait for a client on
     `/runs/{id}/couple` (WebSocket) or the TCP coupling port; standalone runs start stepping when
     a slot is free. Everything the run needs is checked before the 201."""
     raw = await _read_body(request, manager.settings.max_body)
     try:  # parsing and validation off the event loop: a big scene never stalls other requests
-        body = await asyncio.to_thread(parse_run_request, raw, manager.settings)
+        body = await asyncio.to_thread(parse_run_request, raw, manager.settings,
+                                       "toml" in request.headers.get("content-type", ""))
     except BodyNotJson as exc:
         raise HTTPException(400, str(exc)) from None
     except RequestInvalid as exc:
