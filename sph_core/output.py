@@ -109,7 +109,20 @@ class RunWriter:
         tmp = self.dir / "run.pvd.tmp"
         tmp.write_text(pvd)
         os.replace(tmp, self.dir / "run.pvd")
+        self._last_snapshot(t, x, z, data)
         return Path(path)
+
+    def _last_snapshot(self, t: float, x: np.ndarray, z: np.ndarray, data: dict[str, Any]) -> None:
+        """snapshots/last.npz: the newest snapshot's positions, pressure, speed and kind in
+        float32, for the run monitor's particle scatter (GET /runs/{id}/particles); replaced
+        atomically, so a reader never sees half a file."""
+        tmp = self.dir / "snapshots" / "last.npz.tmp"
+        with open(tmp, "wb") as fh:
+            np.savez(fh, t=np.float64(t), x=x.astype(np.float32), z=z.astype(np.float32),
+                     pressure=np.asarray(data["pressure"], np.float32),
+                     speed=np.asarray(data["speed"], np.float32),
+                     kind=np.asarray(data["kind"], np.int8))
+        os.replace(tmp, self.dir / "snapshots" / "last.npz")
 
     def close(self) -> None:
         if not self._csv_file.closed:

@@ -103,7 +103,7 @@ async def get_scene(run: RunDep) -> Response:
 
 @router.get("/{run_id}/gauges", responses={404: _detail("no such run, or no gauge data yet")})
 async def get_gauges(run: RunDep, format: Literal["csv", "json"] = Query("csv")) -> Response:
-    """Gauge series as CSV (dry gauges written `dry`) or JSON (`null` where dry)."""
+    """Gauge series as CSV (a dry gauge an empty field) or JSON (`null` where dry)."""
     path = run.dir / (run.info.gauges_file or "gauges.csv")
     if not path.exists():
         raise HTTPException(404, f"run {run.info.id} has no gauge data yet")
@@ -125,6 +125,37 @@ async def get_bodies(run: RunDep, format: Literal["csv", "json"] = Query("csv"))
         return FileResponse(paths[-1], media_type="text/csv", filename=f"{run.info.id}-bodies.csv")
     columns, rows = await asyncio.to_thread(read_gauges, paths[-1])
     return Response(json.dumps({"columns": columns, "rows": rows}), media_type="application/json")
+
+
+MAX_SCATTER = 40_000   # particles sent to the page's scatter (every k-th beyond it)
+
+
+def _last_particles(run_dir, field: str) -> dict | None:
+    import numpy as np
+
+    paths = sorted(run_dir.glob("sph*/snapshots/last.npz"), key=lambda p: p.stat().st_mtime)
+    if not paths:
+        return None
+    with np.load(paths[-1], allow_pickle=False) as z:
+        x, zz, value, kind = z["x"], z["z"], z[field], z["kind"]
+        t = float(z["t"])
+    stride = max(1, -(-x.size // MAX_SCATTER))
+    r = lambda a: [round(float(v), 6) for v in a[::stride]]  # noqa: E731
+    return {"t": t, "field": field, "stride": stride, "x": r(x), "z": r(zz), "value": r(value),
+            "kind": [int(k) for k in kind[::stride]]}
+
+
+@router.get("/{run_id}/particles", responses={**NOT_FOUND, 404: _detail(
+    "no run, or no snapshot yet (the scene's output.snapshot_every)")})
+async def get_particles(run: RunDep, field: Literal["pressure", "speed"] = Query("pressure")) -> Response:
+    """The newest snapshot's particles for a scatter plot: t [s], x, z [m], `value` (pressure
+    [Pa] or speed [m/s]) and `kind` (0 fluid, 1 wall/bed/structure, 2/3 open-end buffers), at
+    most 40 000 (every `stride`-th beyond that)."""
+    data = await asyncio.to_thread(_last_particles, run.dir, field)
+    if data is None:
+        raise HTTPException(404, f"run {run.info.id} has no snapshot yet (set the scene's "
+                                 "output.snapshot_every)")
+    return Response(json.dumps(data), media_type="application/json")
 
 
 @router.delete("/{run_id}", response_model=RunInfo, responses=NOT_FOUND)

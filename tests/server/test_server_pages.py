@@ -43,16 +43,23 @@ def _chromium() -> str | None:
 
 
 def test_page_in_a_real_browser_follows_a_run(tmp_path):
-    """Headless Chromium (Debian's, through Playwright): start a standalone run from the page,
-    see its progress move and a gauge trace drawn; the screenshot is kept as an artifact
-    (WAVESPH_ARTIFACTS, default tmp)."""
+    """Headless Chromium (Debian's, through Playwright): start a *coupled* run from the page,
+    couple a wave client to it (a linear wave, in a thread), see its progress move, a gauge
+    trace drawn and the last snapshot's particles scattered; the screenshot is kept as an
+    artifact (WAVESPH_ARTIFACTS, default tmp)."""
     playwright = pytest.importorskip("playwright.sync_api", reason="Playwright for Python is not installed")
     browser_path = _chromium()
     if browser_path is None:
         pytest.skip("no Chromium installed (apt-get install chromium)")
-    body = {"mode": "standalone", "scene": scene(t_end=3.0, dp=0.02)}
     import json
+    import threading
 
+    from wave_client.coupling import CouplingOptions, couple
+    from wave_client.theories import build_theory
+
+    body = {"mode": "coupled", "coupling": {"window_max": 0.05},
+            "scene": scene(t_end=3.0, dp=0.02, open_boundaries=[{"side": "left"}],
+                           output={"probe_every": 0.05, "snapshot_every": 0.5})}
     with live_server(tmp_path) as srv, playwright.sync_playwright() as pw:
         browser = pw.chromium.launch(executable_path=browser_path, headless=True)
         page = browser.new_page()
@@ -60,12 +67,52 @@ def test_page_in_a_real_browser_follows_a_run(tmp_path):
         page.fill("#body", json.dumps(body))
         page.click("#start")
         page.wait_for_function("document.querySelector('#selected').textContent !== 'none'")
+        run_id = page.text_content("#selected")
+
+        def client() -> None:
+            try:
+                couple(f"ws://127.0.0.1:{srv.port}/runs/{run_id}/couple",
+                                     lambda w: build_theory("linear", height=0.02, period=1.0,
+                                                            depth=w.depth, ramp_time=1.0),
+                                     CouplingOptions(window=0.05), timeout=300, progress=False)
+            except Exception:  # noqa: BLE001 -- the cancel at the end closes the socket
+                pass
+
+        thread = threading.Thread(target=client, daemon=True)
+        thread.start()
         page.wait_for_function("Number(document.querySelector('#plot').dataset.points || 0) > 5",
-                               timeout=120_000)
+                               timeout=240_000)
         first = page.text_content("#progress")
         page.wait_for_function(f"document.querySelector('#progress').textContent !== {json.dumps(first)}",
                                timeout=60_000)
+        page.wait_for_function("Number(document.querySelector('#particles').dataset.points || 0) > 100",
+                               timeout=60_000)
+        page.select_option("#field", "speed")
+        page.wait_for_function("document.querySelector('#snapinfo').textContent.startsWith('t = ')")
         out = Path(os.environ.get("WAVESPH_ARTIFACTS", tmp_path))
         out.mkdir(parents=True, exist_ok=True)
-        page.screenshot(path=str(out / "run_monitor.png"))
+        page.screenshot(path=str(out / "run_monitor.png"), full_page=True)
         browser.close()
+        assert srv.http.get(f"/runs/{run_id}").json()["windows"] >= 2   # the client drove it
+        srv.http.delete(f"/runs/{run_id}")   # the client then sees the server close the socket
+        thread.join(timeout=60)
+
+
+def test_particles_endpoint_serves_the_last_snapshot(tmp_path):
+    """GET /runs/{id}/particles: the newest snapshot's positions and the chosen field; 404 before
+    the first snapshot (here a standalone still tank, snapshots every 0.1 s)."""
+    with live_server(tmp_path) as srv:
+        r = srv.http.post("/runs", json={"mode": "standalone", "scene": scene(
+            t_end=0.2, output={"probe_every": 0.05, "snapshot_every": 0.1})})
+        run_id = r.json()["id"]
+        srv.wait_state(run_id, "finished", timeout=300)
+        d = srv.http.get(f"/runs/{run_id}/particles", params={"field": "pressure"}).json()
+        assert d["t"] == pytest.approx(0.2) and len(d["x"]) == len(d["z"]) == len(d["value"]) > 50
+        fluid = [v for v, k in zip(d["value"], d["kind"]) if k == 0]
+        assert max(fluid) == pytest.approx(1000 * 9.81 * 0.3, rel=0.25)   # hydrostatic at the floor
+        s = srv.http.get(f"/runs/{run_id}/particles", params={"field": "speed"}).json()
+        assert all(v >= 0 for v in s["value"])
+        assert srv.http.get(f"/runs/{run_id}/particles", params={"field": "rho"}).status_code == 422
+        r2 = srv.http.post("/runs", json={"mode": "standalone", "scene": scene(t_end=0.05)})
+        srv.wait_state(r2.json()["id"], "finished", timeout=300)
+        assert srv.http.get(f"/runs/{r2.json()['id']}/particles").status_code == 404
