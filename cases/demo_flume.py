@@ -150,8 +150,10 @@ def _gauge_index(report: Any, name: str) -> int:
     return 1 + list(GAUGES).index(name)
 
 
-def plot_demo(report: Any, info: dict, path: Path, dp: float, t_end: float, t0: float) -> Path:
-    """Measured vs theoretical elevation at each gauge, and the flume with its gauges."""
+def plot_demo(report: Any, info: dict, path: Path, dp: float, t_end: float, t0: float,
+              rmse_over_h: float | None = None) -> Path:
+    """Measured vs theoretical elevation at each gauge, and the flume with its gauges; the title
+    says the resolution is deliberately coarse and gives the flat-bed gauge's RMSE/H."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -182,7 +184,10 @@ def plot_demo(report: Any, info: dict, path: Path, dp: float, t_end: float, t0: 
         ax.text(x, d + 0.03, n, color="C3", ha="center", fontsize=8)
     ax.set(xlabel="x [m]", ylabel="z [m]", title="flume: open inlet at x = 0, 1:10 beach, "
            f"still water at z = {d:.4g} m (floor z = 0)", ylim=(-0.02, d + 0.1))
-    fig.suptitle(f"wavesph demo: coupled run {info['id'][:8]}, {info['particles']} particles")
+    rmse = "n/a" if rmse_over_h is None else f"{100 * rmse_over_h:.1f} %"
+    fig.suptitle(f"wavesph demo: coupled run {info['id'][:8]}, {info['particles']} particles; "
+                 f"deliberately coarse (dp = {dp:g} m, H/dp = {HEIGHT / dp:.3g}) to run in about a "
+                 f"minute; RMSE/H at the flat-bed gauge {rmse} (t >= {t0:.2f} s)")
     fig.savefig(path, dpi=100)
     plt.close(fig)
     return path

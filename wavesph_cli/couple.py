@@ -54,12 +54,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                    help="coupling window [s]; default min(server window_max, T/50)")
     p.add_argument("--t-end", type=float, default=None, help="stop at this time [s]")
     p.add_argument("--absorb", action="store_true",
-                   help="apply the seed 002 active-absorption correction on the client side; only "
-                        "for a server whose open boundaries do not absorb themselves")
+                   help="apply the active-absorption correction of Verbrugghe et al. 2019 "
+                        "(seed 002) on the client side; only for a server whose open boundaries "
+                        "do not absorb themselves")
     p.add_argument("--absorb-wave", choices=("total", "incident"), default="total",
-                   help="what the client's correction compares: the total elevation (seed 002), "
-                        "or the incident (right-going) characteristic, for two-way models whose "
-                        "boundary already lets SPH's reflection out (CouplingOptions.absorb_wave)")
+                   help="what the client's correction compares: the total elevation "
+                        "(Verbrugghe et al. 2019, seed 002), or the incident (right-going) "
+                        "characteristic, for two-way models whose boundary already lets SPH's "
+                        "reflection out (CouplingOptions.absorb_wave)")
     p.add_argument("--absorb-cutoff", type=float, default=None,
                    help="low-pass cutoff [Hz] of the absorption's measured mismatch (default 3/T)")
     p.add_argument("--x-offset", type=float, default=None,

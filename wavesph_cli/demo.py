@@ -100,7 +100,8 @@ def main(args: argparse.Namespace) -> int:
           f"measured vs Stokes 2): "
           f"{_rmse_text(figures['rmse_over_H_flat'])}", file=sys.stderr)
     if not args.no_plot:
-        plot_demo(report, info, out / "elevation.png", dp, t_end, figures["compare_from_s"])
+        plot_demo(report, info, out / "elevation.png", dp, t_end, figures["compare_from_s"],
+                  figures["rmse_over_H_flat"])
     print(f"outputs in {out.resolve()}:\n"
           f"  {info['id']}/gauges.csv   SPH-measured gauges (server)\n"
           f"  {info['id']}/meta.json    run record ({info['status']})\n"

@@ -1,4 +1,4 @@
-"""`wavesph plan SCENE.toml --height H --period T`: the SPH zone, dp, coupling window and method
+"""`wavesph plan SCENE.toml --H H --T T`: the SPH zone, dp, coupling window and method
 a scene needs, with the error and wall time predicted from the measured sweep (cases/planning.py)."""
 
 from __future__ import annotations
@@ -14,8 +14,12 @@ from sph_core.scene import SceneError, load_scene
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("scene", type=Path, help="SPH scene (TOML) with a still_water_level")
-    parser.add_argument("--height", type=float, required=True, help="wave height H [m]")
-    parser.add_argument("--period", type=float, required=True, help="wave period T [s]")
+    # --H/--T as in `wavesph couple`/`submit`, the HTTP source and a scene's [source] table;
+    # --height/--period kept as the long spellings
+    parser.add_argument("--H", "--height", dest="height", type=float, required=True,
+                        help="wave height H [m]")
+    parser.add_argument("--T", "--period", dest="period", type=float, required=True,
+                        help="wave period T [s]")
     parser.add_argument("--target-error", type=float, default=DEFAULT_TARGET,
                         help=f"accepted RMSE/H against theory (default {DEFAULT_TARGET})")
     parser.add_argument("--data", type=Path, default=None,
