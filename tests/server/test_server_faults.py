@@ -69,9 +69,9 @@ def test_request_validation_runs_off_the_event_loop(tmp_path, factory, monkeypat
 
     real = runs_router.parse_run_request
 
-    def slow(raw, settings):  # stands for a heavy validation: it must not stall the server
+    def slow(raw, settings, toml=False):  # stands for a heavy validation: no stalled server
         time.sleep(1.0)
-        return real(raw, settings)
+        return real(raw, settings, toml)
 
     monkeypatch.setattr(runs_router, "parse_run_request", slow)
     with live_server(tmp_path, factory) as srv:

@@ -3,6 +3,8 @@ double). Proves both sides of the protocol agree when written by different hands
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pytest
 
@@ -74,4 +76,6 @@ def test_wave_client_names_its_log_columns_from_gauges(srv, engines, tmp_path):
     text = log.read_text()
     header = next(ln for ln in text.splitlines() if not ln.startswith("#")).split(",")
     assert sorted(c[len("eta_model_"):] for c in header if c.startswith("eta_model_")) == server_gauges
-    assert "eta_0" not in header and "# gauges: " in text
+    assert "eta_0" not in header and "#" not in text   # one header row, no comment lines
+    notes = json.loads(log.with_suffix(".meta.json").read_text())["notes"]
+    assert any(n.startswith("gauges: ") for n in notes)   # the run's metadata, beside the CSV

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import argparse
 import asyncio
+import json
 import math
 import time
 
@@ -215,11 +216,13 @@ def test_coupled_run_applies_seed002_correction(transport, tmp_path):
         np.testing.assert_allclose(s.eta, ref.elevation(NODE_X), atol=1e-15)
         assert np.all(np.isfinite(s.w))
     assert all(r.du_inlet == pytest.approx(-0.01 * C) for r in report.records[1:])
-    # the CSV log has a row per window, with units stated in its header
+    # the CSV log has a row per window and one header row; its metadata (units, model, gauges)
+    # is in <stem>.meta.json beside it
     lines = log.read_text().splitlines()
-    assert lines[0].startswith("# ") and "SI units" in log.read_text()
-    assert "# model: AiryWave(height=0.08" in log.read_text() and "gauge_x [m]: 0.5 5 9.5" in log.read_text()
-    rows = [ln for ln in lines if not ln.startswith("#")]
+    notes = "\n".join(json.loads(log.with_suffix(".meta.json").read_text())["notes"])
+    assert "SI units" in notes
+    assert "model: AiryWave(height=0.08" in notes and "gauge_x [m]: 0.5 5 9.5" in notes
+    rows = lines
     assert rows[0].startswith("t,steps,eta_0,wet_0") and len(rows) == n + 1
     assert float(rows[-1].split(",")[0]) == pytest.approx(T_END)
 
