@@ -70,24 +70,26 @@ def _crossings(t: np.ndarray, y: np.ndarray) -> np.ndarray:
     return t[k] - y[k] * (t[k + 1] - t[k]) / (y[k + 1] - y[k])
 
 
-def heave(dp: float) -> dict:
-    """Undamped release 0.02 m too deep in a 3.2 m closed tank, heave only, against linear
-    potential flow for the same tank and release (cases/heave_potential.py, converged: dx 0.01
-    and 0.005 m give the same crossings within 0.3 %). Heave Z from the equilibrium position;
+def heave(dp: float, offset: float = 0.02, constants: dict | None = None,
+          length: float = 3.2, t_end: float = 1.2, save: str | None = None) -> dict:
+    """Undamped release ``offset`` too deep in a ``length`` closed tank, heave only, against
+    linear potential flow for the same tank and release (cases/heave_potential.py, converged: dx
+    0.01 and 0.005 m give the same crossings within 0.3 %). Heave Z from the equilibrium position;
     the period measure is twice the time between its first two zero crossings (the motion is
     a heave mode coupled with the tank's sloshing, the same measure on both); the decay is the
-    ratio of the first two half-cycle peaks, for both."""
+    first half-cycle peak over the release offset, for both. ``constants``: [constants] of the
+    scene (a study's one factor); ``save``: an .npz path for both series."""
     from cases.heave_potential import heave_release
 
-    t_end, length = 1.2, 3.2
     d = archimedes_draft(DENSITY, HEIGHT)
     sim = Simulation(floating_box_scene(dp=dp, breadth=BREADTH, height=HEIGHT, density=DENSITY,
-                                        depth=DEPTH, offset=0.02, tank_length=length, t_end=t_end,
-                                        probe_every=0.005))
+                                        depth=DEPTH, offset=offset, tank_length=length,
+                                        t_end=t_end, probe_every=0.005, constants=constants))
     tic = time.perf_counter()
     sim.advance_to(t_end)
     wall = time.perf_counter() - tic
     t, zc = _series(sim, "box_z")
+    _, fz = _series(sim, "box_fz")
     zb = zc - 0.5 * HEIGHT
     # equilibrium bottom: the level the water has then, minus the draft
     area = sim.n_fluid * dp * dp
@@ -95,6 +97,9 @@ def heave(dp: float) -> dict:
     z_sph = zb - zb_eq
     tl, z_lin = heave_release(length, DEPTH, BREADTH, d, DENSITY * BREADTH * HEIGHT,
                               float(z_sph[0]), t_end, dx=0.01)
+    if save:
+        Path(save).parent.mkdir(parents=True, exist_ok=True)
+        np.savez(save, t=t, z=z_sph, fz=fz, t_lin=tl, z_lin=z_lin)
     cs, cl = _crossings(t, z_sph), _crossings(tl, z_lin)
 
     def peaks(tt, zz, c):
@@ -103,12 +108,12 @@ def heave(dp: float) -> dict:
     ps, pl = peaks(t, z_sph, cs), peaks(tl, z_lin, cl)
     period = 2.0 * float(cs[1] - cs[0]) if cs.size > 1 else None
     ref = 2.0 * float(cl[1] - cl[0])
-    return _line("heave_period", period, ref, wall, dp=dp, tank_length=length,
-                 first_crossing=float(cs[0]), first_crossing_linear=float(cl[0]),
+    return _line("heave_period", period, ref, wall, dp=dp, tank_length=length, offset=offset,
+                 constants=constants or {}, first_crossing=float(cs[0]),
+                 first_crossing_linear=float(cl[0]),
                  peak_ratio=(ps[0] / abs(z_sph[0]) if ps else None),
                  peak_ratio_linear=pl[0] / abs(z_lin[0]),
-                 added_mass_inf_linear=heave_release.last["a_inf"], unit="s",
-                 note="draft = 5 dp; later half-cycles are below dp/4 (SPH noise level)")
+                 added_mass_inf_linear=heave_release.last["a_inf"], unit="s")
 
 
 def flap_still(dp: float) -> dict:
@@ -121,7 +126,38 @@ def flap_still(dp: float) -> dict:
                  unit="rad (max |theta| over 1 s)")
 
 
+SPRING_IN_WATER = 600.0   # N m/rad: natural frequency ~20 rad/s, radiation damping ratio ~0.06
+
+
 def spring_flap(dp: float) -> dict:
+    """A bottom-hinged flap on a torsion spring in still water (0.3 m deep on both sides),
+    started with a small rate, against linear wavemaker theory (added inertia and radiation
+    damping at the natural frequency, cases.rigid_bodies.spring_flap_in_water). The stiff spring
+    keeps the radiation damping small (a flap is an efficient wavemaker: at 10 rad/s it would
+    be damped at ~0.8 of critical). Period: mean of the zero-crossing intervals over 1.5 s,
+    before the radiated waves come back from the tank ends (~8 s)."""
+    from cases.rigid_bodies import spring_flap_in_water
+
+    ref = spring_flap_in_water(0.04, 0.4, 500.0, SPRING_IN_WATER, 0.3)
+    t_end = 1.5
+    sim = Simulation(hinged_flap_scene(dp=dp, spring=SPRING_IN_WATER, omega0=0.5,
+                                       in_water=True, t_end=t_end, probe_every=0.002))
+    tic = time.perf_counter()
+    sim.advance_to(t_end)
+    t, th = _series(sim, "flap_theta")
+    c = _crossings(t, th)
+    period = 2.0 * float(np.mean(np.diff(c))) if c.size > 2 else None
+    peaks = [float(np.max(np.abs(th[(t >= a) & (t <= b)]))) for a, b in zip(c[:-1], c[1:])]
+    decay = (float(np.log(peaks[0] / peaks[-1]) / (len(peaks) - 1) / np.pi)
+             if len(peaks) > 1 else None)   # log decrement per half cycle / pi ~ zeta
+    return _line("spring_flap_period", period, ref["period"], time.perf_counter() - tic, dp=dp,
+                 medium="water 0.3 m deep both sides", spring=SPRING_IN_WATER,
+                 added_inertia_linear=ref["added_inertia"], inertia=ref["inertia"],
+                 zeta_linear=ref["zeta"], zeta_measured=decay, half_cycles=len(peaks),
+                 unit="s")
+
+
+def spring_flap_air(dp: float) -> dict:
     """In air (the water is a pool held away from the flap): hinge inertia, gravity, spring."""
     k = 40.0
     ref = spring_flap_period(0.04, 0.4, 500.0, k)
@@ -130,8 +166,29 @@ def spring_flap(dp: float) -> dict:
     tic = time.perf_counter()
     sim.advance_to(sim.scene.t_end)
     t, th = _series(sim, "flap_theta")
-    return _line("spring_flap_period", zero_crossing_period(t, th), ref,
+    return _line("spring_flap_period_air", zero_crossing_period(t, th), ref,
                  time.perf_counter() - tic, dp=dp, medium="air (no water on the flap)", unit="s")
+
+
+def wedge(dp: float) -> dict:
+    """Zhao et al. (1996) drop test: pressure along the face at 0.00435 s against Wagner's
+    theory with the run's own speed (cases/wedge_entry.py; the measured distributions were not
+    at hand), and the SPH values at 0.0158 s (flow separated: no Wagner reference)."""
+    from cases.wedge_entry import TIMES, wedge_pressures, wedge_scene
+
+    sim = Simulation(wedge_scene(dp=dp))
+    tic = time.perf_counter()
+    rows = wedge_pressures(sim, TIMES)
+    first = rows[0]
+    xs = np.array(first["x"])
+    sel = np.isfinite(first["p_sph"]) & np.isfinite(first["p_wagner"]) & (
+        xs <= 0.8 * first["c_wagner"])
+    value = float(np.mean(np.array(first["p_sph"])[sel])) if sel.any() else None
+    ref = float(np.mean(np.array(first["p_wagner"])[sel])) if sel.any() else None
+    return _line("wedge_pressure", value, ref, time.perf_counter() - tic, dp=dp,
+                 unit="Pa (mean over the face points at x <= 0.8 c, t = 0.00435 s)",
+                 reference_kind="Wagner (1932) outer solution, the run's own V(t)",
+                 times=rows)
 
 
 def momentum(dp: float) -> dict:
@@ -185,7 +242,8 @@ def flume_throughput(dp: float, steps: int) -> list[dict]:
 
 
 CHECKS = ("archimedes_draft", "heave_period", "flap_still", "spring_flap_period",
-          "momentum_zero_gravity", "wedge_pressure", "flap_pitch", "throughput")
+          "spring_flap_period_air", "momentum_zero_gravity", "wedge_pressure", "flap_pitch",
+          "throughput")
 
 
 def main() -> None:
@@ -195,7 +253,8 @@ def main() -> None:
     ap.add_argument("--checks", nargs="*", default=list(CHECKS), choices=CHECKS)
     a = ap.parse_args()
     runners = {"archimedes_draft": archimedes, "heave_period": heave, "flap_still": flap_still,
-               "spring_flap_period": spring_flap, "momentum_zero_gravity": momentum}
+               "spring_flap_period": spring_flap, "spring_flap_period_air": spring_flap_air,
+               "momentum_zero_gravity": momentum, "wedge_pressure": wedge}
     for c in a.checks:
         if c in runners:
             print(json.dumps(runners[c](a.dp)), flush=True)

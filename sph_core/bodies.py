@@ -286,7 +286,9 @@ def _particle_loads(ps, n, cells, prm, bd):
     s2 = 4.0 * h * h
     eta2 = 0.01 * h * h
     af = prm.alpha_f
-    av = prm.alpha * prm.c0 * h
+    # the wall artificial viscosity of fluid_pass (alpha_wall x alpha): the same pair term, or
+    # fluid + body momentum is not conserved when alpha_wall_factor != 1
+    av = prm.alpha_wall * prm.alpha * prm.c0 * h
     nu4 = 4.0 * prm.nu
     noslip = prm.noslip
     id0 = bd.id0
@@ -589,6 +591,17 @@ class BodySet:
     def columns(self) -> list[str]:
         return [f"{n}_{k}" for n in self.names
                 for k in ("x", "z", "theta", "u", "w", "omega", "fx", "fz", "my")]
+
+    def follow(self, name: str, x0: np.ndarray, z0: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Where points given at t_start (scene coordinates x0, z0) are now, carried rigidly by
+        body ``name`` (probes with ``follow``)."""
+        b = self.names.index(name)
+        bd = self.state
+        dth = float(bd.q[b, 2] - bd.q0[b, 2])
+        c, s = math.cos(dth), math.sin(dth)
+        rx = np.asarray(x0, dtype=float) - bd.q0[b, 0]
+        rz = np.asarray(z0, dtype=float) - bd.q0[b, 1]
+        return bd.q[b, 0] + c * rx - s * rz, bd.q[b, 1] + s * rx + c * rz
 
     def particle_body(self, ids: np.ndarray) -> np.ndarray:
         """Body index of each particle id (-1: not a body particle), for snapshots."""
