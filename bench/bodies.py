@@ -34,6 +34,16 @@ from sph_core.scene import make_scene  # noqa: E402
 from sph_core.simulation import Simulation  # noqa: E402
 
 DENSITY, HEIGHT, BREADTH, DEPTH = 500.0, 0.2, 0.4, 0.3   # the floating box of the checks
+CONSTANTS: dict = {}   # --constants: [constants] overrides for every check's scene
+
+
+def _sim(scene) -> Simulation:
+    """A Simulation of ``scene`` with the --constants overrides."""
+    if CONSTANTS:
+        d = scene.model_dump(mode="json")
+        d["constants"].update(CONSTANTS)
+        scene = make_scene(d)
+    return Simulation(scene)
 
 
 def _line(check: str, value, reference, wall: float, **extra) -> dict:
@@ -52,7 +62,7 @@ def archimedes(dp: float) -> dict:
     """Box released 0.02 m (20 % of its draft) too deep, heave only, with a heave damper (zero at
     rest: the equilibrium is unchanged) so it settles in ~1 s; draft = mean of the last 0.5 s."""
     t_end = 2.0
-    sim = Simulation(floating_box_scene(dp=dp, breadth=BREADTH, height=HEIGHT, density=DENSITY,
+    sim = _sim(floating_box_scene(dp=dp, breadth=BREADTH, height=HEIGHT, density=DENSITY,
                                         depth=DEPTH, offset=0.02, damper=800.0, t_end=t_end))
     tic = time.perf_counter()
     sim.advance_to(t_end)
@@ -82,7 +92,7 @@ def heave(dp: float, offset: float = 0.02, constants: dict | None = None,
     from cases.heave_potential import heave_release
 
     d = archimedes_draft(DENSITY, HEIGHT)
-    sim = Simulation(floating_box_scene(dp=dp, breadth=BREADTH, height=HEIGHT, density=DENSITY,
+    sim = _sim(floating_box_scene(dp=dp, breadth=BREADTH, height=HEIGHT, density=DENSITY,
                                         depth=DEPTH, offset=offset, tank_length=length,
                                         t_end=t_end, probe_every=0.005, constants=constants))
     tic = time.perf_counter()
@@ -118,7 +128,7 @@ def heave(dp: float, offset: float = 0.02, constants: dict | None = None,
 
 def flap_still(dp: float) -> dict:
     t_end = 1.0
-    sim = Simulation(hinged_flap_scene(dp=dp, t_end=t_end))
+    sim = _sim(hinged_flap_scene(dp=dp, t_end=t_end))
     tic = time.perf_counter()
     sim.advance_to(t_end)
     _, th = _series(sim, "flap_theta")
@@ -140,7 +150,7 @@ def spring_flap(dp: float) -> dict:
 
     ref = spring_flap_in_water(0.04, 0.4, 500.0, SPRING_IN_WATER, 0.3)
     t_end = 1.5
-    sim = Simulation(hinged_flap_scene(dp=dp, spring=SPRING_IN_WATER, omega0=0.5,
+    sim = _sim(hinged_flap_scene(dp=dp, spring=SPRING_IN_WATER, omega0=0.5,
                                        in_water=True, t_end=t_end, probe_every=0.002))
     tic = time.perf_counter()
     sim.advance_to(t_end)
@@ -161,7 +171,7 @@ def spring_flap_air(dp: float) -> dict:
     """In air (the water is a pool held away from the flap): hinge inertia, gravity, spring."""
     k = 40.0
     ref = spring_flap_period(0.04, 0.4, 500.0, k)
-    sim = Simulation(hinged_flap_scene(dp=dp, spring=k, omega0=0.05, in_water=False,
+    sim = _sim(hinged_flap_scene(dp=dp, spring=k, omega0=0.05, in_water=False,
                                        t_end=3.2 * ref, probe_every=ref / 100))
     tic = time.perf_counter()
     sim.advance_to(sim.scene.t_end)
@@ -176,7 +186,7 @@ def wedge(dp: float) -> dict:
     at hand), and the SPH values at 0.0158 s (flow separated: no Wagner reference)."""
     from cases.wedge_entry import TIMES, wedge_pressures, wedge_scene
 
-    sim = Simulation(wedge_scene(dp=dp))
+    sim = _sim(wedge_scene(dp=dp))
     tic = time.perf_counter()
     rows = wedge_pressures(sim, TIMES)
     first = rows[0]
@@ -197,7 +207,7 @@ def momentum(dp: float) -> dict:
         "water_blocks": [{"x0": 0.3, "x1": 0.9, "z0": 0.3, "z1": 0.9}],
         "bodies": [{"name": "box", "shape": "box", "x0": 0.52, "x1": 0.68, "z0": 0.52,
                     "z1": 0.6, "density": 800.0, "velocity": (0.5, -0.3, 1.0)}]})
-    sim = Simulation(scene)
+    sim = _sim(scene)
     zero_gravity(sim)
 
     def total() -> np.ndarray:
@@ -226,7 +236,7 @@ def flume_throughput(dp: float, steps: int) -> list[dict]:
            "density": 500.0}
     out = []
     for label, bodies in (("without_body", []), ("with_body", [box])):
-        sim = Simulation(make_scene({**base, "bodies": bodies}))
+        sim = _sim(make_scene({**base, "bodies": bodies}))
         sim.advance_steps(20)   # compile + warm-up
         w0, s0 = sim.wall_time, sim.steps
         sim.advance_steps(steps)
@@ -251,13 +261,16 @@ def main() -> None:
     ap.add_argument("--dp", type=float, default=0.02)
     ap.add_argument("--steps", type=int, default=1000, help="steps per throughput variant")
     ap.add_argument("--checks", nargs="*", default=list(CHECKS), choices=CHECKS)
+    ap.add_argument("--constants", type=json.loads, default={},
+                    help='JSON [constants] for every scene, e.g. \'{"h_over_dp": 2.0}\'')
     a = ap.parse_args()
+    CONSTANTS.update(a.constants)
     runners = {"archimedes_draft": archimedes, "heave_period": heave, "flap_still": flap_still,
                "spring_flap_period": spring_flap, "spring_flap_period_air": spring_flap_air,
                "momentum_zero_gravity": momentum, "wedge_pressure": wedge}
     for c in a.checks:
         if c in runners:
-            print(json.dumps(runners[c](a.dp)), flush=True)
+            print(json.dumps({**runners[c](a.dp), "constants": a.constants}), flush=True)
         elif c == "throughput":
             for line in flume_throughput(a.dp, a.steps):
                 print(json.dumps(line), flush=True)

@@ -43,6 +43,7 @@ from __future__ import annotations
 
 import csv
 import math
+import warnings
 from pathlib import Path
 from typing import NamedTuple
 
@@ -475,9 +476,19 @@ class BodySet:
         self.polygons = [shape_polygon(b) for b in scene.bodies]
         nb = len(scene.bodies)
         px, pz, owner = [], [], []
+        self.thin: list[str] = []
         for b, poly in enumerate(self.polygons):
             x, z = _lattice_in(scene, poly)
-            shell = _distance(poly, x, z) < thickness
+            dist = _distance(poly, x, z)
+            # a body thinner than the kernel support 2h lets fluid on its two sides interact
+            # through it and its particles' Adami pressure mix both sides' pressures (measured:
+            # a 0.04 m flap at dp 0.02, h/dp 2 oscillated 11 % slower than at dp 0.01)
+            if x.size and 2.0 * (float(dist.max()) + 0.5 * scene.dp) < 2.0 * scene.h:
+                self.thin.append(self.names[b])
+                warnings.warn(f"bodies.{self.names[b]}: thinner than the kernel support 2h = "
+                              f"{2.0 * scene.h:.4g} m: the fluid on its two sides interacts "
+                              f"through it; thicken it or refine dp", stacklevel=2)
+            shell = dist < thickness
             x, z = x[shell], z[shell]
             if x.size == 0:
                 raise ValueError(f"bodies.{b}: no particle fits inside the shape at dp = {scene.dp}")
