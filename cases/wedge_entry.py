@@ -42,7 +42,8 @@ HEIGHT = 0.29          # m, keel to top
 MASS = 241.0           # kg per metre of span
 V0 = 6.15              # m/s downwards at first contact
 TIMES = (0.00435, 0.0158)   # s after contact: the paper's pressure distributions
-N_POINTS = 12          # pressure points along the right face, keel to knuckle
+N_POINTS = 48          # pressure points along the right face, keel to knuckle (5 mm apart)
+WINDOW = 5e-4          # s: SPH pressures and force averaged over t +- WINDOW (acoustic noise)
 
 
 def wedge_outline(xc: float, z_keel: float) -> list[tuple[float, float]]:
@@ -96,6 +97,11 @@ def wagner_pressure(x: np.ndarray, c: float, v: float, dv: float, rho: float = 1
     return np.where(r2 > 0, p, np.nan)
 
 
+def _finite(a: np.ndarray) -> list[float | None]:
+    """A JSON-safe list: None for nan (dry point, or outside Wagner's wetted width)."""
+    return [float(v) if np.isfinite(v) else None for v in a]
+
+
 def wagner_force(c: float, v: float, dv: float, rho: float = 1000.0) -> float:
     """Wagner's vertical force [N/m] (the integral of wagner_pressure's first two terms over
     |x| < c): d/dt (rho pi c^2 V / 2) = rho pi (c dc/dt V + c^2 dV/dt / 2)."""
@@ -103,11 +109,16 @@ def wagner_force(c: float, v: float, dv: float, rho: float = 1000.0) -> float:
     return rho * math.pi * (c * dc * v + 0.5 * c * c * dv)
 
 
-def wedge_pressures(sim, times=TIMES, x_max_over_c: float = 0.8) -> list[dict]:
-    """Advance ``sim`` (a wedge_scene run) to each time and compare: the SPH pressure at the face
-    points (x from the keel, horizontal), the wedge's speed and deceleration, Wagner's c and
-    pressure at the same x, and the RMS difference over x <= x_max_over_c * c (relative to
-    Wagner's largest pressure there) and the ratio at the point nearest the keel."""
+def wedge_pressures(sim, times=TIMES, x_max_over_c: float = 0.8, window: float = WINDOW,
+                    samples: int = 11) -> list[dict]:
+    """Advance ``sim`` (a wedge_scene run) through each time and compare with Wagner: the SPH
+    pressure at the face points (x from the keel, horizontal) and the fluid's vertical force,
+    each averaged over ``samples`` instants in t +- ``window`` (the weakly compressible impact
+    rings: acoustic waves of period ~ wetted width / c0 make the instantaneous values swing by
+    a factor 2, the experiment's transducers average too), the wedge's speed, deceleration and
+    penetration at t; Wagner's c and pressure at the same x; the RMS difference over x <=
+    x_max_over_c * c relative to Wagner's largest pressure there; the ratio at the point nearest
+    the keel; and the instantaneous force at t."""
     half = 0.5 * BREADTH
     xs = half * (np.arange(N_POINTS) + 0.5) / N_POINTS
     k = sim.bodies.names.index("wedge")
@@ -115,21 +126,28 @@ def wedge_pressures(sim, times=TIMES, x_max_over_c: float = 0.8) -> list[dict]:
     z0 = float(bd.q0[k, 1])
     out = []
     for tt in times:
-        sim.advance_to(tt)
-        v = -float(bd.qd[k, 1])
-        dv = -float(bd.acc[k, 1])
-        zeta = z0 - float(bd.q[k, 1])
+        ps, fs = [], []
+        for ts in tt + np.linspace(-window, window, samples):
+            sim.advance_to(ts)
+            vals = sim.probe_values()
+            ps.append([np.nan if vals[f"face_p{i}"] is None else vals[f"face_p{i}"]
+                       for i in range(N_POINTS)])
+            fs.append(float(bd.load[k, 1]))
+            if abs(ts - tt) < 1e-12:
+                v, dv = -float(bd.qd[k, 1]), -float(bd.acc[k, 1])
+                zeta = z0 - float(bd.q[k, 1])
+                f_now = fs[-1]
+        with np.errstate(all="ignore"):
+            p_sph = np.nanmean(np.array(ps, dtype=float), axis=0)   # nan: dry throughout
         c = math.pi * zeta / (2.0 * math.tan(math.radians(DEADRISE_DEG)))
-        vals = sim.probe_values()
-        p_sph = np.array([np.nan if vals[f"face_p{i}"] is None else vals[f"face_p{i}"]
-                          for i in range(N_POINTS)], dtype=float)
         p_w = wagner_pressure(xs, c, v, dv)
         sel = (xs <= x_max_over_c * c) & np.isfinite(p_sph) & np.isfinite(p_w)
         rms = (float(np.sqrt(np.mean((p_sph[sel] - p_w[sel]) ** 2)) / np.max(p_w[sel]))
                if sel.any() else None)
-        out.append({"t": sim.t, "v": v, "dv": dv, "zeta": zeta, "c_wagner": c,
-                    "force_sph": float(bd.load[k, 1]), "force_wagner": wagner_force(c, v, dv),
-                    "x": xs.tolist(), "p_sph": p_sph.tolist(), "p_wagner": p_w.tolist(),
+        out.append({"t": tt, "window": window, "v": v, "dv": dv, "zeta": zeta, "c_wagner": c,
+                    "force_sph": float(np.mean(fs)), "force_sph_instant": f_now,
+                    "force_wagner": wagner_force(c, v, dv),
+                    "x": xs.tolist(), "p_sph": _finite(p_sph), "p_wagner": _finite(p_w),
                     "rms_rel": rms, "keel_ratio": (float(p_sph[0] / p_w[0])
                                                    if np.isfinite(p_sph[0] * p_w[0]) else None),
                     "points_compared": int(sel.sum()), "separated": c > half})

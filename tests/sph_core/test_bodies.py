@@ -291,7 +291,7 @@ def test_wedge_entry_force_against_wagner() -> None:
     SPH's), and the face pressure nearest the keel positive and of Wagner's order."""
     from cases.wedge_entry import wedge_pressures, wedge_scene
 
-    sim = Simulation(wedge_scene(dp=0.01, constants=STUDY, t_end=0.005))
+    sim = Simulation(wedge_scene(dp=0.01, constants=STUDY, t_end=0.006))
     (row,) = wedge_pressures(sim, (0.00435,))
     assert row["force_sph"] == pytest.approx(row["force_wagner"], rel=0.15)
     assert 0.5 < row["keel_ratio"] < 2.0
