@@ -53,21 +53,25 @@ def tank_end(dp: float) -> float:
 
 X_BODY = 1.5          # x [m] of the optional body's centre: on the flat bed, past the flat gauge
 BODIES = ("box", "flap")
+FLAP_THICKNESS = 0.08  # m
+FLAP_SPRING = 20.0     # N m/rad
 
 
 def demo_body(kind: str, dp: float) -> dict[str, Any]:
     """The demo's optional rigid body (issue 14) at X_BODY: ``box``, 0.2 m wide, 0.1 m high,
     500 kg/m^3, free in heave and pitch (draft 0.05 m); ``flap``, bottom-hinged on the bed,
-    0.05 m above still water, 500 kg/m^3, with a torsion spring (k = 20 N m/rad)."""
+    0.05 m above still water, 500 kg/m^3, with a torsion spring (k = FLAP_SPRING), FLAP_THICKNESS
+    thick (4 dp at dp 0.02: thicker than the kernel support, BODIES.md)."""
     d = depth_for(dp)
     if kind == "box":
         return {"name": "box", "shape": "box", "x0": X_BODY - 0.1, "x1": X_BODY + 0.1,
                 "z0": d - 0.05, "z1": d + 0.05, "density": 500.0, "motion": "free",
                 "dofs": ["heave", "pitch"]}
     if kind == "flap":
-        t = max(0.04, 2.0 * dp)
+        t = max(FLAP_THICKNESS, 4.0 * dp)
         return {"name": "flap", "shape": "flap", "x0": X_BODY - 0.5 * t, "x1": X_BODY + 0.5 * t,
-                "z0": 0.0, "z1": d + 0.05, "density": 500.0, "motion": "hinged", "spring": 20.0}
+                "z0": 0.0, "z1": d + 0.05, "density": 500.0, "motion": "hinged",
+                "spring": FLAP_SPRING}
     raise ValueError(f"body: one of {BODIES}, got {kind!r}")
 
 

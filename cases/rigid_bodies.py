@@ -161,6 +161,28 @@ def spring_flap_in_water(thickness: float, height: float, density: float, spring
             "added_inertia": a, "damping": b, "zeta": zeta, "k_eff": k_eff, "inertia": i_p}
 
 
+def flap_wave_response(thickness: float, height: float, density: float, spring: float,
+                       depth: float, wave_height: float, period: float, rho: float = 1000.0,
+                       g: float = 9.81) -> dict[str, float]:
+    """Linear pitch amplitude [rad] of a bottom-hinged flap (as spring_flap_in_water) in regular
+    waves of ``wave_height`` and ``period``, in a channel open on both sides: the excitation of
+    the flap held fixed is exact in linear theory (a full-depth surface-piercing barrier
+    reflects the wave totally: the weather side carries the standing wave 2A cosh k0 z /
+    cosh k0 h, the lee side none), X = 2 rho g A C_0 / cosh(k0 h); the response
+    Theta = X / (k_eff - (I_p + a) w^2 + i b w)."""
+    w = 2.0 * math.pi / period
+    m = density * thickness * height
+    i_p = m * (thickness ** 2 + 4.0 * height ** 2) / 12.0
+    k_eff = spring - m * g * 0.5 * height + rho * g * thickness * depth ** 2 / 2.0
+    a, b = flap_hydrodynamics(w, depth, rho, g)
+    k0, _ = _flap_wavenumbers(w, depth, g, 1)
+    c0 = depth * math.sinh(k0 * depth) / k0 - (math.cosh(k0 * depth) - 1.0) / k0 ** 2
+    x = 2.0 * rho * g * 0.5 * wave_height * c0 / math.cosh(k0 * depth)
+    theta = x / complex(k_eff - (i_p + a) * w * w, b * w)
+    return {"amplitude": abs(theta), "excitation": x, "added_inertia": a, "damping": b,
+            "k_eff": k_eff, "inertia": i_p}
+
+
 def zero_crossing_period(t: np.ndarray, y: np.ndarray) -> float:
     """Mean period [s] from the upward zero crossings of y - mean(y) (linear interpolation)."""
     y = np.asarray(y) - np.mean(y)

@@ -144,7 +144,16 @@ def wedge_pressures(sim, times=TIMES, x_max_over_c: float = 0.8, window: float =
         sel = (xs <= x_max_over_c * c) & np.isfinite(p_sph) & np.isfinite(p_w)
         rms = (float(np.sqrt(np.mean((p_sph[sel] - p_w[sel]) ** 2)) / np.max(p_w[sel]))
                if sel.any() else None)
+        cot = 1.0 / math.tan(math.radians(DEADRISE_DEG))
+        g = sim.scene.constants.g
         out.append({"t": tt, "window": window, "v": v, "dv": dv, "zeta": zeta, "c_wagner": c,
+                    # impulse of the fluid on the wedge since contact, M (V0 - V) + M g t, and
+                    # the added-mass momentum rho pi c^2 V / 2 of Wagner (c = pi zeta cot / 2,
+                    # over-predicts c at 30 deg) and of von Karman (c = zeta cot, no pile-up:
+                    # under-predicts): a bracket for the integral of the force
+                    "impulse_sph": MASS * (V0 - v) + MASS * g * tt,
+                    "impulse_wagner": 0.5 * 1000.0 * math.pi * c * c * v,
+                    "impulse_von_karman": 0.5 * 1000.0 * math.pi * (zeta * cot) ** 2 * v,
                     "force_sph": float(np.mean(fs)), "force_sph_instant": f_now,
                     "force_wagner": wagner_force(c, v, dv),
                     "x": xs.tolist(), "p_sph": _finite(p_sph), "p_wagner": _finite(p_w),
