@@ -21,7 +21,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from bodies import heave  # noqa: E402
 
-VARIANTS = {
+HEAVE_VARIANTS = {
     "base": ({}, 0.02),                                        # the old defaults
     "awf0": ({"alpha_wall_factor": 0.0}, 0.02),                # no wall AV (fluid-body too)
     "h2": ({"h_over_dp": 2.0}, 0.02),
@@ -38,10 +38,10 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--dp", type=float, default=0.02)
     ap.add_argument("--t-end", type=float, default=1.2)
-    ap.add_argument("--variants", nargs="*", default=list(VARIANTS), choices=list(VARIANTS))
+    ap.add_argument("--variants", nargs="*", default=list(HEAVE_VARIANTS), choices=list(HEAVE_VARIANTS))
     a = ap.parse_args()
     for v in a.variants:
-        constants, offset = VARIANTS[v]
+        constants, offset = HEAVE_VARIANTS[v]
         line = heave(a.dp, offset=offset, constants=constants, t_end=a.t_end,
                      save=f"runs/heave_study/{v}_dp{a.dp}.npz")
         print(json.dumps({"variant": v, **line}), flush=True)

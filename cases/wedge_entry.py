@@ -38,20 +38,20 @@ from sph_core.scene import Scene, make_scene
 
 BREADTH = 0.5          # m, at the knuckles
 DEADRISE_DEG = 30.0
-HEIGHT = 0.29          # m, keel to top
+WEDGE_HEIGHT = 0.29    # m, keel to top
 MASS = 241.0           # kg per metre of span
 V0 = 6.15              # m/s downwards at first contact
 TIMES = (0.00435, 0.0158)   # s after contact: the paper's pressure distributions
 N_POINTS = 48          # pressure points along the right face, keel to knuckle (5 mm apart)
-WINDOW = 5e-4          # s: SPH pressures and force averaged over t +- WINDOW (acoustic noise)
+PRESSURE_WINDOW = 5e-4  # s: SPH pressures and force averaged over t +- this (acoustic noise)
 
 
 def wedge_outline(xc: float, z_keel: float) -> list[tuple[float, float]]:
-    """The section: keel at (xc, z_keel), knuckles at +-B/2, vertical sides to HEIGHT."""
+    """The section: keel at (xc, z_keel), knuckles at +-B/2, vertical sides to WEDGE_HEIGHT."""
     half = 0.5 * BREADTH
     zk = z_keel + half * math.tan(math.radians(DEADRISE_DEG))
-    return [(xc, z_keel), (xc + half, zk), (xc + half, z_keel + HEIGHT),
-            (xc - half, z_keel + HEIGHT), (xc - half, zk)]
+    return [(xc, z_keel), (xc + half, zk), (xc + half, z_keel + WEDGE_HEIGHT),
+            (xc - half, z_keel + WEDGE_HEIGHT), (xc - half, zk)]
 
 
 def face_points(xc: float, z_keel: float, offset: float) -> list[tuple[float, float]]:
@@ -74,7 +74,7 @@ def wedge_scene(dp: float = 0.01, depth: float = 0.6, length: float = 1.2,
     xc = 0.5 * length
     return make_scene({
         "name": "wedge_entry", "dp": dp, "t_end": t_end, "still_water_level": depth,
-        "tank": {"x0": 0.0, "x1": length, "z0": 0.0, "z1": depth + HEIGHT + 0.1},
+        "tank": {"x0": 0.0, "x1": length, "z0": 0.0, "z1": depth + WEDGE_HEIGHT + 0.1},
         "water_blocks": [{"x0": 0.0, "x1": length, "z0": 0.0, "z1": depth}],
         "constants": {"c0_factor": c0_factor, **(constants or {})},
         "output": {"probe_every": probe_every},
@@ -109,8 +109,8 @@ def wagner_force(c: float, v: float, dv: float, rho: float = 1000.0) -> float:
     return rho * math.pi * (c * dc * v + 0.5 * c * c * dv)
 
 
-def wedge_pressures(sim, times=TIMES, x_max_over_c: float = 0.8, window: float = WINDOW,
-                    samples: int = 11) -> list[dict]:
+def wedge_pressures(sim, times=TIMES, x_max_over_c: float = 0.8,
+                    window: float = PRESSURE_WINDOW, samples: int = 11) -> list[dict]:
     """Advance ``sim`` (a wedge_scene run) through each time and compare with Wagner: the SPH
     pressure at the face points (x from the keel, horizontal) and the fluid's vertical force,
     each averaged over ``samples`` instants in t +- ``window`` (the weakly compressible impact
