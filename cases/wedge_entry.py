@@ -31,6 +31,7 @@ solution does not apply: only the SPH values are reported there.
 from __future__ import annotations
 
 import math
+import warnings
 
 import numpy as np
 
@@ -137,8 +138,9 @@ def wedge_pressures(sim, times=TIMES, x_max_over_c: float = 0.8,
                 v, dv = -float(bd.qd[k, 1]), -float(bd.acc[k, 1])
                 zeta = z0 - float(bd.q[k, 1])
                 f_now = fs[-1]
-        with np.errstate(all="ignore"):
-            p_sph = np.nanmean(np.array(ps, dtype=float), axis=0)   # nan: dry throughout
+        with warnings.catch_warnings():   # a point dry throughout: nan, said, not warned
+            warnings.simplefilter("ignore", RuntimeWarning)
+            p_sph = np.nanmean(np.array(ps, dtype=float), axis=0)
         c = math.pi * zeta / (2.0 * math.tan(math.radians(DEADRISE_DEG)))
         p_w = wagner_pressure(xs, c, v, dv)
         sel = (xs <= x_max_over_c * c) & np.isfinite(p_sph) & np.isfinite(p_w)
