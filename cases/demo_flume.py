@@ -51,8 +51,33 @@ def tank_end(dp: float) -> float:
     return dp * round((X_TOE + (depth_for(dp) + 0.1) / SLOPE) / dp)
 
 
-def demo_scene(dp: float, t_end: float) -> dict[str, Any]:
-    """The flume as a server scene (plain dict, validated by the server)."""
+X_BODY = 1.5          # x [m] of the optional body's centre: on the flat bed, past the flat gauge
+BODIES = ("box", "flap")
+FLAP_THICKNESS = 0.08  # m
+FLAP_SPRING = 20.0     # N m/rad
+
+
+def demo_body(kind: str, dp: float) -> dict[str, Any]:
+    """The demo's optional rigid body (issue 14) at X_BODY: ``box``, 0.2 m wide, 0.1 m high,
+    500 kg/m^3, free in heave and pitch (draft 0.05 m); ``flap``, bottom-hinged on the bed,
+    0.05 m above still water, 500 kg/m^3, with a torsion spring (k = FLAP_SPRING), FLAP_THICKNESS
+    thick (4 dp at dp 0.02: thicker than the kernel support, BODIES.md)."""
+    d = depth_for(dp)
+    if kind == "box":
+        return {"name": "box", "shape": "box", "x0": X_BODY - 0.1, "x1": X_BODY + 0.1,
+                "z0": d - 0.05, "z1": d + 0.05, "density": 500.0, "motion": "free",
+                "dofs": ["heave", "pitch"]}
+    if kind == "flap":
+        t = max(FLAP_THICKNESS, 4.0 * dp)
+        return {"name": "flap", "shape": "flap", "x0": X_BODY - 0.5 * t, "x1": X_BODY + 0.5 * t,
+                "z0": 0.0, "z1": d + 0.05, "density": 500.0, "motion": "hinged",
+                "spring": FLAP_SPRING}
+    raise ValueError(f"body: one of {BODIES}, got {kind!r}")
+
+
+def demo_scene(dp: float, t_end: float, body: str | None = None) -> dict[str, Any]:
+    """The flume as a server scene (plain dict, validated by the server); ``body``: None, or one
+    of BODIES placed on the flat bed (``demo_body``)."""
     d, x1 = depth_for(dp), tank_end(dp)
     return {
         "name": "wavesph-demo", "dp": dp, "t_end": t_end, "still_water_level": d,
@@ -67,15 +92,17 @@ def demo_scene(dp: float, t_end: float) -> dict[str, Any]:
         "output": {"probe_every": PERIOD / 20},
         "probes": [{"kind": "elevation", "name": n, "x": x} for n, x in GAUGES.items()],
         "open_boundaries": [{"side": "left", "elevation": "imposed", "absorb": True}],
+        **({"bodies": [demo_body(body, dp)]} if body else {}),
     }
 
 
-def run_demo(dp: float, t_end: float, transport: str, out: Path) -> tuple[dict, Any]:
+def run_demo(dp: float, t_end: float, transport: str, out: Path,
+             body: str | None = None) -> tuple[dict, Any]:
     """The demo flume at spacing ``dp`` [m] to ``t_end`` [s], coupled over ``transport`` ("ws" or
-    "tcp") to a server in this process storing its runs in ``out``: (final run record, client
-    report or None)."""
+    "tcp") to a server in this process storing its runs in ``out``, with an optional ``body``
+    in the SPH zone: (final run record, client report or None)."""
     with InProcessServer(out) as srv:
-        return _couple(srv, demo_scene(dp, t_end), transport, out)
+        return _couple(srv, demo_scene(dp, t_end, body), transport, out)
 
 
 def _couple(srv: InProcessServer, scene: dict, transport: str, out: Path) -> tuple[dict, Any]:

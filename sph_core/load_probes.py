@@ -29,6 +29,10 @@ class LoadProbes:
         pts = [xz for p in self.lines for xz in p.points]
         self._lx = np.array([xz[0] for xz in pts], dtype=float)
         self._lz = np.array([xz[1] for xz in pts], dtype=float)
+        self._lx0, self._lz0 = self._lx.copy(), self._lz.copy()   # at t_start (follow)
+        bounds = np.cumsum([0] + [len(p.points) for p in self.lines])
+        self._follow = [(slice(a, b), p.follow) for a, b, p in zip(bounds[:-1], bounds[1:],
+                                                                      self.lines) if p.follow]
         self._lout = np.zeros((len(pts), 4))
         self._side: dict[str, np.ndarray] = {}       # id -> 1 if x >= section, 0 if not, -1 unknown
         self._volume = {p.name: 0.0 for p in self.overtopping}
@@ -49,9 +53,12 @@ class LoadProbes:
         return cols
 
     def values(self, ps: Any, cells: Any, h: float, alpha_w: float, alpha_f: float,
-               t: float) -> dict[str, float | None]:
-        """Every column at the current state of particle set ``ps`` (cell lists ``cells``)."""
+               t: float, bodies: Any = None) -> dict[str, float | None]:
+        """Every column at the current state of particle set ``ps`` (cell lists ``cells``);
+        ``bodies`` (a BodySet) places the pressure lines that follow a body."""
         out: dict[str, float | None] = {}
+        for sl, name in self._follow:
+            self._lx[sl], self._lz[sl] = bodies.follow(name, self._lx0[sl], self._lz0[sl])
         f, kind = ps.f, ps.kind
         n = ps.n
         x, z = f[X, :n], f[Z, :n]

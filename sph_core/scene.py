@@ -204,6 +204,9 @@ class PointProbe(_Model):
     name: str = Field(min_length=1)
     x: float
     z: float
+    follow: str | None = Field(None, description=(
+        "name of a body: the point(s) move rigidly with it (given at t_start, in scene "
+        "coordinates; e.g. a pressure line on a moving hull)"))
 
 
 class ElevationProbe(_Model):
@@ -248,6 +251,9 @@ class PressureLineProbe(_Model):
     kind: Literal["pressure_line"]
     name: str = Field(min_length=1)
     points: list[tuple[float, float]] = Field(min_length=1, description="(x, z) of each point [m]")
+    follow: str | None = Field(None, description=(
+        "name of a body: the point(s) move rigidly with it (given at t_start, in scene "
+        "coordinates; e.g. a pressure line on a moving hull)"))
 
 
 class OvertoppingProbe(_Model):
@@ -361,6 +367,10 @@ class Scene(_Model):
         bnames = [b.name for b in self.bodies]
         if len(set(bnames)) != len(bnames):
             raise ValueError(f"bodies: duplicate names {bnames}")
+        for i, p in enumerate(self.probes):
+            follow = getattr(p, "follow", None)
+            if follow is not None and follow not in bnames:
+                raise ValueError(f"probes.{i}.follow: no body named {follow!r} (bodies: {bnames})")
         if self.output.snapshot_every and self.output.snapshot_every > self.t_end - self.t_start:
             raise ValueError("output.snapshot_every: must not exceed the run's length t_end - t_start")
         return self

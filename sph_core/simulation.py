@@ -132,6 +132,7 @@ class Simulation:
         self._fronts = [p for p in scene.probes if isinstance(p, FrontProbe)]
         self._px = np.array([p.x for p in self._points], dtype=float)
         self._pz = np.array([p.z for p in self._points], dtype=float)
+        self._px0, self._pz0 = self._px.copy(), self._pz.copy()   # at t_start (follow)
         self._pout = np.zeros((len(self._points), 4))
         self.loads = LoadProbes(scene)  # force, pressure_line, overtopping
         nz = int(math.floor((t.z1 - t.z0) / (0.5 * dp)))
@@ -208,6 +209,10 @@ class Simulation:
         aw = self.prm.alpha_w
         out: dict[str, float | None] = {}
         if self._points:
+            for k, p in enumerate(self._points):
+                if p.follow:
+                    x, z = self.bodies.follow(p.follow, self._px0[k:k + 1], self._pz0[k:k + 1])
+                    self._px[k], self._pz[k] = x[0], z[0]
             interpolate_points(ps.view, self.cells, self._px, self._pz, self.h, aw, self._pout)
             for k, p in enumerate(self._points):
                 wet = self._pout[k, 3] > 0.05
@@ -231,7 +236,7 @@ class Simulation:
                 out[f"{p.name}_x"] = float(x[sel].max()) if sel.any() else None
         if self.loads:
             out.update(self.loads.values(self.particles, self.cells, self.h, aw,
-                                         self.prm.alpha_f, self.t))
+                                         self.prm.alpha_f, self.t, self.bodies))
         return out
 
     # ---------------------------------------------------------------- outputs

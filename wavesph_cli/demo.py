@@ -36,6 +36,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("-o", "--out", type=Path, default=None,
                         help="run directory (default ./runs/demo-<UTC time>); must be new or empty")
     parser.add_argument("--no-plot", action="store_true", help="skip the figure")
+    parser.add_argument("--body", choices=("box", "flap"), default=None,
+                        help="put a rigid body in the SPH zone at x = 1.5 m: a floating box "
+                             "(heave, pitch) or a bottom-hinged flap on a spring; its motion "
+                             "and loads go to <run id>/sph/bodies.csv (GET /runs/{id}/bodies)")
     parser.add_argument("--dambreak", action="store_true",
                         help="run the standalone dam break (Martin & Moyce) instead, as "
                              "`wavesph run examples/scenes/dambreak_martin_moyce.toml` does")
@@ -78,7 +82,7 @@ def main(args: argparse.Namespace) -> int:
     out.mkdir(parents=True, exist_ok=True)
     tic = time.perf_counter()
     try:
-        info, report = run_demo(dp, t_end, args.transport, out)
+        info, report = run_demo(dp, t_end, args.transport, out, body=args.body)
     except KeyboardInterrupt:
         print(f"\nwavesph demo: interrupted; partial results in {out}", file=sys.stderr)
         return 130
@@ -107,6 +111,8 @@ def main(args: argparse.Namespace) -> int:
           f"  {info['id']}/meta.json    run record ({info['status']})\n"
           f"  client_gauges.csv          measured and theoretical elevation per window\n"
           + ("" if args.no_plot else "  elevation.png              measured vs theory\n")
+          + (f"  {info['id']}/sph/bodies.csv the {args.body}'s motion and loads\n"
+             if args.body else "")
           + "  summary.json               these figures", file=sys.stderr)
     return 0
 
