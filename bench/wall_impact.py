@@ -14,6 +14,7 @@ Prints one JSON object:
   particles' own pressure), each raw and after a centred moving average of
   ``--average-ms`` (the experiment's trace too); ``arrival`` = first time p > 0.1 rho g H;
   ``dry_ms_first_100ms``: how long the fluid probe saw no fluid in the 0.1 s after arrival;
+  ``mean_5_50ms_pa``: the mean load 5-50 ms after arrival (after the spike; dry counts as 0);
   ``noise_rms``: RMS of (raw - the 1 ms moving average) over the 0.25 s after arrival;
 - cost: steps, wall time (say whether the machine was loaded), particle-steps/s.
 
@@ -70,7 +71,8 @@ def impact_figures(t: np.ndarray, p: np.ndarray, average: float) -> dict:
     return {"arrival_s": round(float(t_arr), 5), "dry_ms_first_100ms": round(1e3 * dry, 2),
             "peak_pa": round(float(q[k]), 1), "peak_t_s": round(float(t[k]), 5),
             "peak_avg_pa": round(float(avg[ka]), 1), "peak_avg_t_s": round(float(t[ka]), 5),
-            "noise_rms_pa": round(float(np.sqrt(np.mean(hp[nwin] ** 2))), 1)}
+            "noise_rms_pa": round(float(np.sqrt(np.mean(hp[nwin] ** 2))), 1),
+            "mean_5_50ms_pa": round(float(np.mean(q[(t >= t_arr + 0.005) & (t <= t_arr + 0.05)])), 1)}
 
 
 class Sensors:
