@@ -48,5 +48,5 @@ def test_sloping_bed_rows_share_the_bottom_spacing_near_the_right_wall():
     d = np.sqrt(((pts[:, None, :] - pts[None, :, :]) ** 2).sum(-1))
     np.fill_diagonal(d, np.inf)
     assert d.min(axis=1).max() < 1.01 * dp   # every particle has a neighbour one spacing away
-    bed_right = np.sort(x[(np.isclose(z, 0.095 - 0.0)) & (x < L)])
+    bed_right = np.sort(x[np.isclose(z, 0.095) & (x < L)])   # a dummy row just below the bed top
     assert bed_right.size and L - bed_right[-1] < 0.51 * dp + 1e-12
