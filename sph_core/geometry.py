@@ -1,9 +1,13 @@
 """Particle positions for a scene: fluid on a lattice, dummy wall particles in layers.
 
-Every particle sits on the lattice (x0 + (i + 1/2) dp, z0 + (j + 1/2) dp) anchored at the tank's
-lower-left inner corner, except the right wall, which is laid out from x1 so that it is always
-dp/2 from the wall face. Wall layers are ``n_layers = ceil(2h/dp)`` deep so that a fluid particle
-at the wall sees a full kernel support (2h) of dummy particles.
+Fluid particles sit on the lattice (x0 + (i + 1/2) dp, z0 + (j + 1/2) dp) anchored at the tank's
+lower-left inner corner. Wall layers are ``n_layers = ceil(2h/dp)`` deep so that a fluid particle
+at the wall sees a full kernel support (2h) of dummy particles. The side walls are columns dp/2,
+3dp/2, ... outside their faces x0 and x1, running down through the corners; the bottom rows (and
+sloping beds) between them are spaced ``wall_dx`` = (x1 - x0) / round((x1 - x0) / dp), so that
+they meet both columns one spacing away whatever the tank length. (On the dp lattice a tank
+402.5 dp long left a gap of 1.5 dp at the right corner in every layer, through which a violent
+impact pushed fluid out of the tank: docs/wall_pressure.md.)
 """
 
 from __future__ import annotations
@@ -32,14 +36,23 @@ def wall_layers(scene: Scene) -> int:
     return int(math.ceil(2.0 * scene.h / scene.dp - 1e-9))
 
 
-def _lattice(scene: Scene, xa: float, xb: float, za: float, zb: float) -> tuple[np.ndarray, np.ndarray]:
-    """Lattice points with xa < x < xb and za < z < zb."""
+def wall_dx(scene: Scene) -> float:
+    """x spacing of the bottom rows and beds: the tank length over a whole number of spacings
+    closest to dp, so the rows end about one spacing from both side walls' first columns."""
+    length = scene.tank.x1 - scene.tank.x0
+    return length / max(1, round(length / scene.dp))
+
+
+def _lattice(scene: Scene, xa: float, xb: float, za: float, zb: float,
+             dx: float | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Lattice points with xa < x < xb and za < z < zb (x spacing ``dx``, default dp)."""
     dp, t = scene.dp, scene.tank
-    i0 = math.floor((xa - t.x0) / dp - 0.5) - 1
-    i1 = math.ceil((xb - t.x0) / dp - 0.5) + 1
+    dx = dp if dx is None else dx
+    i0 = math.floor((xa - t.x0) / dx - 0.5) - 1
+    i1 = math.ceil((xb - t.x0) / dx - 0.5) + 1
     j0 = math.floor((za - t.z0) / dp - 0.5) - 1
     j1 = math.ceil((zb - t.z0) / dp - 0.5) + 1
-    xs = t.x0 + (np.arange(i0, i1 + 1) + 0.5) * dp
+    xs = t.x0 + (np.arange(i0, i1 + 1) + 0.5) * dx
     zs = t.z0 + (np.arange(j0, j1 + 1) + 0.5) * dp
     eps = 1e-9 * dp
     xs = xs[(xs > xa + eps) & (xs < xb - eps)]
@@ -76,8 +89,8 @@ def build_layout(scene: Scene) -> Layout:
     # tank walls: left and right columns (including the corners), bottom rows
     zs = t.z0 + (np.arange(-nl, math.ceil((t.z1 - t.z0) / dp)) + 0.5) * dp
     zs = zs[zs <= t.z1]
-    xs_bottom = t.x0 + (np.arange(0, math.ceil((t.x1 - t.x0) / dp - 0.5 + 1e-9)) + 0.5) * dp
-    xs_bottom = xs_bottom[xs_bottom < t.x1 - 0.25 * dp]
+    dx = wall_dx(scene)
+    xs_bottom = t.x0 + (np.arange(round((t.x1 - t.x0) / dx)) + 0.5) * dx
     wx, wz = [], []
     for k in range(nl):
         for xw in (t.x0 - (k + 0.5) * dp, t.x1 + (k + 0.5) * dp):
@@ -89,7 +102,7 @@ def build_layout(scene: Scene) -> Layout:
     for bed in scene.beds:
         pts = np.asarray(bed.points)
         bx, bz = _lattice(scene, max(pts[:, 0].min(), t.x0), min(pts[:, 0].max(), t.x1),
-                          max(pts[:, 1].min() - th, t.z0), min(pts[:, 1].max(), t.z1))
+                          max(pts[:, 1].min() - th, t.z0), min(pts[:, 1].max(), t.z1), dx)
         d, below = _polyline_distance(bed, bx, bz)
         keep = below & (d < th)
         wx.append(bx[keep])
