@@ -62,6 +62,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--shift-a", type=float, help="shifting coefficient A (Lind et al. 2012)")
     ap.add_argument("--shift-fs-div", type=float, help="free-surface position-divergence limit")
     ap.add_argument("--alpha-wall", type=float, help="artificial viscosity factor against walls")
+    ap.add_argument("--inlet-pressure", choices=["hydrostatic", "extrapolated"],
+                    help="inlet buffer pressure (scene default if unset)")
     a = ap.parse_args(argv)
     cst = {k: v for k, v in {"h_over_dp": a.h_over_dp, "alpha": a.alpha, "wall_slip": a.slip,
                              "delta": a.delta, "cfl": a.cfl, "nu": a.nu,
@@ -74,12 +76,14 @@ def main(argv: list[str] | None = None) -> int:
         model = build_theory("stokes", height=a.H, period=a.T, depth=a.d, ramp_time=a.T, order=2)
         prof = amplitude_profile(model, ramp=a.T, height=a.H, period=a.T, depth=a.d, dp=dp,
                                  periods=a.periods, flume_wavelengths=a.flume_wavelengths,
+                                 inlet_pressure=a.inlet_pressure,
                                  c0=c0, **cst)
         length = float(model.length)
         decays.append(prof.decay_per_m)
         sep_decay, sep_k, sep_kr = separated_decay(prof.x, prof.amp, prof.k)
         print(json.dumps({"H": a.H, "T": a.T, "d": a.d, "dp": dp, "H_over_dp": round(a.H / dp, 3),
                           "constants": cst, "c0_factor": a.c0_factor,
+                          "inlet_pressure": a.inlet_pressure,
                           "flume_wavelengths": a.flume_wavelengths,
                           "wavelength_m": round(length, 4),
                           "x": prof.x.tolist(),

@@ -24,7 +24,10 @@ interpolated linearly in time and linearly in z between the nodes):
     The outlet extrapolates by default (scene.OUTLET_PRESSURE, with the measured reflection: half
     the hydrostatic buffer's): the hydrostatic buffer takes the pressure of the surface measured
     2h inside the face, out of phase with the face and without the wave's non-hydrostatic
-    pressure; the ghost nodes carry the fluid's own pressure field into the buffer.
+    pressure; the ghost nodes carry the fluid's own pressure field into the buffer. The inlet
+    extrapolates by default too (scene.INLET_PRESSURE): the continuum hydrostatic profile is not
+    the SPH fluid's discrete equilibrium near its free surface, and the difference pulls the
+    fluid's surface corner into the buffer.
 Crossings (d: depth into the buffer, counted per end so that mass balance is exact):
     fluid with d >= 0 where the imposed flow leaves (u n_x > 0), or with d >= dp
                                  -> buffer                         (counter OUT)

@@ -29,7 +29,7 @@ from .boundary_data import (BoundaryData, BoundaryDataError, BoundaryNodes, Boun
 from .eos import GAMMA, hydrostatic_density
 from .open_boundary import INLET_IDLE
 from .particles import INLET, M, P, RHO, WALL, X, Z, ParticleSet
-from .scene import OUTLET_PRESSURE, OpenBoundary, Scene
+from .scene import INLET_PRESSURE, OUTLET_PRESSURE, OpenBoundary, Scene
 from .state import OpenEnds, closed_ends
 
 SIDES = ("left", "right")
@@ -239,7 +239,7 @@ def buffer_pressure(o: OpenBoundary) -> str:
     """How the buffer of open end ``o`` gets its pressure: ``hydrostatic`` or ``extrapolated``."""
     if o.pressure is not None:
         return o.pressure
-    return OUTLET_PRESSURE if o.elevation == "extrapolated" else "hydrostatic"
+    return OUTLET_PRESSURE if o.elevation == "extrapolated" else INLET_PRESSURE
 
 
 def flume_nodes(scene: Scene) -> dict[str, BoundaryNodes]:
