@@ -54,14 +54,15 @@ class AmplitudeProfile:
 def amplitude_profile(model: Any, *, ramp: float, height: float, period: float, depth: float,
                       dp: float, periods: float = 4.0, n_gauges: int = 12,
                       flume_wavelengths: float = 1.0, inlet_pressure: str | None = None,
-                      **constants: Any) -> AmplitudeProfile:
+                      settle_periods: float = 0.0, **constants: Any) -> AmplitudeProfile:
     """Run the flume driven by ``model`` (its start-up ramp lasting ``ramp`` s) and measure
     the amplitude ratio along it (``constants`` override the scene's, e.g. alpha). The flume is
-    ``flume_wavelengths`` long; the gauges stay within 3/4 of a wavelength of the inlet."""
+    ``flume_wavelengths`` long; the gauges stay within 3/4 of a wavelength of the inlet. The
+    window starts ``settle_periods`` periods after the front has passed the last gauge."""
     length = float(model.length)
     xs = np.round(np.linspace(2.0 * math.sqrt(2.0) * dp, 0.75 * length, n_gauges), 4)
     # the ramped front and one period past the last gauge
-    t0 = ramp + xs[-1] / group_velocity(length, period, depth) + period
+    t0 = ramp + xs[-1] / group_velocity(length, period, depth) + (1.0 + settle_periods) * period
     scene = wave_flume_scene(depth=depth, wavelength=length, height=height, dp=dp,
                              t_end=t0 + periods * period, length=flume_wavelengths * length,
                              absorb=(True, True),

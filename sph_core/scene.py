@@ -267,18 +267,12 @@ Probe = Annotated[Union[PointProbe, ElevationProbe, FrontProbe, ForceProbe, Pres
 # K_R / three-gauge K_R / RMSE/H): H/dp = 6: 1.7 % / 3.9 % / 4.4 % against hydrostatic
 # 4.0 % / 7.0 % / 4.2 %; H/dp = 3: 1.8 % / 4.0 % against 4.0 % / 6.5 %; same cost.
 OUTLET_PRESSURE = "extrapolated"
-# buffer pressure of an inlet (elevation "imposed") that does not name one. Seed 002's table says
-# hydrostatic, rho0 g (z_s - z) below the imposed surface z_s: the continuum profile. The SPH
-# fluid's own equilibrium is not that near a free surface (kernel truncation: at h/dp 2 its top
-# row carries ~2x rho0 g dp/2, 195 against 98 Pa at dp 0.02; the rows below match within a few
-# %), so a hydrostatic buffer pulls the fluid's surface corner into the buffer (4 cm/s in still
-# water, one particle lost through the inlet of tests/sph_core/test_open_boundary.py's still
-# flume). Extrapolated through the ghost nodes the buffer carries the fluid's own pressure; the
-# imposed elevation still switches buffer particles on and off and the velocity stays imposed.
-# Measured at h/dp 2, dp 0.02 (docs/wave_decay_study.md, under load): demo RMSE/H 0.048 ->
-# 0.042, wave_decay 4.84 -> 4.11 %/m; the first gauge 2h·√2 from the face reads 0.944 of the
-# theory's amplitude against 0.989 (a near-field deficit that is gone by 0.3 m).
-INLET_PRESSURE = "extrapolated"
+# buffer pressure of an inlet (elevation "imposed") that does not name one: seed 002's table.
+# Within h of its surface a hydrostatic buffer takes the fluid's own pressure through the ghost
+# nodes (open_boundary.SURFACE_BAND_H). Extrapolated everywhere, the inlet let a fluid particle
+# through the floor at its bottom corner (case V, dp 0.02) and generated 5 % less amplitude
+# within 0.3 m of the face (docs/wave_decay_study.md).
+INLET_PRESSURE = "hydrostatic"
 
 
 class OpenBoundary(_Model):
@@ -304,8 +298,9 @@ class OpenBoundary(_Model):
     pressure: Literal["hydrostatic", "extrapolated"] | None = Field(
         None, description="buffer pressure: hydrostatic below the buffer's surface, or "
                           "extrapolated from the fluid through mirrored ghost nodes; None: "
-                          "OUTLET_PRESSURE for an extrapolated elevation, else INLET_PRESSURE "
-                          "(both extrapolated)")
+                          "OUTLET_PRESSURE (extrapolated) for an extrapolated elevation, else "
+                          "INLET_PRESSURE (hydrostatic); hydrostatic buffers extrapolate within "
+                          "h of their surface")
 
 
 class Output(_Model):
