@@ -286,7 +286,9 @@ def _particle_loads(ps, n, cells, prm, bd):
     s2 = 4.0 * h * h
     eta2 = 0.01 * h * h
     af = prm.alpha_f
-    av = prm.alpha * prm.c0 * h
+    # body particles are wall particles: the fluid pass applies alpha_wall x alpha to them, and
+    # the reaction must be the same term, or the fluid + body momentum is not conserved
+    av = prm.alpha_wall * prm.alpha * prm.c0 * h
     nu4 = 4.0 * prm.nu
     noslip = prm.noslip
     id0 = bd.id0
