@@ -1,6 +1,7 @@
 """How much does the SPH flume damp a progressive wave over distance, at a given resolution?
 
     python bench/wave_decay.py [--H 0.04 --T 1.4 --d 0.24] [--dp 0.02 0.01 0.005] [--periods 4]
+        [--settle-periods 0] [--inlet-pressure hydrostatic|extrapolated] [--no-outlet-absorb]
         [--h-over-dp 2.0] [--alpha 0.01] [--slip no_slip|free_slip] [--c0-factor 10] [--delta 0.1]
         [--cfl 0.25] [--integrator kdk|symplectic_pc] [--nu 1e-6] [--alpha-wall 1.0]
         [--shifting none|fickian] [--shift-a 2.0]
@@ -48,6 +49,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--d", type=float, default=0.24, help="still-water depth [m]")
     ap.add_argument("--dp", type=float, nargs="+", default=[0.02], help="particle spacing(s) [m]")
     ap.add_argument("--periods", type=float, default=4.0, help="periods analysed")
+    ap.add_argument("--settle-periods", type=float, default=0.0,
+                    help="extra periods between the front's passage and the analysed window")
     ap.add_argument("--flume-wavelengths", type=float, default=1.0,
                     help="flume length in wavelengths (gauges stay within 3/4 of the first)")
     ap.add_argument("--h-over-dp", type=float, help="smoothing length / dp (scene default if unset)")
@@ -62,6 +65,10 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--shift-a", type=float, help="shifting coefficient A (Lind et al. 2012)")
     ap.add_argument("--shift-fs-div", type=float, help="free-surface position-divergence limit")
     ap.add_argument("--alpha-wall", type=float, help="artificial viscosity factor against walls")
+    ap.add_argument("--no-outlet-absorb", action="store_true",
+                    help="outlet without the absorption correction (diagnostic: its reflection)")
+    ap.add_argument("--inlet-pressure", choices=["hydrostatic", "extrapolated"],
+                    help="inlet buffer pressure (scene default if unset)")
     a = ap.parse_args(argv)
     cst = {k: v for k, v in {"h_over_dp": a.h_over_dp, "alpha": a.alpha, "wall_slip": a.slip,
                              "delta": a.delta, "cfl": a.cfl, "nu": a.nu,
@@ -74,12 +81,16 @@ def main(argv: list[str] | None = None) -> int:
         model = build_theory("stokes", height=a.H, period=a.T, depth=a.d, ramp_time=a.T, order=2)
         prof = amplitude_profile(model, ramp=a.T, height=a.H, period=a.T, depth=a.d, dp=dp,
                                  periods=a.periods, flume_wavelengths=a.flume_wavelengths,
+                                 inlet_pressure=a.inlet_pressure, settle_periods=a.settle_periods,
+                                 outlet_absorb=not a.no_outlet_absorb,
                                  c0=c0, **cst)
         length = float(model.length)
         decays.append(prof.decay_per_m)
         sep_decay, sep_k, sep_kr = separated_decay(prof.x, prof.amp, prof.k)
         print(json.dumps({"H": a.H, "T": a.T, "d": a.d, "dp": dp, "H_over_dp": round(a.H / dp, 3),
                           "constants": cst, "c0_factor": a.c0_factor,
+                          "inlet_pressure": a.inlet_pressure, "settle_periods": a.settle_periods,
+                          "outlet_absorb": not a.no_outlet_absorb,
                           "flume_wavelengths": a.flume_wavelengths,
                           "wavelength_m": round(length, 4),
                           "x": prof.x.tolist(),

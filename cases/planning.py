@@ -159,7 +159,7 @@ def step_estimate(dp: float, depth: float, height: float, period: float,
                   method: str) -> float:
     """dt [s] of the adaptive step at the wave's largest orbital speed (c0 = 10 sqrt(g d))."""
     c = METHODS[method]
-    h = c.get("h_over_dp", 1.4142) * dp
+    h = c["h_over_dp"] * dp
     k = 2 * math.pi / wavelength(period, depth)
     u = math.pi * height / period / math.tanh(k * depth)
     return c.get("cfl", 0.25) * h / (10.0 * math.sqrt(G * depth) + u)
@@ -277,7 +277,8 @@ def scene_cost(scene: Any, height: float, period: float,
     c = scene.constants
     method = next((m for m, o in METHODS.items()
                    if o.get("integrator", "kdk") == c.integrator
-                   and abs(o.get("h_over_dp", 1.4142) - c.h_over_dp) < 1e-3), "wcsph_kdk")
+                   and abs(o["h_over_dp"] - c.h_over_dp) < 1e-3
+                   and o["alpha_wall_factor"] == c.alpha_wall_factor), "wcsph_kdk")
     wave = (height, period, scene.still_water_level - scene.tank.z0)
     fit = fit_error(rows, method, wave) or fit_error(rows, "wcsph_kdk", wave)
     tp = median_throughput(rows, method) or median_throughput(rows, "wcsph_kdk")

@@ -53,19 +53,22 @@ class AmplitudeProfile:
 
 def amplitude_profile(model: Any, *, ramp: float, height: float, period: float, depth: float,
                       dp: float, periods: float = 4.0, n_gauges: int = 12,
-                      flume_wavelengths: float = 1.0, **constants: Any) -> AmplitudeProfile:
+                      flume_wavelengths: float = 1.0, inlet_pressure: str | None = None,
+                      settle_periods: float = 0.0, outlet_absorb: bool = True,
+                      **constants: Any) -> AmplitudeProfile:
     """Run the flume driven by ``model`` (its start-up ramp lasting ``ramp`` s) and measure
     the amplitude ratio along it (``constants`` override the scene's, e.g. alpha). The flume is
-    ``flume_wavelengths`` long; the gauges stay within 3/4 of a wavelength of the inlet."""
+    ``flume_wavelengths`` long; the gauges stay within 3/4 of a wavelength of the inlet. The
+    window starts ``settle_periods`` periods after the front has passed the last gauge."""
     length = float(model.length)
     xs = np.round(np.linspace(2.0 * math.sqrt(2.0) * dp, 0.75 * length, n_gauges), 4)
     # the ramped front and one period past the last gauge
-    t0 = ramp + xs[-1] / group_velocity(length, period, depth) + period
+    t0 = ramp + xs[-1] / group_velocity(length, period, depth) + (1.0 + settle_periods) * period
     scene = wave_flume_scene(depth=depth, wavelength=length, height=height, dp=dp,
                              t_end=t0 + periods * period, length=flume_wavelengths * length,
-                             absorb=(True, True),
+                             absorb=(True, outlet_absorb),
                              right_elevation="extrapolated", probe_every=period / 40,
-                             name="wave_decay", **constants)
+                             name="wave_decay", left_pressure=inlet_pressure, **constants)
     probes = [ElevationProbe(kind="elevation", name=f"g{i}", x=float(x)) for i, x in enumerate(xs)]
     scene = scene.model_copy(update={"probes": probes})
     res = run_wave_flume(scene, model, window=period / 50)

@@ -41,7 +41,8 @@ def wave_flume_scene(*, depth: float, wavelength: float, height: float, dp: floa
                      length: float | None = None, absorb: tuple[bool, bool] = (True, True),
                      right_elevation: str = "extrapolated", probe_every: float = 0.02,
                      c0: float | None = None, g: float = 9.81, name: str = "wave_flume",
-                     absorption: str = "linear", **constants: Any) -> Scene:
+                     absorption: str = "linear", left_pressure: str | None = None,
+                     **constants: Any) -> Scene:
     """A flat-bed flume [0, length] x [0, top] (floor z = 0, still water at z = depth) with open
     ends and elevation gauges mid-flume and L/16 apart within L/4 of it.
 
@@ -63,7 +64,7 @@ def wave_flume_scene(*, depth: float, wavelength: float, height: float, dp: floa
         "probes": probes,
         "open_boundaries": [
             {"side": "left", "elevation": "imposed", "absorb": absorb[0],
-             "absorption": absorption},
+             "absorption": absorption, "pressure": left_pressure},
             {"side": "right", "elevation": right_elevation, "absorb": absorb[1],
              "absorption": absorption}],
     })

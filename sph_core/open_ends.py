@@ -29,7 +29,7 @@ from .boundary_data import (BoundaryData, BoundaryDataError, BoundaryNodes, Boun
 from .eos import GAMMA, hydrostatic_density
 from .open_boundary import INLET_IDLE
 from .particles import INLET, M, P, RHO, WALL, X, Z, ParticleSet
-from .scene import OUTLET_PRESSURE, OpenBoundary, Scene
+from .scene import INLET_PRESSURE, OUTLET_PRESSURE, OpenBoundary, Scene
 from .state import OpenEnds, closed_ends
 
 SIDES = ("left", "right")
@@ -43,6 +43,7 @@ class OpenState:
     eta_meas: np.ndarray
     counters: np.ndarray
     samples: dict[str, BoundarySample]
+    zs: np.ndarray | None = None   # the buffers' surfaces (None in checkpoints made before it)
 
 
 class OpenBoundaries:
@@ -115,6 +116,7 @@ class OpenBoundaries:
             e.x_face[b] = nd.x_face
             e.nx[b] = -1.0 if b == 0 else 1.0
             e.swl[b] = swl
+            e.zs[b] = swl   # at rest until the first update
             period = o.absorption_period or source_period(sources.get(o.side))
             e.sqgd[b] = absorption_gain(o.absorption, c.g, depth, period)
             e.absorb[b] = o.absorb
@@ -225,13 +227,16 @@ class OpenBoundaries:
     def state(self) -> OpenState | None:
         if not self.active:
             return None
-        return OpenState(self.ends.eta_meas.copy(), self.ends.counters.copy(), dict(self.samples))
+        return OpenState(self.ends.eta_meas.copy(), self.ends.counters.copy(), dict(self.samples),
+                         self.ends.zs.copy())
 
     def set_state(self, s: OpenState | None) -> None:
         if s is None:
             return
         self.ends.eta_meas[:] = s.eta_meas
         self.ends.counters[:] = s.counters
+        if s.zs is not None:
+            self.ends.zs[:] = s.zs
         self.samples = dict(s.samples)
 
 
@@ -239,7 +244,7 @@ def buffer_pressure(o: OpenBoundary) -> str:
     """How the buffer of open end ``o`` gets its pressure: ``hydrostatic`` or ``extrapolated``."""
     if o.pressure is not None:
         return o.pressure
-    return OUTLET_PRESSURE if o.elevation == "extrapolated" else "hydrostatic"
+    return OUTLET_PRESSURE if o.elevation == "extrapolated" else INLET_PRESSURE
 
 
 def flume_nodes(scene: Scene) -> dict[str, BoundaryNodes]:

@@ -148,20 +148,23 @@ class Constants(_Model):
     g: float = Field(9.81, gt=0, description="gravity [m/s^2], acting in -z")
     c0: float | None = Field(None, gt=0, description="speed of sound [m/s]; default c0_factor*sqrt(2 g H)")
     c0_factor: float = Field(10.0, gt=0, description="c0 = c0_factor * sqrt(2 g H), H = water height")
-    # h/dp 2 measures far better for waves (14 -> 6.2 %/m at H/dp 2, docs/wave_decay_study.md)
-    # but as the default it makes tests/sph_core/test_open_boundary.py's still open flume lose
-    # one fluid particle: not made the default until that is understood
-    h_over_dp: float = Field(1.4142, ge=1.0, le=2.0,
-                             description="smoothing length h / dp; sqrt(2) keeps the lattice gradient moment within 1%")
+    # h/dp 2 (~50 neighbours): the wave keeps far more of itself than at sqrt(2) (flume 14 ->
+    # 6.2 %/m at H/dp 2, 25x less particle noise, phase speed -3.6 -> -0.3 %; one step costs
+    # ~2x, 0.7x the steps: ~1.25x per simulated second; docs/wave_decay_study.md)
+    h_over_dp: float = Field(2.0, ge=1.0, le=2.0, description=(
+        "smoothing length h / dp; 2 (default) for waves, sqrt(2) is cheaper (~0.8x per "
+        "simulated second) and noisier"))
     cfl: float = Field(0.25, gt=0, le=0.5, description="Courant number of the adaptive time step")
     alpha: float = Field(0.01, ge=0, description="Monaghan artificial viscosity coefficient")
     nu: float = Field(1.0e-6, ge=0, description="laminar kinematic viscosity [m^2/s]")
     delta: float = Field(0.1, ge=0, description="delta-SPH density diffusion coefficient")
     # the wave's loss to artificial viscosity against the bed does not converge with dp (the
-    # boundary layer is far thinner than dp): 6.1 -> 1.8 %/m (closed tank, dp 0.02) without it
-    alpha_wall_factor: float = Field(1.0, ge=0, description=(
+    # boundary layer is far thinner than dp): 6.1 -> 1.8 %/m (closed tank, dp 0.02) without it.
+    # A violent surge over a bed wants it back (dam break: cases/dambreak.py sets 1).
+    alpha_wall_factor: float = Field(0.0, ge=0, description=(
         "artificial viscosity against walls = this x alpha (DualSPHysics' ViscoBoundFactor); "
-        "applies with no_slip walls only"))
+        "0 (default) for waves, 1 for violent flows on a bed (the dam-break case); applies "
+        "with no_slip walls only"))
     shifting: Literal["none", "fickian"] = Field("none", description=(
         "particle shifting after each step: fickian = Lind et al. 2012, tangential only near "
         "the free surface (sph_core.shifting)"))
@@ -276,6 +279,12 @@ Probe = Annotated[Union[PointProbe, ElevationProbe, FrontProbe, ForceProbe, Pres
 # K_R / three-gauge K_R / RMSE/H): H/dp = 6: 1.7 % / 3.9 % / 4.4 % against hydrostatic
 # 4.0 % / 7.0 % / 4.2 %; H/dp = 3: 1.8 % / 4.0 % against 4.0 % / 6.5 %; same cost.
 OUTLET_PRESSURE = "extrapolated"
+# buffer pressure of an inlet (elevation "imposed") that does not name one: seed 002's table.
+# Within h of its surface a hydrostatic buffer takes the fluid's own pressure through the ghost
+# nodes (open_boundary.SURFACE_BAND_H). Extrapolated everywhere, the inlet let a fluid particle
+# through the floor at its bottom corner (case V, dp 0.02) and generated 5 % less amplitude
+# within 0.3 m of the face (docs/wave_decay_study.md).
+INLET_PRESSURE = "hydrostatic"
 
 
 class OpenBoundary(_Model):
@@ -301,7 +310,9 @@ class OpenBoundary(_Model):
     pressure: Literal["hydrostatic", "extrapolated"] | None = Field(
         None, description="buffer pressure: hydrostatic below the buffer's surface, or "
                           "extrapolated from the fluid through mirrored ghost nodes; None: "
-                          "OUTLET_PRESSURE for an extrapolated elevation, else hydrostatic")
+                          "OUTLET_PRESSURE (extrapolated) for an extrapolated elevation, else "
+                          "INLET_PRESSURE (hydrostatic); hydrostatic buffers extrapolate within "
+                          "h of their surface")
 
 
 class Output(_Model):

@@ -131,6 +131,7 @@ class OpenEnds(NamedTuple):
     win_eta: np.ndarray   # [2 ends, 2 levels] target elevation
     win_etag: np.ndarray  # [2 ends, 2 levels] source's elevation at the gauge
     eta_meas: np.ndarray  # [2] measured elevation at the gauges (NaN: dry / not measured)
+    zs: np.ndarray        # [2] surface z_s of each buffer at its last update [m]
     counters: np.ndarray  # int64[2, 4]: C_IN, C_OUT, C_CREATED, C_REMOVED
     next_id: np.ndarray   # int64[1]: id of the next created particle
 
@@ -143,5 +144,5 @@ def closed_ends(capacity: int, n_nodes: int = 2) -> OpenEnds:
                     b2(), b2(), b2(), z2(), z2(), np.ones(2), 0.0, 0.0,
                     np.tile(np.linspace(0.0, 1.0, n_nodes), (2, 1)), z2(),
                     np.zeros((2, 2, n_nodes)), np.zeros((2, 2, n_nodes)), np.zeros((2, 2)),
-                    np.zeros((2, 2)), np.full(2, np.nan), np.zeros((2, 4), dtype=np.int64),
+                    np.zeros((2, 2)), np.full(2, np.nan), z2(), np.zeros((2, 4), dtype=np.int64),
                     np.zeros(1, dtype=np.int64))

@@ -21,7 +21,7 @@ def test_example_scenes_load(name):
 def test_default_speed_of_sound():
     s = make_scene(BASE)
     assert s.c0 == pytest.approx(10 * (2 * 9.81 * 0.5) ** 0.5)
-    assert s.h == pytest.approx(1.4142 * 0.01)
+    assert s.h == pytest.approx(2.0 * 0.01)   # h/dp 2 by default (issue 11, wave decay study)
 
 
 @pytest.mark.parametrize("edit, field", [
