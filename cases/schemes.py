@@ -12,11 +12,16 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
-# Riemann SPH variants (sph_core.riemann): MUSCL reconstruction or none, Zhang et al. (2017)
-# low-dissipation limiter or the plain Godunov flux (beta = 1)
+# Riemann SPH variants (sph_core.riemann): MUSCL reconstruction (van Leer or minmod limiter) or
+# none, Zhang et al. (2017) low-dissipation limiter or the plain Godunov flux (beta = 1).
+# riemann_muscl is the scene's default [scheme] kind = "riemann".
 RIEMANN_VARIANTS: dict[str, dict[str, Any]] = {
-    "riemann_muscl_lowdiss": {"kind": "riemann", "reconstruction": "muscl", "low_dissipation": True},
-    "riemann_muscl": {"kind": "riemann", "reconstruction": "muscl", "low_dissipation": False},
+    "riemann_muscl": {"kind": "riemann", "reconstruction": "muscl", "limiter": "vanleer",
+                      "low_dissipation": False},
+    "riemann_muscl_minmod": {"kind": "riemann", "reconstruction": "muscl", "limiter": "minmod",
+                             "low_dissipation": False},
+    "riemann_muscl_lowdiss": {"kind": "riemann", "reconstruction": "muscl", "limiter": "vanleer",
+                              "low_dissipation": True},
     "riemann_lowdiss": {"kind": "riemann", "reconstruction": "none", "low_dissipation": True},
     "riemann_plain": {"kind": "riemann", "reconstruction": "none", "low_dissipation": False},
 }
