@@ -46,6 +46,7 @@ def test_limiters(lim):
     assert limited(0.3, 0.3, lim) == pytest.approx(0.3)      # consistent slope kept
     assert limited(-0.3, 0.2, lim) == 0.0                    # extremum: first order
     assert 0.0 < limited(0.1, 0.3, lim) <= 0.3
+    assert limited(3.0, 0.3, lim) == pytest.approx(0.3)     # never past the mid-point
 
 
 def _disordered_block(linear_v: bool, limiter: int, seed: int = 3):
@@ -113,3 +114,19 @@ def test_muscl_removes_the_hydrostatic_pressure_jump():
     none = np.abs(ps0.drho[fl0]).max()
     assert none > 1.0        # kg/m^3/s: the jump's diffusion is real without reconstruction
     assert muscl < 1e-9 * none
+
+
+def test_scene_scheme_selects_the_riemann_params():
+    from sph_core.scene import Scheme, SceneError, make_scene
+    from sph_core.simulation import scheme_params
+
+    assert scheme_params(Scheme()) == {"riemann": False, "limiter": NO_RECONSTRUCTION, "rs_eta": 0.0}
+    assert scheme_params(Scheme(kind="riemann")) == {"riemann": True, "limiter": VANLEER,
+                                                     "rs_eta": 0.0}
+    assert scheme_params(Scheme(kind="riemann", reconstruction="none", low_dissipation=True)) == {
+        "riemann": True, "limiter": NO_RECONSTRUCTION, "rs_eta": 3.0}
+    base = {"dp": 0.05, "t_end": 1.0, "tank": {"x0": 0, "x1": 1, "z0": 0, "z1": 1},
+            "water_blocks": [{"x0": 0, "x1": 0.5, "z0": 0, "z1": 0.5}]}
+    assert make_scene({**base, "scheme": {"kind": "riemann", "limiter": "minmod"}}).scheme.limiter == "minmod"
+    with pytest.raises(SceneError, match="scheme.limiter"):
+        make_scene({**base, "scheme": {"kind": "riemann", "limiter": "superbee"}})
