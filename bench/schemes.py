@@ -52,7 +52,7 @@ ENTRIES: list[tuple[str, dict[str, Any]]] = [
     *[(name, {"scheme": sch, "constants": BEST_WAVE}) for name, sch in RIEMANN_VARIANTS.items()],
 ]
 
-G = 9.81
+_G = 9.81
 RHO0 = 1000.0
 
 
@@ -75,7 +75,7 @@ def still_water(overrides: dict[str, Any], quick: bool) -> dict[str, Any]:
 
     d = 0.25
     dp = d / (10 if quick else 25)
-    t_end = (10.0 if quick else 20.0) * math.sqrt(d / G)
+    t_end = (10.0 if quick else 20.0) * math.sqrt(d / _G)
     z = dp
     scene = make_scene({
         "name": "still", "dp": dp, "t_end": t_end, "still_water_level": d,
@@ -87,7 +87,7 @@ def still_water(overrides: dict[str, Any], quick: bool) -> dict[str, Any]:
     sim = Simulation(scene)
     sim.advance_to(t_end)
     p = np.array([r["bed_p"] for r in sim.history if r["t"] >= 0.5 * t_end])
-    exact = RHO0 * G * (d - z)
+    exact = RHO0 * _G * (d - z)
     st = sim.fluid_state()
     return {"still_dp": dp, "bed_p_error": round(float(p.mean() / exact - 1.0), 5),
             "bed_p_noise_pa": round(float(p.std()), 3),
@@ -99,9 +99,9 @@ def dambreak(overrides: dict[str, Any], quick: bool) -> dict[str, Any]:
 
     a = 0.1
     dp = a / (10 if quick else 20)
-    scale = math.sqrt(2 * G / a)               # T = t scale
+    scale = math.sqrt(2 * _G / a)               # T = t scale
     t_end = 6.0 / scale
-    every = 0.01 * math.sqrt(a / G)
+    every = 0.01 * math.sqrt(a / _G)
     zp = 0.2 * a
     scene = dambreak_scene(a=a, dp=dp, t_end=t_end, probe_every=every,
                            scheme=overrides.get("scheme"),
@@ -123,7 +123,7 @@ def dambreak(overrides: dict[str, Any], quick: bool) -> dict[str, Any]:
     wet = np.nonzero(np.isfinite(pr))[0]
     pr_wet = pr[wet[0]:] if wet.size else np.array([])
     pr_wet = np.nan_to_num(pr_wet)      # a dry sample after the impact: no pressure
-    window = 0.1 * math.sqrt(a / G)
+    window = 0.1 * math.sqrt(a / _G)
     return {"dambreak_dp": dp, "a_over_dp": round(a / dp, 3),
             "front_error": round(fe["rms_rel_error"], 5),
             "front_max_error": round(fe["max_rel_error"], 5),
@@ -147,7 +147,7 @@ def wave(overrides: dict[str, Any], quick: bool) -> dict[str, Any]:
                          order=2)
     cst = {**overrides.get("constants", {})}
     prof = amplitude_profile(model, ramp=period, height=height, period=period, depth=depth, dp=dp,
-                             periods=2.0 if quick else 4.0, c0=10.0 * math.sqrt(G * depth),
+                             periods=2.0 if quick else 4.0, c0=10.0 * math.sqrt(_G * depth),
                              scheme=overrides.get("scheme"), **cst)
     length = float(model.length)
     return {"wave_dp": dp, "H_over_dp": round(height / dp, 3),
@@ -155,7 +155,7 @@ def wave(overrides: dict[str, Any], quick: bool) -> dict[str, Any]:
             "wave_wall_s": round(prof.wall_s, 1)}
 
 
-def warm_up(overrides: dict[str, Any]) -> float:
+def _warm_up(overrides: dict[str, Any]) -> float:
     """Compile (or load) the step before the timed runs; returns its seconds."""
     from sph_core.simulation import Simulation
 
@@ -181,7 +181,7 @@ def main(argv: list[str] | None = None) -> int:
             continue
         rec: dict[str, Any] = {"scheme": ov.get("scheme", {}).get("kind", "wcsph"), "name": name,
                                "options": ov, "quick": a.quick,
-                               "warmup_s": round(warm_up(ov), 1)}
+                               "warmup_s": round(_warm_up(ov), 1)}
         rec["dp"] = None
         for part in (dambreak, still_water) + (() if a.no_wave else (wave,)):
             try:

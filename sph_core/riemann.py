@@ -54,7 +54,7 @@ LIMITERS = {"minmod": 1, "vanleer": 2}
 NO_RECONSTRUCTION = 0
 MINMOD = 1
 VANLEER = 2
-FASTMATH = {"nsz", "arcp", "contract", "afn", "reassoc"}
+_FASTMATH = {"nsz", "arcp", "contract", "afn", "reassoc"}
 
 
 @njit(cache=True, inline="always")
@@ -82,7 +82,7 @@ def interface_state(ul, ur, pl, pr, zc, inv_c, eta, wall_factor):
     return ustar, 0.5 * (pl + pr) + 0.5 * beta * wall_factor * zc * du
 
 
-@njit(parallel=True, cache=True, fastmath=FASTMATH)
+@njit(parallel=True, cache=True, fastmath=_FASTMATH)
 def riemann_gradients(ps, n, cells, prm):
     """Kernel-corrected gradients of p, vx, vz of every fluid and buffer particle (rows gpx..gwz;
     zero elsewhere, and where the neighbour moment matrix is near singular: first order there)."""

