@@ -20,9 +20,9 @@ RIEMANN_STILL = ("Riemann SPH (MUSCL, van Leer, beta 1) at h/dp sqrt 2: surface 
                  "the same scene stays within 0.15 % and 0.0006 m/s: docs/schemes.md)")
 
 
-def _xfail_riemann(request, strict: bool = True) -> None:
+def _xfail_riemann(request) -> None:
     if request.node.callspec.params["still_run"] == "riemann":
-        request.applymarker(pytest.mark.xfail(strict=strict, reason=RIEMANN_STILL))
+        request.applymarker(pytest.mark.xfail(strict=True, reason=RIEMANN_STILL))
 
 
 @pytest.fixture(scope="module", params=list(SCHEMES))
@@ -76,8 +76,7 @@ def test_mass_and_particles_conserved_and_in_tank(still_run):
     assert np.all((st["x"] > t.x0) & (st["x"] < t.x1) & (st["z"] > t.z0))
 
 
-def test_surface_gauge_reads_still_water_level(still_run, request):
-    _xfail_riemann(request, strict=False)   # 3.9 mm against 2.5 before the van Leer cap
+def test_surface_gauge_reads_still_water_level(still_run):
     sim, scene, *_ = still_run
     eta = sim.probe_values()["g_eta"]
     assert abs(eta) < 0.25 * DP, f"still-water gauge reads eta = {eta:.4g} m"
