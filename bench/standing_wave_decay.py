@@ -3,6 +3,8 @@
     python bench/standing_wave_decay.py [--dp 0.02 0.01] [--h-over-dp 2] [--alpha 0.01]
         [--alpha-wall 1] [--slip no_slip|free_slip] [--delta 0.1] [--c0-factor 10] [--periods 6]
         [--cfl 0.25] [--nu 1e-6] [--shifting none|fickian] [--shift-a 2] [--shift-fs-div 1.8]
+        [--scheme wcsph|riemann] [--reconstruction muscl|none] [--limiter minmod|vanleer]
+        [--low-dissipation | --no-low-dissipation]
 
 The first sloshing mode of a tank half a wavelength long, the wave of bench/wave_decay.py
 (cases.standing_wave). Its amplitude decay rate in time over the group velocity is the decay
@@ -28,6 +30,7 @@ os.environ.setdefault("OMP_WAIT_POLICY", "passive")
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from cases.standing_wave import standing_wave_decay  # noqa: E402
+from cases.schemes import add_scheme_arguments, scheme_from_args  # noqa: E402
 from cases.wave_decay import convergence_orders  # noqa: E402
 
 
@@ -50,19 +53,22 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--shifting", choices=["none", "fickian"])
     ap.add_argument("--shift-a", type=float)
     ap.add_argument("--shift-fs-div", type=float)
+    add_scheme_arguments(ap)
     a = ap.parse_args(argv)
     cst = {k: v for k, v in {"h_over_dp": a.h_over_dp, "alpha": a.alpha, "wall_slip": a.slip,
                              "delta": a.delta, "cfl": a.cfl, "nu": a.nu,
                              "integrator": a.integrator, "shifting": a.shifting,
                              "shift_a": a.shift_a, "shift_fs_div": a.shift_fs_div,
                              "alpha_wall_factor": a.alpha_wall}.items() if v is not None}
+    scheme = scheme_from_args(a)
     decays = []
     for dp in a.dp:
         r = standing_wave_decay(dp=dp, depth=a.d, length=a.length, amplitude=a.a,
-                                periods=a.periods, c0_factor=a.c0_factor, **cst)
+                                periods=a.periods, c0_factor=a.c0_factor, scheme=scheme,
+                                **cst)
         decays.append(r.equiv_decay_per_m)
         print(json.dumps({
-            "dp": dp, "a_over_dp": round(a.a / dp, 3), "constants": cst, "c0_factor": a.c0_factor,
+            "dp": dp, "a_over_dp": round(a.a / dp, 3), "constants": cst, "scheme": scheme, "c0_factor": a.c0_factor,
             "omega_error": round(r.omega_error, 5), "beta_per_s": round(r.beta_per_s, 5),
             "equiv_decay_per_m": round(r.equiv_decay_per_m, 4),
             "equiv_loss_per_wavelength": round(r.loss_per_wavelength(2.0 * a.length), 4),

@@ -6,6 +6,8 @@
         [--cfl 0.25] [--integrator kdk|symplectic_pc] [--nu 1e-6] [--alpha-wall 1.0]
         [--shifting none|fickian] [--shift-a 2.0]
         [--shift-fs-div 1.8] [--flume-wavelengths 1]
+        [--scheme wcsph|riemann] [--reconstruction muscl|none] [--limiter minmod|vanleer]
+        [--low-dissipation | --no-low-dissipation]
 
 A flume one wavelength long with open ends driven by second-order Stokes theory (the wave of the
 coupled flume, cases/coupled_flume.py, by default), gauges from 2h past the inlet to 3/4 of the
@@ -39,6 +41,7 @@ os.environ.setdefault("OMP_WAIT_POLICY", "passive")  # before numba: shared, loa
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from cases.wave_decay import amplitude_profile, convergence_orders, separated_decay  # noqa: E402
+from cases.schemes import add_scheme_arguments, scheme_from_args  # noqa: E402
 from wave_client.theories import build_theory  # noqa: E402
 
 
@@ -69,12 +72,14 @@ def main(argv: list[str] | None = None) -> int:
                     help="outlet without the absorption correction (diagnostic: its reflection)")
     ap.add_argument("--inlet-pressure", choices=["hydrostatic", "extrapolated"],
                     help="inlet buffer pressure (scene default if unset)")
+    add_scheme_arguments(ap)
     a = ap.parse_args(argv)
     cst = {k: v for k, v in {"h_over_dp": a.h_over_dp, "alpha": a.alpha, "wall_slip": a.slip,
                              "delta": a.delta, "cfl": a.cfl, "nu": a.nu,
                              "integrator": a.integrator, "shifting": a.shifting,
                              "shift_a": a.shift_a, "shift_fs_div": a.shift_fs_div,
                              "alpha_wall_factor": a.alpha_wall}.items() if v is not None}
+    scheme = scheme_from_args(a)
     c0 = a.c0_factor * math.sqrt(9.81 * a.d)
     decays = []
     for dp in a.dp:
@@ -83,12 +88,12 @@ def main(argv: list[str] | None = None) -> int:
                                  periods=a.periods, flume_wavelengths=a.flume_wavelengths,
                                  inlet_pressure=a.inlet_pressure, settle_periods=a.settle_periods,
                                  outlet_absorb=not a.no_outlet_absorb,
-                                 c0=c0, **cst)
+                                 c0=c0, scheme=scheme, **cst)
         length = float(model.length)
         decays.append(prof.decay_per_m)
         sep_decay, sep_k, sep_kr = separated_decay(prof.x, prof.amp, prof.k)
         print(json.dumps({"H": a.H, "T": a.T, "d": a.d, "dp": dp, "H_over_dp": round(a.H / dp, 3),
-                          "constants": cst, "c0_factor": a.c0_factor,
+                          "constants": cst, "scheme": scheme, "c0_factor": a.c0_factor,
                           "inlet_pressure": a.inlet_pressure, "settle_periods": a.settle_periods,
                           "outlet_absorb": not a.no_outlet_absorb,
                           "flume_wavelengths": a.flume_wavelengths,

@@ -40,14 +40,17 @@ DAMBREAK_ALPHA_WALL_FACTOR = 1.0
 
 
 def dambreak_scene(a: float = 1.0, dp: float = 0.01, t_end: float = 1.0, tank_length: float | None = None,
-                   probe_every: float | None = None, snapshot_every: float = 0.0, **constants) -> Scene:
+                   probe_every: float | None = None, snapshot_every: float = 0.0,
+                   scheme: dict | None = None, probes: list[dict] | None = None,
+                   **constants) -> Scene:
     """Column a x 2a at the left wall of a tank (default length 4a, height 5a) with a front probe.
 
     The walls reach 5a because the run-up jet on the right wall passes 3a before t = 1 s (a = 1 m);
     a particle above the walls has left the domain and stops the run.
 
     ``constants`` override the scene constants; alpha defaults to DAMBREAK_ALPHA and
-    alpha_wall_factor to DAMBREAK_ALPHA_WALL_FACTOR."""
+    alpha_wall_factor to DAMBREAK_ALPHA_WALL_FACTOR. ``scheme``: the scene's [scheme] table
+    (default wcsph); ``probes``: more probes beside the front."""
     constants.setdefault("alpha", DAMBREAK_ALPHA)
     constants.setdefault("alpha_wall_factor", DAMBREAK_ALPHA_WALL_FACTOR)
     length = 4.0 * a if tank_length is None else tank_length
@@ -59,7 +62,8 @@ def dambreak_scene(a: float = 1.0, dp: float = 0.01, t_end: float = 1.0, tank_le
         "water_blocks": [{"x0": 0.0, "x1": a, "z0": 0.0, "z1": 2.0 * a}],
         "constants": constants,
         "output": {"probe_every": every, "snapshot_every": snapshot_every},
-        "probes": [{"kind": "front", "name": "front"}],
+        "probes": [{"kind": "front", "name": "front"}] + list(probes or []),
+        "scheme": scheme or {},
     })
 
 

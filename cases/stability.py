@@ -77,7 +77,7 @@ def _advance(sim: Any, t_end: float) -> tuple[str, float | None, str]:
     return "completed", None, ""
 
 
-def _still_tank(dp: float, t_end: float, **constants: Any) -> Any:
+def _still_tank(dp: float, t_end: float, scheme: dict | None = None, **constants: Any) -> Any:
     from sph_core.scene import make_scene
 
     d = 0.3
@@ -85,7 +85,7 @@ def _still_tank(dp: float, t_end: float, **constants: Any) -> Any:
         "name": "still_water", "dp": dp, "t_end": t_end, "still_water_level": d,
         "tank": {"x0": 0.0, "x1": 1.0, "z0": 0.0, "z1": d + 0.1},
         "water_blocks": [{"x0": 0.0, "x1": 1.0, "z0": 0.0, "z1": d}],
-        "constants": constants, "output": {"probe_every": 0.05},
+        "constants": constants, "output": {"probe_every": 0.05}, "scheme": scheme or {},
         "probes": [{"kind": "elevation", "name": "mid", "x": 0.5}]})
 
 

@@ -58,9 +58,10 @@ def _mode(x: np.ndarray, z: np.ndarray, k: float) -> tuple[np.ndarray, np.ndarra
 
 def standing_wave_decay(*, dp: float, depth: float = 0.24, length: float = 1.0,
                         amplitude: float = 0.02, periods: float = 6.0, c0_factor: float = 10.0,
-                        g: float = 9.81, **constants: Any) -> StandingWaveDecay:
+                        g: float = 9.81, scheme: dict | None = None,
+                        **constants: Any) -> StandingWaveDecay:
     """Run the closed tank (``constants`` override the scene's, e.g. h_over_dp, alpha;
-    c0 = c0_factor sqrt(g d)) and fit its losses."""
+    c0 = c0_factor sqrt(g d); ``scheme`` the scene's [scheme] table) and fit its losses."""
     k = math.pi / length
     omega = math.sqrt(g * k * math.tanh(k * depth))
     period = 2.0 * math.pi / omega
@@ -69,7 +70,7 @@ def standing_wave_decay(*, dp: float, depth: float = 0.24, length: float = 1.0,
         "tank": {"x0": 0.0, "x1": length, "z0": 0.0, "z1": depth + 4 * amplitude + 4 * dp},
         "water_blocks": [{"x0": 0.0, "x1": length, "z0": 0.0, "z1": depth}],
         "constants": {"c0": c0_factor * math.sqrt(g * depth), "g": g, **constants},
-        "output": {"probe_every": period / 40},
+        "output": {"probe_every": period / 40}, "scheme": scheme or {},
         "probes": [{"kind": "elevation", "name": "gauge", "x": 0.1 * length}]})
     sim = Simulation(scene)
     ps = sim.particles

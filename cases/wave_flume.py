@@ -42,13 +42,15 @@ def wave_flume_scene(*, depth: float, wavelength: float, height: float, dp: floa
                      right_elevation: str = "extrapolated", probe_every: float = 0.02,
                      c0: float | None = None, g: float = 9.81, name: str = "wave_flume",
                      absorption: str = "linear", left_pressure: str | None = None,
+                     scheme: dict | None = None,
                      **constants: Any) -> Scene:
     """A flat-bed flume [0, length] x [0, top] (floor z = 0, still water at z = depth) with open
     ends and elevation gauges mid-flume and L/16 apart within L/4 of it.
 
     length defaults to one wavelength; the tank top leaves 2H + 4dp above still water. c0
     defaults to 10 sqrt(g d): the shallow-water celerity bounds the orbital speeds, and the
-    hydrostatic density variation g d / c0^2 stays at 1 %."""
+    hydrostatic density variation g d / c0^2 stays at 1 %. ``scheme``: the scene's [scheme]
+    table (default wcsph)."""
     # whole number of particle spacings: the right buffer continues the fluid lattice
     length = dp * round((wavelength if length is None else length) / dp)
     top = depth + 2.0 * height + 4.0 * dp
@@ -61,7 +63,7 @@ def wave_flume_scene(*, depth: float, wavelength: float, height: float, dp: floa
         "tank": {"x0": 0.0, "x1": length, "z0": 0.0, "z1": top},
         "water_blocks": [{"x0": 0.0, "x1": length, "z0": 0.0, "z1": depth}],
         "constants": cst, "output": {"probe_every": probe_every},
-        "probes": probes,
+        "probes": probes, "scheme": scheme or {},
         "open_boundaries": [
             {"side": "left", "elevation": "imposed", "absorb": absorb[0],
              "absorption": absorption, "pressure": left_pressure},

@@ -30,12 +30,16 @@ X, Z, VX, VZ, AX, AZ, RHO, P, M = range(9)
 XN, ZN, VXN, VZN, RHON = range(9, 14)
 # recomputed after every reorder: density rate, wall velocity for viscous terms (Adami no-slip)
 DRHO, VWX, VWZ = range(14, 17)
-N_FIELDS = 17
+# Riemann SPH with MUSCL (riemann.py): gradients of p, vx, vz of fluid and buffer particles,
+# recomputed before every force pass
+GPX, GPZ, GUX, GUZ, GWX, GWZ = range(17, 23)
+N_FIELDS = 23
 N_SORTED_KDK = 9
 N_SORTED_PC = 14
 
 FIELD_NAMES = ("x", "z", "vx", "vz", "ax", "az", "rho", "p", "m",
-               "xn", "zn", "vxn", "vzn", "rhon", "drho", "vwx", "vwz")
+               "xn", "zn", "vxn", "vzn", "rhon", "drho", "vwx", "vwz",
+               "gpx", "gpz", "gux", "guz", "gwx", "gwz")
 
 
 @dataclass

@@ -24,7 +24,7 @@ from typing import Any, Callable, Mapping
 import numba
 import numpy as np
 
-from . import step, wcsph
+from . import riemann, step, wcsph
 from .bodies import BodyLog, BodySet
 from .boundary_data import BoundaryData, BoundaryDataError, BoundarySample
 from .eos import hydrostatic_density, tait_b
@@ -37,12 +37,21 @@ from .output import RunWriter
 from .particles import FLUID, INACTIVE, M, P, RHO, VX, VZ, WALL, X, Z, Checkpoint, ParticleSet
 from .probes import (fluid_neighbour_counts, interpolate_points, line_mass_density,
                      surface_from_line)
-from .scene import ElevationProbe, FrontProbe, PointProbe, Scene
+from .scene import ElevationProbe, FrontProbe, PointProbe, Scene, Scheme
 from .state import Params
 
 STEPS_PER_CALL = 200  # steps per jitted call between progress callbacks
 # cells per kernel support radius 2h (neighbours.py): 2 = cells of side h, a 5 x 5 search block
 CELLS_PER_SUPPORT = 2
+
+
+def scheme_params(scheme: Scheme) -> dict[str, Any]:
+    """The Params fields of the scene's [scheme] (riemann, limiter, rs_eta)."""
+    if scheme.kind != "riemann":
+        return {"riemann": False, "limiter": riemann.NO_RECONSTRUCTION, "rs_eta": 0.0}
+    lim = riemann.LIMITERS[scheme.limiter] if scheme.reconstruction == "muscl" else riemann.NO_RECONSTRUCTION
+    return {"riemann": True, "limiter": lim,
+            "rs_eta": scheme.low_dissipation_eta if scheme.low_dissipation else 0.0}
 
 
 class UnstableError(RuntimeError):
@@ -109,7 +118,7 @@ class Simulation:
                           noslip=c.wall_slip == "no_slip", fx0=fx0, fx1=fx1,
                           fz0=t.z0 - 0.5 * dp, fz1=t.z1, alpha_wall=c.alpha_wall_factor,
                           shift_a=c.shift_a if c.shifting == "fickian" else 0.0,
-                          shift_fs_div=c.shift_fs_div)
+                          shift_fs_div=c.shift_fs_div, **scheme_params(scene.scheme))
         self.integrator = wcsph.INTEGRATORS[c.integrator]
         self.passes_per_step = wcsph.PASSES_PER_STEP[c.integrator]
         self._counts = np.zeros(ps.capacity, dtype=np.int64)

@@ -18,7 +18,8 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .particles import (AX, AZ, DRHO, M, P, RHO, RHON, VWX, VWZ, VX, VXN, VZ, VZN, XN, ZN, X, Z)
+from .particles import (AX, AZ, DRHO, GPX, GPZ, GUX, GUZ, GWX, GWZ, M, P, RHO, RHON, VWX, VWZ, VX,
+                        VXN, VZ, VZN, XN, ZN, X, Z)
 
 
 class Particles(NamedTuple):
@@ -46,6 +47,12 @@ class Particles(NamedTuple):
     drho: np.ndarray
     vwx: np.ndarray      # wall particles: velocity for the viscous term (Adami no-slip)
     vwz: np.ndarray
+    gpx: np.ndarray      # Riemann SPH + MUSCL: grad p, grad vx = (gux, guz), grad vz = (gwx, gwz)
+    gpz: np.ndarray
+    gux: np.ndarray
+    guz: np.ndarray
+    gwx: np.ndarray
+    gwz: np.ndarray
     kind: np.ndarray     # int8: particles.FLUID, WALL, INLET, ...
     ids: np.ndarray      # int64 identity, kept through sorts
     cell: np.ndarray     # int64 cell index of the slot (set by the sort)
@@ -54,7 +61,8 @@ class Particles(NamedTuple):
 def particles_view(f: np.ndarray, kind: np.ndarray, ids: np.ndarray, cell: np.ndarray) -> Particles:
     """Named views of the storage ``f`` (no copy)."""
     return Particles(f, f[X], f[Z], f[VX], f[VZ], f[AX], f[AZ], f[RHO], f[P], f[M], f[XN], f[ZN],
-                     f[VXN], f[VZN], f[RHON], f[DRHO], f[VWX], f[VWZ], kind, ids, cell)
+                     f[VXN], f[VZN], f[RHON], f[DRHO], f[VWX], f[VWZ], f[GPX], f[GPZ], f[GUX], f[GUZ],
+                     f[GWX], f[GWZ], kind, ids, cell)
 
 
 class Cells(NamedTuple):
@@ -99,6 +107,10 @@ class Params(NamedTuple):
     alpha_wall: float    # artificial viscosity against walls = alpha_wall * alpha
     shift_a: float       # particle shifting coefficient A (0: off; shifting.py)
     shift_fs_div: float  # position divergence below which shifting is tangential only
+    # scheme (scene [scheme]; riemann.py): Riemann SPH instead of delta-SPH + Monaghan AV
+    riemann: bool = False
+    limiter: int = 0     # MUSCL slope limiter (riemann.LIMITERS): 0 = no reconstruction
+    rs_eta: float = 0.0  # Zhang et al. 2017 dissipation limiter eta (0: full dissipation)
 
 
 class OpenEnds(NamedTuple):

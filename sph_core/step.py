@@ -22,8 +22,9 @@ One step, as the two integrators order the same stages (wcsph.py has the equatio
     measure_boundaries              [G]      correct (guards)
                                              update_buffers                [D]
 
-[F] forces = ``wall_pass`` (Adami wall state) then ``fluid_pass`` (continuity, delta-SPH,
-pressure, viscosity, gravity) then ``body_loads`` (fluid loads on the rigid bodies, their
+[F] forces = ``wall_pass`` (Adami wall state) then, for Riemann SPH with MUSCL,
+``riemann_gradients``, then ``fluid_pass`` (continuity, delta-SPH, pressure, viscosity, gravity;
+or the Riemann flux, riemann.py) then ``body_loads`` (fluid loads on the rigid bodies, their
 accelerations): ``_forces`` below. Bodies follow the fluid's stages: kdk half-kick + drift with
 the fluid's, half-kick after the fluid's; symplectic predictor / corrector likewise; each stage
 then places the body particles (``place_bodies``: x, v = V + omega x r, a). Without bodies every
@@ -60,6 +61,7 @@ from .bodies import (bodies_correct, bodies_kick, bodies_kick_drift, bodies_pred
 from .neighbours import sort_by_cell
 from .open_boundary import extrapolate_buffers, measure_boundaries, update_buffers
 from .particles import N_SORTED_KDK, N_SORTED_PC
+from .riemann import NO_RECONSTRUCTION, riemann_gradients
 from .shifting import shift_particles
 from .wcsph import (KDK, ST_CAPACITY, ST_DENSITY, ST_LEFT_DOMAIN, ST_NONFINITE, ST_REACHED_T,
                     ST_STEP_LIMIT, fluid_pass, kdk_kick, kdk_kick_drift, pc_correct, pc_predict,
@@ -70,6 +72,8 @@ from .wcsph import (KDK, ST_CAPACITY, ST_DENSITY, ST_LEFT_DOMAIN, ST_NONFINITE, 
 def _forces(ps, n, cells, prm, bd):
     """Rates of every fluid particle (ax, az, drho) and body (acc) at the current, sorted state."""
     wall_pass(ps, n, cells, prm)
+    if prm.riemann and prm.limiter != NO_RECONSTRUCTION:
+        riemann_gradients(ps, n, cells, prm)   # MUSCL: gradients of p and v (riemann.py)
     fluid_pass(ps, n, cells, prm)
     body_loads(ps, n, cells, prm, bd)
 

@@ -38,6 +38,7 @@ from .eos import density, pressure
 from .kernels import f_of_q, w_of_q
 from .neighbours import block_of
 from .particles import FLUID, INLET, OUTLET, WALL
+from .riemann import NO_RECONSTRUCTION, interface_state, limited
 
 # status codes returned by the time loop (step.run)
 ST_REACHED_T = 0
@@ -134,6 +135,8 @@ def wall_pass(ps, n, cells, prm):
 def fluid_pass(ps, n, cells, prm):
     """The fused gather over fluid particles: continuity, delta-SPH, pressure, viscosity, gravity.
 
+    With ``prm.riemann`` the pair's continuity, delta-SPH, pressure and artificial viscosity are
+    the Riemann SPH flux instead (riemann.py; MUSCL gradients from riemann_gradients).
     Writes ax, az, drho of each fluid particle; returns nothing (reductions are in the kicks)."""
     x = ps.x
     z = ps.z
@@ -172,6 +175,18 @@ def fluid_pass(ps, n, cells, prm):
     nu4 = 4.0 * prm.nu
     ddiff = 2.0 * prm.delta * h * c0
     noslip = prm.noslip
+    rs = prm.riemann
+    lim = prm.limiter
+    muscl = lim != NO_RECONSTRUCTION
+    eta = prm.rs_eta
+    inv_c0 = 1.0 / c0
+    wall_rs = prm.alpha_wall
+    gpx = ps.gpx
+    gpz = ps.gpz
+    gux = ps.gux
+    guz = ps.guz
+    gwx = ps.gwx
+    gwz = ps.gwz
     for i in prange(n):
         if kind[i] == FLUID:
             xi = x[i]
@@ -208,22 +223,52 @@ def fluid_pass(ps, n, cells, prm):
                     # continuity uses the particle's own (for walls: prescribed) velocity
                     dvx = vxi - vx[j]
                     dvz = vzi - vz[j]
-                    cont -= vol * fij * (dvx * dx + dvz * dz)
-                    # m_j (p_i + p_j) / (rho_i rho_j), with the divisions shared per pair
-                    pf = vol * (pi + p[j]) * inv_rhoi
                     visc = kj != WALL or noslip
-                    # height of i above j along gravity (z_i - z_j for g = (0, -g)); wall
-                    # densities come from the Adami extrapolation, so they carry the hydrostatic
-                    # part as the fluid's do and take part in the diffusion
-                    up = -(gdir_x * dx + gdir_z * dz)
-                    diff += (rhoj - rhoi - khyd * up) * fij * vol
+                    if rs:
+                        # Riemann problem along e = r_ji / |r_ji| (riemann.py), r_ji = -(dx, dz)
+                        r = max(math.sqrt(r2), 1e-9 * h)   # coincident particles: no NaN
+                        ex = -dx / r
+                        ez = -dz / r
+                        ul = vxi * ex + vzi * ez
+                        ur = vx[j] * ex + vz[j] * ez
+                        ui = ul
+                        pl = pi
+                        pr = p[j]
+                        if muscl:
+                            dpj = pr - pl
+                            si = -(gpx[i] * dx + gpz[i] * dz)
+                            sj = si if kj == WALL else -(gpx[j] * dx + gpz[j] * dz)
+                            pl += 0.5 * limited(si, dpj, lim)
+                            pr -= 0.5 * limited(sj, dpj, lim)
+                            if kj != WALL:
+                                duj = ur - ul
+                                si = -((gux[i] * dx + guz[i] * dz) * ex
+                                       + (gwx[i] * dx + gwz[i] * dz) * ez)
+                                sj = -((gux[j] * dx + guz[j] * dz) * ex
+                                       + (gwx[j] * dx + gwz[j] * dz) * ez)
+                                ul += 0.5 * limited(si, duj, lim)
+                                ur -= 0.5 * limited(sj, duj, lim)
+                        ustar, pstar = interface_state(ul, ur, pl, pr, 0.5 * (rhoi + rhoj) * c0,
+                                                       inv_c0, eta,
+                                                       wall_rs if kj == WALL else 1.0)
+                        cont += 2.0 * vol * fij * r * (ui - ustar)
+                        pf = 2.0 * vol * pstar * inv_rhoi
+                    else:
+                        cont -= vol * fij * (dvx * dx + dvz * dz)
+                        # m_j (p_i + p_j) / (rho_i rho_j), with the divisions shared per pair
+                        pf = vol * (pi + p[j]) * inv_rhoi
+                        # height of i above j along gravity (z_i - z_j for g = (0, -g)); wall
+                        # densities come from the Adami extrapolation, so they carry the
+                        # hydrostatic part as the fluid's do and take part in the diffusion
+                        up = -(gdir_x * dx + gdir_z * dz)
+                        diff += (rhoj - rhoi - khyd * up) * fij * vol
                     if kj == WALL:
                         dvx = vxi - vwx[j]
                         dvz = vzi - vwz[j]
                     if visc:
                         vr = dvx * dx + dvz * dz
                         mden = mj / ((rhoi + rhoj) * (r2 + eta2))
-                        if vr < 0.0:
+                        if vr < 0.0 and not rs:
                             pf -= 2.0 * (av_wall if kj == WALL else av) * vr * mden
                         lam = nu4 * r2 * mden
                         fx -= lam * fij * dvx
