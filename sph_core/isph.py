@@ -60,8 +60,9 @@ MAX_ROW = 64   # non-zeros per PPE row, generous: a full 2D support at h/dp 2 ha
 
 
 @njit(parallel=True, cache=True, fastmath=FASTMATH)
-def free_surface_flags(ps, n, cells, prm, by_density, threshold, flag):
-    """flag[i] = 1 for a free-surface fluid particle, 0 for an interior one, -1 for the rest."""
+def free_surface_flags(ps, n, cells, prm, by_density, threshold, flag, rho_k):
+    """flag[i] = 1 for a free-surface fluid particle, 0 for an interior one, -1 for the rest;
+    rho_k[i] = sum_j m_j W_ij (fluid and wall, self included) of every fluid particle."""
     x = ps.x
     z = ps.z
     m = ps.m
@@ -78,7 +79,8 @@ def free_surface_flags(ps, n, cells, prm, by_density, threshold, flag):
     for i in prange(n):
         flag[i] = -1
         if kind[i] == FLUID:
-            s = 0.0
+            sr = 0.0
+            sdiv = 0.0
             cxl, cxh, czl, czh = block_of(cell[i], cells)
             for zz in range(czl, czh + 1):
                 row = zz * ncx
@@ -89,18 +91,17 @@ def free_surface_flags(ps, n, cells, prm, by_density, threshold, flag):
                         r2 = dx * dx + dz * dz
                         if r2 < s2:
                             q = math.sqrt(r2) * inv_h
-                            if by_density:
-                                s += m[j] * w_of_q(q, aw)
-                            else:
-                                s += m[j] / rho0 * f_of_q(q, af) * r2
+                            sr += m[j] * w_of_q(q, aw)
+                            sdiv += m[j] / rho0 * f_of_q(q, af) * r2
+            rho_k[i] = sr
             if by_density:
-                flag[i] = 1 if s <= threshold * rho0 else 0
+                flag[i] = 1 if sr <= threshold * rho0 else 0
             else:
-                flag[i] = 1 if s <= threshold else 0
+                flag[i] = 1 if sdiv <= threshold else 0
 
 
 @njit(parallel=True, cache=True, fastmath=FASTMATH)
-def wall_state(ps, n, cells, prm, flag, wsum, dwall):
+def wall_state(ps, n, cells, prm, dt, wsum, dwall):
     """Adami et al. (2012) for every wall particle s from its fluid neighbours f:
     wsum[s] = sum_f W_sf, dwall[s] = sum_f W_sf rho_f (g - a_s) . r_sf / wsum (the hydrostatic
     part of p_s), and the no-slip velocity vw_s = 2 v_s - sum_f v_f W_sf / wsum."""
@@ -131,7 +132,8 @@ def wall_state(ps, n, cells, prm, flag, wsum, dwall):
             sd = 0.0
             svx = 0.0
             svz = 0.0
-            n_in = 0
+            nx = 0.0
+            nz = 0.0
             cxl, cxh, czl, czh = block_of(cell[i], cells)
             for zz in range(czl, czh + 1):
                 row = zz * ncx
@@ -142,17 +144,32 @@ def wall_state(ps, n, cells, prm, flag, wsum, dwall):
                         r2 = dx * dx + dz * dz
                         if r2 < s2:
                             w = w_of_q(math.sqrt(r2) * inv_h, aw)
-                            if flag[j] == 0:
-                                n_in += 1
                             sw += w
                             sd += rho[j] * (bx * dx + bz * dz) * w
                             svx += vx[j] * w
                             svz += vz[j] * w
-            # a wall that sees only free-surface fluid is at the surface itself: Dirichlet
-            # p = 0 as for that fluid (its extrapolation would be negative above the water)
-            wsum[i] = sw if n_in > 0 else 0.0
-            if n_in == 0:
-                ps.p[i] = 0.0
+                            nx -= dx * w
+                            nz -= dz * w
+            # the no-penetration part: fluid approaching the wall (relative normal velocity
+            # u_n < 0, n from the wall into the fluid) must stop within the step, so the
+            # ghost pressure rises by rho |u_n| / dt (n . r_fs) over each neighbour f
+            nn = math.sqrt(nx * nx + nz * nz)
+            if nn > 0.0:
+                nx /= nn
+                nz /= nn
+                for zz in range(czl, czh + 1):
+                    row = zz * ncx
+                    for j in range(cell_start[row + cxl], cell_start[row + cxh + 1]):
+                        if kind[j] == FLUID:
+                            dx = x[i] - x[j]
+                            dz = z[i] - z[j]
+                            r2 = dx * dx + dz * dz
+                            if r2 < s2:
+                                un = (vx[j] - vx[i]) * nx + (vz[j] - vz[i]) * nz
+                                if un < 0.0:
+                                    w = w_of_q(math.sqrt(r2) * inv_h, aw)
+                                    sd -= rho[j] * un / dt * (-(dx * nx + dz * nz)) * w
+            wsum[i] = sw
             if sw > 0.0:
                 dwall[i] = sd / sw
                 vwx[i] = 2.0 * vx[i] - svx / sw
@@ -242,7 +259,7 @@ def ppe_unknowns(ps, n, flag, wsum, idx):
 
 @njit(parallel=True, cache=True, fastmath=FASTMATH)
 def ppe_assemble(ps, n, cells, prm, dt, idx, wsum, dwall, wscale, indptr, indices, data, b,
-                 x0, slot):
+                 x0, slot, rho_k, rho_ref, relax):
     """Fill the PPE rows (module docstring, step 3) in CSR with MAX_ROW slots per row (the
     unused tail of a row is padding the caller compacts); b the right-hand side, x0 the warm
     start (the last pressure), slot[k] the particle of unknown k. Returns the largest row length.
@@ -253,13 +270,14 @@ def ppe_assemble(ps, n, cells, prm, dt, idx, wsum, dwall, wscale, indptr, indice
         k = idx[i]
         if k >= 0:
             longest = max(longest, _assemble_row(ps, i, k, cells, prm, inv_dt, idx, wsum, dwall,
-                                                 wscale, indptr, indices, data, b, x0, slot))
+                                                 wscale, indptr, indices, data, b, x0, slot,
+                                                 rho_k, rho_ref, relax))
     return longest
 
 
 @njit(cache=True, fastmath=FASTMATH)
 def _assemble_row(ps, i, k, cells, prm, inv_dt, idx, wsum, dwall, wscale, indptr, indices, data,
-                  b, x0, slot):
+                  b, x0, slot, rho_k, rho_ref, relax):
     """Row k (particle i) of the PPE; returns its length."""
     x = ps.x
     z = ps.z
@@ -278,11 +296,6 @@ def _assemble_row(ps, i, k, cells, prm, inv_dt, idx, wsum, dwall, wscale, indptr
     eta2 = 0.01 * h * h
     af = prm.alpha_f
     aw = prm.alpha_w
-    gx = prm.gx
-    gz = prm.gz
-    ax = ps.ax
-    az = ps.az
-    dt = 1.0 / inv_dt
     slot[k] = i
     x0[k] = p[i]
     base = indptr[k]
@@ -304,15 +317,10 @@ def _assemble_row(ps, i, k, cells, prm, inv_dt, idx, wsum, dwall, wscale, indptr
                 if r2 >= s2:
                     continue
                 fij = f_of_q(math.sqrt(r2) * inv_h, af)
-                uj = vx[j]
-                wj = vz[j]
-                if kj == WALL:
-                    # the wall's own predictor: its Adami pressure (which holds the term
-                    # rho (g - a_s) . r_sf) will take (g - a_s) dt back off, as the fluid's does
-                    uj += dt * (gx - ax[j])
-                    wj += dt * (gz - az[j])
-                # div u*_i = sum_j V_j (u*_j - u*_i) . grad_i W_ij, grad_i W_ij = -F r_ij
-                div -= m[j] / rho[j] * fij * ((uj - vx[i]) * dx + (wj - vz[i]) * dz)
+                # div u*_i = sum_j V_j (u*_j - u*_i) . grad_i W_ij, grad_i W_ij = -F r_ij, over
+                # the fluid: the walls' part is their ghost pressure (the Neumann condition)
+                if kj == FLUID:
+                    div -= m[j] / rho[j] * fij * ((vx[j] - vx[i]) * dx + (vz[j] - vz[i]) * dz)
                 rs = rho[i] + rho[j]
                 bij = 8.0 * m[j] / (rs * rs) * fij * r2 / (r2 + eta2)
                 diag += bij
@@ -322,7 +330,9 @@ def _assemble_row(ps, i, k, cells, prm, inv_dt, idx, wsum, dwall, wscale, indptr
                     data[base + cnt] = -bij
                     cnt += 1
         data[base] = diag
-        b[k] = -div * inv_dt
+        # density-invariance relaxation (Asai et al. 2012): a kernel density above the lattice's
+        # pushes apart, below pulls together, so volume errors do not accumulate
+        b[k] = -div * inv_dt + relax * (rho_k[i] - rho_ref) / rho_ref * inv_dt * inv_dt
     else:  # wall: p_s - sum_f w_sf p_f = dwall_s, scaled
         inv_sw = wscale / wsum[i]
         data[base] = wscale
@@ -516,7 +526,8 @@ class IsphStepper:
     def __init__(self, capacity: int, prm: Any, dp: float, solver: str = "amg",
                  tolerance: float = 1e-5, max_iter: int = 20000, free_surface: str = "density",
                  fs_threshold: float | None = None, shifting: bool = True,
-                 gradient: str = "corrected", v_ref: float = 0.0) -> None:
+                 gradient: str = "corrected", v_ref: float = 0.0,
+                 density_relaxation: float = 0.0) -> None:
         if solver not in PPE_SOLVERS:
             raise ValueError(f"ppe_solver: one of {PPE_SOLVERS}, got {solver!r}")
         self.prm = prm
@@ -534,6 +545,9 @@ class IsphStepper:
         self.wscale = 7.0 / (prm.rho0 * prm.h * prm.h)
         cap = int(capacity)
         self.flag = np.zeros(cap, dtype=np.int8)
+        self.rho_k = np.zeros(cap)
+        self.rho_ref = 0.0
+        self.relax = float(density_relaxation)
         self.wsum = np.zeros(cap)
         self.dwall = np.zeros(cap)
         self.idx = np.zeros(cap, dtype=np.int64)
@@ -564,7 +578,7 @@ class IsphStepper:
         m = ppe_unknowns(ps, n, self.flag, self.wsum, self.idx)
         longest = ppe_assemble(ps, n, cells, prm, dt, self.idx, self.wsum, self.dwall,
                                self.wscale, self.indptr, self.indices, self.data, self.b, self.x0,
-                               self.slot)
+                               self.slot, self.rho_k, self.rho_ref, self.relax)
         if longest >= MAX_ROW:  # a row lost terms: the particles are far denser than the lattice
             raise RuntimeError(f"ISPH: a PPE row has more than {MAX_ROW - 1} neighbours")
         nnz = compact_rows(m, self.indptr, self.indices, self.data, self.ptr)
@@ -612,8 +626,12 @@ class IsphStepper:
         """One projection step from the sorted state ``ps``; the state ends sorted in ``ps2``.
         Returns (n, n_bad, n_out, max |v|^2, max |a*|^2)."""
         prm = self.prm
-        free_surface_flags(ps, n, cells, prm, self.by_density, self.fs_threshold, self.flag)
-        wall_state(ps, n, cells, prm, self.flag, self.wsum, self.dwall)
+        free_surface_flags(ps, n, cells, prm, self.by_density, self.fs_threshold, self.flag,
+                           self.rho_k)
+        if self.rho_ref == 0.0:  # the initial lattice's interior kernel density (~1.006 rho0)
+            inner = (self.flag[:n] == 0)
+            self.rho_ref = float(np.median(self.rho_k[:n][inner])) if inner.any() else prm.rho0
+        wall_state(ps, n, cells, prm, dt, self.wsum, self.dwall)
         a2 = predict(ps, n, cells, prm, dt)
         self._solve(ps, n, cells, dt)
         n_bad, n_out, v2 = correct(ps, n, cells, prm, dt, self.corrected)

@@ -207,9 +207,11 @@ class Scheme(_Model):
     ppe_tolerance: float = Field(1e-5, gt=0, lt=1, description=(
         "ISPH: relative residual |b - A p| / |b| at which the pressure solve stops"))
     ppe_max_iter: int = Field(20000, ge=1, description="ISPH: iteration cap of the pressure solve")
-    free_surface: Literal["density", "divergence"] = Field("density", description=(
+    free_surface: Literal["density", "divergence"] = Field("divergence", description=(
         "ISPH free-surface criterion (Dirichlet p = 0): density = seed 004's kernel sum "
-        "rho_f = sum m W <= threshold rho0; divergence = position divergence <= threshold"))
+        "rho_f = sum m W <= threshold rho0; divergence = position divergence <= threshold "
+        "(the default: with density the top layer of still water settled until it no longer "
+        "counted as surface, and the surface corners oscillated; docs/schemes.md)"))
     free_surface_threshold: float | None = Field(None, gt=0, description=(
         "ISPH: threshold of the free-surface criterion (default 0.9 for density, seed 004; "
         "1.5 for divergence)"))
@@ -222,6 +224,10 @@ class Scheme(_Model):
     isph_vref_factor: float = Field(1.0, ge=0, description=(
         "ISPH: the time step's speed is at least this x sqrt(2 g H), H the water height "
         "(0: the flow's max|v| alone)"))
+    isph_density_relaxation: float = Field(0.01, ge=0, le=1, description=(
+        "ISPH: weight of the density-invariance term (rho_k - rho_ref)/(rho_ref dt^2) added to "
+        "the divergence source (Asai et al. 2012); 0: the seed's divergence-free source alone "
+        "(measured: the still-water surface then rises ~4 mm/s at d/dp 25; 0.01 holds it)"))
     isph_shifting: bool = Field(True, description=(
         "ISPH: Fickian particle shifting (Lind et al. 2012) with Constants.shift_a after each step"))
 
