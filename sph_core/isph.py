@@ -503,6 +503,40 @@ def correct(ps, n, cells, prm, dt, corrected):
     return n_bad, n_out, v2max
 
 
+def solve_ppe(solver: str, m: int, ptr: np.ndarray, indices: np.ndarray, data: np.ndarray,
+              b: np.ndarray, x0: np.ndarray, tol: float, max_iter: int,
+              scratch: np.ndarray) -> tuple[np.ndarray, int, float]:
+    """Solve the m x m CSR system (diagonal first in each row) by ``solver`` (PPE_SOLVERS) from
+    the warm start ``x0`` (overwritten by ``explicit``); returns (solution, iterations,
+    relative residual |b - A x| / |b|)."""
+    if solver == "explicit":
+        it, rel = jacobi(ptr, indices, data, b, x0, scratch, m, tol, max_iter)
+        return x0, int(it), float(rel)
+    nnz = int(ptr[m])
+    a = sp.csr_matrix((data[:nnz], indices[:nnz], ptr[: m + 1]), shape=(m, m))
+    if solver == "direct":  # SuperLU: the reference the iterative solvers are checked by
+        sol = spla.spsolve(a.tocsc(), b)
+        it = 1
+    else:
+        if solver == "amg":
+            import pyamg  # only this solver needs it
+            pre = pyamg.smoothed_aggregation_solver(a, symmetry="nonsymmetric",
+                                                    max_coarse=200).aspreconditioner()
+        else:
+            ilu = spla.spilu(a.tocsc(), drop_tol=1e-4, fill_factor=5)
+            pre = spla.LinearOperator((m, m), ilu.solve)
+        count = [0]
+
+        def _count(_xk: np.ndarray) -> None:
+            count[0] += 1
+
+        sol, _info = spla.bicgstab(a, b, x0=x0, rtol=tol, atol=0.0, maxiter=max_iter, M=pre,
+                                   callback=_count)
+        it = count[0]
+    bn = float(np.linalg.norm(b)) or 1.0
+    return sol, int(it), float(np.linalg.norm(b - a @ sol)) / bn
+
+
 def isph_dt(v2max: float, a2max: float, prm: Any, v_ref: float = 0.0) -> float:
     """dt = min(cfl h / max(|v|_max, v_ref), 0.25 sqrt(h / max|a*|), 0.125 h^2 / nu): no sound
     speed; v_ref is the scene's own speed scale sqrt(2 g H) (Lind et al. 2012 take the step
@@ -581,40 +615,10 @@ class IsphStepper:
                                self.slot, self.rho_k, self.rho_ref, self.relax)
         if longest >= MAX_ROW:  # a row lost terms: the particles are far denser than the lattice
             raise RuntimeError(f"ISPH: a PPE row has more than {MAX_ROW - 1} neighbours")
-        nnz = compact_rows(m, self.indptr, self.indices, self.data, self.ptr)
-        b = self.b[:m]
-        x = self.x0[:m]
+        compact_rows(m, self.indptr, self.indices, self.data, self.ptr)
         tic = time.perf_counter()
-        if self.solver == "explicit":
-            it, rel = jacobi(self.ptr, self.indices, self.data, b, x, self.x2, m, self.tol,
-                             self.max_iter)
-            sol = x
-        else:
-            a = sp.csr_matrix((self.data[:nnz], self.indices[:nnz], self.ptr[: m + 1]),
-                              shape=(m, m))
-            if self.solver == "direct":  # SuperLU: the reference the iterative ones are checked by
-                sol = spla.spsolve(a.tocsc(), b)
-                it = 1
-                bn = float(np.linalg.norm(b)) or 1.0
-                rel = float(np.linalg.norm(b - a @ sol)) / bn
-            elif self.solver == "amg":
-                import pyamg  # only this solver needs it
-                pre = pyamg.smoothed_aggregation_solver(a, symmetry="nonsymmetric",
-                                                        max_coarse=200).aspreconditioner()
-            elif self.solver == "ilu":
-                pre = spla.LinearOperator((m, m), spla.spilu(a.tocsc(), drop_tol=1e-4,
-                                                              fill_factor=5).solve)
-            if self.solver != "direct":
-                count = [0]
-
-                def _count(_xk: np.ndarray) -> None:
-                    count[0] += 1
-
-                sol, info = spla.bicgstab(a, b, x0=x, rtol=self.tol, atol=0.0,
-                                          maxiter=self.max_iter, M=pre, callback=_count)
-                it = count[0]
-                bn = float(np.linalg.norm(b)) or 1.0
-                rel = float(np.linalg.norm(b - a @ sol)) / bn
+        sol, it, rel = solve_ppe(self.solver, m, self.ptr, self.indices, self.data, self.b[:m],
+                                 self.x0[:m], self.tol, self.max_iter, self.x2)
         self.solve_time += time.perf_counter() - tic
         self.ppe_iterations += int(it)
         self.ppe_solves += 1
