@@ -7,34 +7,44 @@ pressure comes from a Poisson equation each step, not from an equation of state,
 sound speed and the time step follows the flow speed.
 
 One step (i fluid, j neighbour, r_ij = r_i - r_j, grad_i W_ij = -F_ij r_ij, V_j = m_j / rho0),
-on the sorted state at t^n:
+on the sorted state at t^n (docs/schemes.md "## ISPH" has the measurements behind each choice):
 
-1. free surface: seed 004 eq. 23-24, fake density rho_f,i = sum_j m_j W_ij (fluid, wall and self)
-   <= 0.9 rho0 (``free_surface = "density"``), or the position divergence
-   sum_j V_j F_ij r_ij^2 <= 1.5 (``"divergence"``; 2 inside the fluid in 2D): Dirichlet p = 0;
+1. free surface (Dirichlet p = 0): the position divergence sum_j V_j F_ij r_ij^2 <= 1.5
+   (``free_surface = "divergence"``, the default; 2 inside the fluid in 2D, Lind et al. 2012), or
+   seed 004's fake density rho_f,i = sum_j m_j W_ij <= 0.9 rho0 (eq. 23-24, ``"density"``);
 2. predictor (eq. 7): u*_i = u^n_i + dt (g + nu lap u_i), the Lo & Shao (2002) laminar term of
    wcsph.fluid_pass; walls: Adami et al. (2012) no-slip velocity;
-3. pressure Poisson equation (eq. 9-12), assembled as a sparse system over the interior fluid
-   particles and the wall particles that have fluid neighbours:
-     fluid i:  sum_j B_ij (p_i - p_j) = -div u*_i / dt,
+3. pressure Poisson equation (eq. 9-12), one sparse system over the interior fluid particles
+   and the wall particles that have fluid neighbours:
+     fluid i:  sum_j B_ij (p_i - p_j) = -div u*_i / dt + relax (rho_k,i - rho_ref) / (rho_ref dt^2)
                B_ij = 8 m_j / (rho_i + rho_j)^2 F_ij r_ij^2 / (r_ij^2 + eta^2),  eta = 0.1 h   (Shao & Lo 2003)
-               div u*_i = sum_j V_j (u*_j - u*_i) . grad_i W_ij                                (Khayyer et al. 2009)
-     wall s:   p_s - sum_f w_sf p_f = sum_f w_sf rho_f (g - a_s) . r_sf,  w_sf = W_sf / sum_f W_sf
-               (Adami et al. 2012, seed 004 eq. 22, linear in the fluid pressures)
-   free-surface particles enter with p = 0. A wall particle s enters div u* with its own
-   predicted velocity v_s + dt (g - a_s): the (g - a_s) part of its Adami pressure takes it back
-   off as the pressure does the fluid's (with v_s alone the hydrostatic column came out 1.45x
-   too heavy: the bed would count twice, in the wall rows and in the divergence). Solved by ``ppe_solver``: ``explicit`` = the seed's
-   Jacobi iteration p_k <- (b_k - sum_{j != k} a_kj p_j) / a_kk (Hosseini et al. 2007; eq. 13,
-   the wall rows updated in the same sweep), or BiCGSTAB preconditioned by smoothed-aggregation
-   AMG (``amg``, pyamg) or by incomplete LU (``ilu``); each warm-started from the last pressure;
-4. corrector (eq. 16-17): u^{n+1} = u* - dt sum_j m_j (p_i + p_j)/rho0^2 grad_i W_ij (eq. 5),
-   r^{n+1} = r^n + dt (u^n + u^{n+1}) / 2;
+               div u*_i = sum_f V_f (u*_f - u*_i) . grad_i W_if   over fluid f    (Khayyer et al. 2009)
+               the last term (Asai et al. 2012, ``isph_density_relaxation``): rho_k = sum m W of a
+               particle with a full support, rho_ref the initial lattice's value;
+     wall s:   p_s - sum_f w_sf p_f = sum_f w_sf rho_f [(g - a_s) . r_sf + max(0, -u_n,f / dt) (n_s . r_fs)]
+               w_sf = W_sf / sum_f W_sf (Adami et al. 2012, seed 004 eq. 22, linear in the fluid
+               pressures) plus a no-penetration part: u_n,f = (u_f - v_s) . n_s the fluid's
+               approach speed, n_s the unit vector from the wall into its fluid neighbours.
+   The walls enter the fluid rows through their pressure only (a ghost-pressure Neumann
+   condition): with the wall velocity also in div u* the hydrostatic column came out 1.45x too
+   heavy, and with the plain Adami rows fluid driven at the bed went through it (the wall pressure
+   rises with the fluid's). Free-surface particles enter with p = 0. Solved by ``ppe_solver``:
+   ``explicit`` = the seed's Jacobi iteration p_k <- (b_k - sum_{j != k} a_kj p_j) / a_kk
+   (Hosseini et al. 2007, eq. 13; the wall rows updated in the same sweep), ``amg`` = BiCGSTAB
+   preconditioned by smoothed-aggregation AMG (pyamg), ``ilu`` = BiCGSTAB with incomplete LU,
+   ``direct`` = SuperLU; the iterative ones warm-started from the last pressure;
+4. corrector (eq. 16-17): u^{n+1} = u* - dt grad p_i / rho0, r^{n+1} = r^n + dt (u^n + u^{n+1}) / 2,
+   grad p by the renormalised difference B_i^-1 sum_j V_j (p_j - p_i) grad_i W_ij (Bonet & Lok
+   1999; ``isph_gradient = "corrected"``, the default) or seed eq. 5 (``"symmetric"``: the
+   surface layer, its kernel cut, then falls at ~g/3 and the still tank blew up within 40 steps);
 5. sort by cell, then Fickian particle shifting (Lind et al. 2012, sph_core.shifting).
 
 The PPE is solved at r^n rather than at seed 004's intermediate r* = r^n + dt u* (eq. 8): one
 neighbour search per step instead of two. The time step (no sound speed):
-    dt = min(isph_cfl h / max|v|, 0.25 sqrt(h / max|g + nu lap u|), 0.125 h^2 / nu).
+    dt = min(isph_cfl h / max(|v|_max, v_ref), 0.25 sqrt(h / max|g + nu lap u|), 0.125 h^2 / nu),
+v_ref = isph_vref_factor sqrt(2 g H) (H the water height), the a-priori speed of Lind et al.
+(2012): without it a tank at rest steps at the force limit 0.25 sqrt(h/g), 7x larger (tried only
+before the wall rows above were settled, where it did not help; not re-measured since).
 """
 
 from __future__ import annotations
@@ -56,13 +66,16 @@ from .wcsph import (FASTMATH, ST_LEFT_DOMAIN, ST_NONFINITE, ST_REACHED_T, ST_STE
 
 PPE_SOLVERS = ("explicit", "amg", "ilu", "direct")
 FS_DEFAULT_THRESHOLD = {"density": 0.9, "divergence": 1.5}
+FULL_SUPPORT_DIV = 1.9   # position divergence of a full 2D support: 2 (1.98 on the lattice)
 MAX_ROW = 64   # non-zeros per PPE row, generous: a full 2D support at h/dp 2 has ~50 neighbours
 
 
 @njit(parallel=True, cache=True, fastmath=FASTMATH)
 def free_surface_flags(ps, n, cells, prm, by_density, threshold, flag, rho_k):
     """flag[i] = 1 for a free-surface fluid particle, 0 for an interior one, -1 for the rest;
-    rho_k[i] = sum_j m_j W_ij (fluid and wall, self included) of every fluid particle."""
+    rho_k[i] = sum_j m_j W_ij (fluid and wall, self included) of a fluid particle whose support
+    is full (position divergence >= FULL_SUPPORT_DIV), else -1: near the surface the kernel sum
+    falls because the fluid ends, not because the fluid expanded."""
     x = ps.x
     z = ps.z
     m = ps.m
@@ -93,7 +106,7 @@ def free_surface_flags(ps, n, cells, prm, by_density, threshold, flag, rho_k):
                             q = math.sqrt(r2) * inv_h
                             sr += m[j] * w_of_q(q, aw)
                             sdiv += m[j] / rho0 * f_of_q(q, af) * r2
-            rho_k[i] = sr
+            rho_k[i] = sr if sdiv >= FULL_SUPPORT_DIV else -1.0
             if by_density:
                 flag[i] = 1 if sr <= threshold * rho0 else 0
             else:
@@ -332,7 +345,9 @@ def _assemble_row(ps, i, k, cells, prm, inv_dt, idx, wsum, dwall, wscale, indptr
         data[base] = diag
         # density-invariance relaxation (Asai et al. 2012): a kernel density above the lattice's
         # pushes apart, below pulls together, so volume errors do not accumulate
-        b[k] = -div * inv_dt + relax * (rho_k[i] - rho_ref) / rho_ref * inv_dt * inv_dt
+        b[k] = -div * inv_dt
+        if rho_k[i] > 0.0:
+            b[k] += relax * (rho_k[i] - rho_ref) / rho_ref * inv_dt * inv_dt
     else:  # wall: p_s - sum_f w_sf p_f = dwall_s, scaled
         inv_sw = wscale / wsum[i]
         data[base] = wscale
@@ -633,7 +648,7 @@ class IsphStepper:
         free_surface_flags(ps, n, cells, prm, self.by_density, self.fs_threshold, self.flag,
                            self.rho_k)
         if self.rho_ref == 0.0:  # the initial lattice's interior kernel density (~1.006 rho0)
-            inner = (self.flag[:n] == 0)
+            inner = self.rho_k[:n] > 0.0
             self.rho_ref = float(np.median(self.rho_k[:n][inner])) if inner.any() else prm.rho0
         wall_state(ps, n, cells, prm, dt, self.wsum, self.dwall)
         a2 = predict(ps, n, cells, prm, dt)
