@@ -19,8 +19,8 @@ on the sorted state at t^n (docs/schemes.md "## ISPH" has the measurements behin
      fluid i:  sum_j B_ij (p_i - p_j) = -div u*_i / dt + relax (rho_k,i - rho_ref) / (rho_ref dt^2)
                B_ij = 8 m_j / (rho_i + rho_j)^2 F_ij r_ij^2 / (r_ij^2 + eta^2),  eta = 0.1 h   (Shao & Lo 2003)
                div u*_i = sum_f V_f (u*_f - u*_i) . grad_i W_if   over fluid f    (Khayyer et al. 2009)
-               the last term (Asai et al. 2012, ``isph_density_relaxation``): rho_k = sum m W of a
-               particle with a full support, rho_ref the initial lattice's value;
+               the last term (Asai et al. 2012, ``isph_density_relaxation``): rho_k = sum m W,
+               rho_ref the initial interior lattice's value (~1.006 rho0);
      wall s:   p_s - sum_f w_sf p_f = sum_f w_sf rho_f [(g - a_s) . r_sf + max(0, -u_n,f / dt) (n_s . r_fs)]
                w_sf = W_sf / sum_f W_sf (Adami et al. 2012, seed 004 eq. 22, linear in the fluid
                pressures) plus a no-penetration part: u_n,f = (u_f - v_s) . n_s the fluid's
@@ -66,16 +66,13 @@ from .wcsph import (FASTMATH, ST_LEFT_DOMAIN, ST_NONFINITE, ST_REACHED_T, ST_STE
 
 PPE_SOLVERS = ("explicit", "amg", "ilu", "direct")
 FS_DEFAULT_THRESHOLD = {"density": 0.9, "divergence": 1.5}
-FULL_SUPPORT_DIV = 1.9   # position divergence of a full 2D support: 2 (1.98 on the lattice)
 MAX_ROW = 64   # non-zeros per PPE row, generous: a full 2D support at h/dp 2 has ~50 neighbours
 
 
 @njit(parallel=True, cache=True, fastmath=FASTMATH)
 def free_surface_flags(ps, n, cells, prm, by_density, threshold, flag, rho_k):
     """flag[i] = 1 for a free-surface fluid particle, 0 for an interior one, -1 for the rest;
-    rho_k[i] = sum_j m_j W_ij (fluid and wall, self included) of a fluid particle whose support
-    is full (position divergence >= FULL_SUPPORT_DIV), else -1: near the surface the kernel sum
-    falls because the fluid ends, not because the fluid expanded."""
+    rho_k[i] = sum_j m_j W_ij (fluid and wall, self included) of every fluid particle."""
     x = ps.x
     z = ps.z
     m = ps.m
@@ -106,7 +103,7 @@ def free_surface_flags(ps, n, cells, prm, by_density, threshold, flag, rho_k):
                             q = math.sqrt(r2) * inv_h
                             sr += m[j] * w_of_q(q, aw)
                             sdiv += m[j] / rho0 * f_of_q(q, af) * r2
-            rho_k[i] = sr if sdiv >= FULL_SUPPORT_DIV else -1.0
+            rho_k[i] = sr
             if by_density:
                 flag[i] = 1 if sr <= threshold * rho0 else 0
             else:
@@ -345,9 +342,7 @@ def _assemble_row(ps, i, k, cells, prm, inv_dt, idx, wsum, dwall, wscale, indptr
         data[base] = diag
         # density-invariance relaxation (Asai et al. 2012): a kernel density above the lattice's
         # pushes apart, below pulls together, so volume errors do not accumulate
-        b[k] = -div * inv_dt
-        if rho_k[i] > 0.0:
-            b[k] += relax * (rho_k[i] - rho_ref) / rho_ref * inv_dt * inv_dt
+        b[k] = -div * inv_dt + relax * (rho_k[i] - rho_ref) / rho_ref * inv_dt * inv_dt
     else:  # wall: p_s - sum_f w_sf p_f = dwall_s, scaled
         inv_sw = wscale / wsum[i]
         data[base] = wscale
@@ -648,7 +643,7 @@ class IsphStepper:
         free_surface_flags(ps, n, cells, prm, self.by_density, self.fs_threshold, self.flag,
                            self.rho_k)
         if self.rho_ref == 0.0:  # the initial lattice's interior kernel density (~1.006 rho0)
-            inner = self.rho_k[:n] > 0.0
+            inner = self.flag[:n] == 0
             self.rho_ref = float(np.median(self.rho_k[:n][inner])) if inner.any() else prm.rho0
         wall_state(ps, n, cells, prm, dt, self.wsum, self.dwall)
         a2 = predict(ps, n, cells, prm, dt)

@@ -41,7 +41,7 @@ def assembled_ppe(res: int = 10):
     n = sim.particles.n
     isph.free_surface_flags(ps, n, sim.cells, prm, st.by_density, st.fs_threshold, st.flag,
                             st.rho_k)
-    st.rho_ref = float(np.median(st.rho_k[:n][st.rho_k[:n] > 0]))
+    st.rho_ref = float(np.median(st.rho_k[:n][st.flag[:n] == 0]))
     isph.wall_state(ps, n, sim.cells, prm, dt, st.wsum, st.dwall)
     isph.predict(ps, n, sim.cells, prm, dt)
     m = isph.ppe_unknowns(ps, n, st.flag, st.wsum, st.idx)
