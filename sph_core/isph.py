@@ -16,11 +16,12 @@ on the sorted state at t^n (docs/schemes.md "## ISPH" has the measurements behin
    wcsph.fluid_pass; walls: Adami et al. (2012) no-slip velocity;
 3. pressure Poisson equation (eq. 9-12), one sparse system over the interior fluid particles
    and the wall particles that have fluid neighbours:
-     fluid i:  sum_j B_ij (p_i - p_j) = -div u*_i / dt + relax (rho_k,i - rho_ref) / (rho_ref dt^2)
+     fluid i:  sum_j B_ij (p_i - p_j) = -div u*_i / dt + relax (rho_k,i - rho_ref) / (rho_ref dt_ref^2)
                B_ij = 8 m_j / (rho_i + rho_j)^2 F_ij r_ij^2 / (r_ij^2 + eta^2),  eta = 0.1 h   (Shao & Lo 2003)
                div u*_i = sum_f V_f (u*_f - u*_i) . grad_i W_if   over fluid f    (Khayyer et al. 2009)
-               the last term (Asai et al. 2012, ``isph_density_relaxation``): rho_k = sum m W,
-               rho_ref the initial interior lattice's value (~1.006 rho0);
+               the last term (Asai et al. 2012, ``isph_density_relaxation``) with dt_ref the
+               nominal step cfl h / v_ref in place of dt: rho_k = sum m W, rho_ref the initial
+               interior lattice's value (~1.006 rho0);
      wall s:   p_s - sum_f w_sf p_f = sum_f w_sf rho_f [(g - a_s) . r_sf + max(0, -u_n,f / dt) (n_s . r_fs)]
                w_sf = W_sf / sum_f W_sf (Adami et al. 2012, seed 004 eq. 22, linear in the fluid
                pressures) plus a no-penetration part: u_n,f = (u_f - v_s) . n_s the fluid's
@@ -342,7 +343,7 @@ def _assemble_row(ps, i, k, cells, prm, inv_dt, idx, wsum, dwall, wscale, indptr
         data[base] = diag
         # density-invariance relaxation (Asai et al. 2012): a kernel density above the lattice's
         # pushes apart, below pulls together, so volume errors do not accumulate
-        b[k] = -div * inv_dt + relax * (rho_k[i] - rho_ref) / rho_ref * inv_dt * inv_dt
+        b[k] = -div * inv_dt + relax * (rho_k[i] - rho_ref) / rho_ref
     else:  # wall: p_s - sum_f w_sf p_f = dwall_s, scaled
         inv_sw = wscale / wsum[i]
         data[base] = wscale
@@ -592,6 +593,11 @@ class IsphStepper:
         self.rho_k = np.zeros(cap)
         self.rho_ref = 0.0
         self.relax = float(density_relaxation)
+        # the relaxation's time scale: the nominal step cfl h / v_ref, not the actual dt (with
+        # 1/dt^2 a shrinking step strengthened it, which shrank the step further: the dam break
+        # blew up within 0.005 s)
+        self.dt_ref = prm.cfl * prm.h / v_ref if v_ref > 0.0 else 0.25 * math.sqrt(
+            prm.h / math.hypot(prm.gx, prm.gz))
         self.wsum = np.zeros(cap)
         self.dwall = np.zeros(cap)
         self.idx = np.zeros(cap, dtype=np.int64)
@@ -622,7 +628,8 @@ class IsphStepper:
         m = ppe_unknowns(ps, n, self.flag, self.wsum, self.idx)
         longest = ppe_assemble(ps, n, cells, prm, dt, self.idx, self.wsum, self.dwall,
                                self.wscale, self.indptr, self.indices, self.data, self.b, self.x0,
-                               self.slot, self.rho_k, self.rho_ref, self.relax)
+                               self.slot, self.rho_k, self.rho_ref,
+                               self.relax / (self.dt_ref * self.dt_ref))
         if longest >= MAX_ROW:  # a row lost terms: the particles are far denser than the lattice
             raise RuntimeError(f"ISPH: a PPE row has more than {MAX_ROW - 1} neighbours")
         compact_rows(m, self.indptr, self.indices, self.data, self.ptr)
