@@ -194,17 +194,21 @@ class Constants(_Model):
 
 
 class Scheme(_Model):
-    """Which SPH scheme solves the fluid (issue 13 adds "isph" here).
+    """Which SPH scheme solves the fluid.
 
     ``riemann`` (sph_core.riemann, seed 003): weakly compressible as wcsph (same EOS, walls, time
     step, integrators), but each pair's continuity and pressure terms come from a linearised
     Riemann problem at the pair's mid-point instead of delta-SPH and Monaghan viscosity
     (constants.alpha and constants.delta are not used; constants.alpha_wall_factor scales the
-    velocity dissipation against walls)."""
+    velocity dissipation against walls).
 
-    kind: Literal["wcsph", "riemann"] = Field("wcsph", description=(
+    The ``ppe_*``, ``free_surface*``, ``isph_*`` options apply to ``kind = "isph"`` only
+    (sph_core.isph: projection method, a pressure Poisson equation per step)."""
+
+    kind: Literal["wcsph", "riemann", "isph"] = Field("wcsph", description=(
         "wcsph: weakly compressible, delta-SPH density diffusion, Monaghan viscosity; "
-        "riemann: weakly compressible, pairwise Riemann flux"))
+        "riemann: weakly compressible, pairwise Riemann flux; "
+        "isph: incompressible SPH (projection method, seed 004)"))
     reconstruction: Literal["muscl", "none"] = Field("muscl", description=(
         "riemann: left/right states extrapolated to the pair's mid-point with limited "
         "gradients (muscl), or the particles' own values (none, first order)"))
@@ -217,6 +221,37 @@ class Scheme(_Model):
         "riemann: Zhang, Hu & Adams (2017) limiter on the pressure dissipation, "
         "beta = min(eta max(U_L - U_R, 0)/c0, 1); false: beta = 1 (plain Godunov flux)"))
     low_dissipation_eta: float = Field(3.0, gt=0, description="riemann: eta of that limiter")
+    ppe_solver: Literal["explicit", "amg", "ilu", "direct"] = Field("amg", description=(
+        "ISPH pressure Poisson solver: explicit = the seed's Jacobi iteration (Hosseini et al. "
+        "2007); amg = BiCGSTAB preconditioned by smoothed-aggregation AMG (pyamg); ilu = "
+        "BiCGSTAB preconditioned by incomplete LU (scipy); direct = sparse LU (SuperLU), the "
+        "reference"))
+    ppe_tolerance: float = Field(1e-5, gt=0, lt=1, description=(
+        "ISPH: relative residual |b - A p| / |b| at which the pressure solve stops"))
+    ppe_max_iter: int = Field(20000, ge=1, description="ISPH: iteration cap of the pressure solve")
+    free_surface: Literal["density", "divergence"] = Field("divergence", description=(
+        "ISPH free-surface criterion (Dirichlet p = 0): density = seed 004's kernel sum "
+        "rho_f = sum m W <= threshold rho0; divergence = position divergence <= threshold "
+        "(the default: with density the top layer of still water settled until it no longer "
+        "counted as surface, and the surface corners oscillated; docs/schemes.md)"))
+    free_surface_threshold: float | None = Field(None, gt=0, description=(
+        "ISPH: threshold of the free-surface criterion (default 0.9 for density, seed 004; "
+        "1.5 for divergence)"))
+    isph_cfl: float = Field(0.2, gt=0, le=0.5, description=(
+        "ISPH Courant number on the flow speed: dt <= isph_cfl h / max|v| (no sound speed)"))
+    isph_gradient: Literal["corrected", "symmetric"] = Field("corrected", description=(
+        "ISPH pressure gradient of the corrector: symmetric = seed 004 eq. 5; corrected = "
+        "renormalised difference form (Bonet & Lok 1999), exact for linear p also where the "
+        "kernel is cut by the free surface"))
+    isph_vref_factor: float = Field(1.0, ge=0, description=(
+        "ISPH: the time step's speed is at least this x sqrt(2 g H), H the water height "
+        "(0: the flow's max|v| alone)"))
+    isph_density_relaxation: float = Field(0.01, ge=0, le=1, description=(
+        "ISPH: weight of the density-invariance term (rho_k - rho_ref)/(rho_ref dt^2) added to "
+        "the divergence source (Asai et al. 2012); 0: the seed's divergence-free source alone "
+        "(measured: the still-water surface then rises ~4 mm/s at d/dp 25; 0.01 holds it)"))
+    isph_shifting: bool = Field(True, description=(
+        "ISPH: Fickian particle shifting (Lind et al. 2012) with Constants.shift_a after each step"))
 
 
 class PointProbe(_Model):
@@ -394,6 +429,14 @@ class Scene(_Model):
             x = getattr(p, "x", None)
             if x is not None and not (t.x0 <= x <= t.x1):
                 raise ValueError(f"probes.{i}.x: must lie inside the tank [{t.x0}, {t.x1}]")
+        if self.scheme.kind == "isph":
+            # the ISPH step (sph_core.isph) has no open-end or rigid-body hooks yet
+            if self.open_boundaries:
+                raise ValueError("scheme.kind: isph does not support open_boundaries (yet); "
+                                 "use kind = \"wcsph\" for a scene with open ends")
+            if self.bodies:
+                raise ValueError("scheme.kind: isph does not support bodies (yet); "
+                                 "use kind = \"wcsph\" for a scene with rigid bodies")
         bnames = [b.name for b in self.bodies]
         if len(set(bnames)) != len(bnames):
             raise ValueError(f"bodies: duplicate names {bnames}")

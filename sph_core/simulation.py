@@ -12,6 +12,8 @@ Every scene runs the same loop: the open inlet/outlet ends are a value (``self.o
 ``open_ends.OpenBoundaries``: named constructors ``from_scene`` / ``closed``), and the time loop
 is one jitted call (``step.run``) up to the next output time (and, with open ends, the next window
 end); Python only handles boundary data, probes, snapshots, metadata and the progress callback.
+ISPH scenes (``scene.scheme.kind == "isph"``) step with ``isph.IsphStepper.run`` instead, a
+Python loop over jitted passes around a sparse pressure solve, with the same returns.
 """
 
 from __future__ import annotations
@@ -25,6 +27,7 @@ import numba
 import numpy as np
 
 from . import riemann, step, wcsph
+from .isph import IsphStepper
 from .bodies import BodyLog, BodySet
 from .boundary_data import BoundaryData, BoundaryDataError, BoundarySample
 from .eos import hydrostatic_density, tait_b
@@ -65,7 +68,8 @@ class UnstableError(RuntimeError):
 
 
 class Simulation:
-    """WCSPH run of one scene; see the module docstring for the contract.
+    """SPH run of one scene (WCSPH, or ISPH with ``[scheme] kind = "isph"``); see the module
+    docstring for the contract.
 
     ``sources`` (side -> BoundaryData) and ``window`` [s] apply to scenes with open ends;
     ``spare`` is the spare particle capacity (default 0.1, 0.3 with open ends: inflow);
@@ -76,6 +80,7 @@ class Simulation:
                  window: float = 0.02, cells_per_support: int = CELLS_PER_SUPPORT) -> None:
         self.scene = scene
         c = scene.constants
+        scheme = scene.scheme
         layout = build_layout(scene)
         dp, h = scene.dp, scene.h
         self.h = h
@@ -95,10 +100,16 @@ class Simulation:
         vol = dp * dp
         ps.add(layout.wall_x, layout.wall_z, WALL, np.full(layout.wall_x.size, c.rho0),
                np.full(layout.wall_x.size, c.rho0 * vol))
-        rho_f = hydrostatic_density(layout.fluid_z, layout.fluid_surface, c.rho0, c.g, self.b)
+        self.isph = scene.scheme.kind == "isph"
+        if self.isph:  # incompressible: constant density rho0
+            rho_f = np.full(layout.fluid_x.size, c.rho0)
+        else:
+            rho_f = hydrostatic_density(layout.fluid_z, layout.fluid_surface, c.rho0, c.g, self.b)
         # mass = rho * dp^2: the lattice is the compressed hydrostatic state, so the initial
         # pressure is hydrostatic and the particle volume is exactly dp^2
         ps.add(layout.fluid_x, layout.fluid_z, FLUID, rho_f, rho_f * vol)
+        if self.isph:  # hydrostatic pressure: the warm start of the first pressure solve
+            ps.f[P, ps.n - rho_f.size: ps.n] = c.rho0 * c.g * (layout.fluid_surface - layout.fluid_z)
         self.bodies.attach(ps, c.rho0, dp)
         self.n_layers = layout.n_layers
         self.open.attach(ps, scene, self.b, layout.n_layers * dp)
@@ -114,16 +125,28 @@ class Simulation:
         lo, hi = c.density_band
         self.prm = Params(h=h, alpha_w=aw, alpha_f=5.0 * aw / (h * h), rho0=c.rho0, c0=self.c0,
                           b=self.b, gamma=7.0, gx=0.0, gz=-c.g, alpha=c.alpha, nu=c.nu,
-                          delta=c.delta, cfl=c.cfl, rho_lo=lo, rho_hi=hi,
+                          delta=c.delta, cfl=scheme.isph_cfl if self.isph else c.cfl,
+                          rho_lo=lo, rho_hi=hi,
                           noslip=c.wall_slip == "no_slip", fx0=fx0, fx1=fx1,
                           fz0=t.z0 - 0.5 * dp, fz1=t.z1, alpha_wall=c.alpha_wall_factor,
-                          shift_a=c.shift_a if c.shifting == "fickian" else 0.0,
+                          shift_a=(c.shift_a if (c.shifting == "fickian"
+                                                 or (self.isph and scheme.isph_shifting)) else 0.0),
                           shift_fs_div=c.shift_fs_div, **scheme_params(scene.scheme))
         self.integrator = wcsph.INTEGRATORS[c.integrator]
         self.passes_per_step = wcsph.PASSES_PER_STEP[c.integrator]
         self._counts = np.zeros(ps.capacity, dtype=np.int64)
-        dt, n_new = step.initialise(ps.view, ps.view2, self.cells, self.prm, self.open.ends,
-                                   self.bodies.state, ps.n)
+        self.stepper: IsphStepper | None = None
+        if self.isph:
+            self.stepper = IsphStepper(ps.capacity, self.prm, dp, scheme.ppe_solver,
+                                       scheme.ppe_tolerance, scheme.ppe_max_iter,
+                                       scheme.free_surface, scheme.free_surface_threshold,
+                                       scheme.isph_shifting, scheme.isph_gradient,
+                                       v_ref=scheme.isph_vref_factor * math.sqrt(2.0 * c.g * scene.water_height),
+                                       density_relaxation=scheme.isph_density_relaxation)
+            dt, n_new = self.stepper.initialise(ps.view, ps.view2, self.cells, ps.n)
+        else:
+            dt, n_new = step.initialise(ps.view, ps.view2, self.cells, self.prm, self.open.ends,
+                                       self.bodies.state, ps.n)
         self.dt = float(dt)
         ps.swap()
         ps.n = int(n_new)
@@ -255,6 +278,8 @@ class Simulation:
                 "n_particles": self.n_particles, "n_fluid": self.n_fluid,
                 "excluded": len(self.excluded), "excluded_particles": self.excluded[-20:],
                 "c0": self.c0, "h": self.h, "integrator": self.scene.constants.integrator,
+                "scheme": self.scene.scheme.kind,
+                **(self.stepper.stats() if self.stepper is not None else {}),
                 "passes_per_step": self.passes_per_step, "threads": numba.get_num_threads(),
                 "particle_steps_per_s": (self.n_particles * self.steps / self.wall_time
                                          if self.wall_time > 0 else None),
@@ -379,9 +404,13 @@ class Simulation:
         ends = self.open.ends
         ends.next_id[0] = ps.next_id
         tic = time.perf_counter()
-        t, dt, steps, status, swapped, n_flag, vmax, n = step.run(
-            ps.view, ps.view2, self.cells, self.prm, ends, self.bodies.state, self.integrator, ps.n,
-            self.t, self.dt, t_stop, max_steps)
+        if self.stepper is not None:
+            t, dt, steps, status, swapped, n_flag, vmax, n = self.stepper.run(
+                ps.view, ps.view2, self.cells, ps.n, self.t, self.dt, t_stop, max_steps)
+        else:
+            t, dt, steps, status, swapped, n_flag, vmax, n = step.run(
+                ps.view, ps.view2, self.cells, self.prm, ends, self.bodies.state, self.integrator,
+                ps.n, self.t, self.dt, t_stop, max_steps)
         self.wall_time += time.perf_counter() - tic
         if swapped:
             ps.swap()

@@ -1,0 +1,704 @@
+"""Incompressible SPH (ISPH): the projection method of Cummins & Rudman (1999) as in seed 004.
+
+Selected by a scene's ``[scheme] kind = "isph"``; ``Simulation`` then steps with an
+``IsphStepper`` (a Python loop over jitted passes: the sparse pressure solve runs in scipy /
+pyamg) instead of ``step.run``. Density is constant (rho0, every particle's mass rho0 dp^2); the
+pressure comes from a Poisson equation each step, not from an equation of state, so there is no
+sound speed and the time step follows the flow speed.
+
+One step (i fluid, j neighbour, r_ij = r_i - r_j, grad_i W_ij = -F_ij r_ij, V_j = m_j / rho0),
+on the sorted state at t^n (docs/schemes.md "## ISPH" has the measurements behind each choice):
+
+1. free surface (Dirichlet p = 0): the position divergence sum_j V_j F_ij r_ij^2 <= 1.5
+   (``free_surface = "divergence"``, the default; 2 inside the fluid in 2D, Lind et al. 2012), or
+   seed 004's fake density rho_f,i = sum_j m_j W_ij <= 0.9 rho0 (eq. 23-24, ``"density"``);
+2. predictor (eq. 7): u*_i = u^n_i + dt (g + nu lap u_i), the Lo & Shao (2002) laminar term of
+   wcsph.fluid_pass; walls: Adami et al. (2012) no-slip velocity;
+3. pressure Poisson equation (eq. 9-12), one sparse system over the interior fluid particles
+   and the wall particles that have fluid neighbours:
+     fluid i:  sum_j B_ij (p_i - p_j) = -div u*_i / dt + relax (rho_k,i - rho_ref) / (rho_ref dt_ref^2)
+               B_ij = 8 m_j / (rho_i + rho_j)^2 F_ij r_ij^2 / (r_ij^2 + eta^2),  eta = 0.1 h   (Shao & Lo 2003)
+               div u*_i = sum_f V_f (u*_f - u*_i) . grad_i W_if   over fluid f    (Khayyer et al. 2009)
+               the last term (Asai et al. 2012, ``isph_density_relaxation``) with dt_ref the
+               nominal step cfl h / v_ref in place of dt: rho_k = sum m W, rho_ref the initial
+               interior lattice's value (~1.006 rho0);
+     wall s:   p_s - sum_f w_sf p_f = sum_f w_sf rho_f [(g - a_s) . r_sf + max(0, -u_n,f / dt) (n_s . r_fs)]
+               w_sf = W_sf / sum_f W_sf (Adami et al. 2012, seed 004 eq. 22, linear in the fluid
+               pressures) plus a no-penetration part: u_n,f = (u_f - v_s) . n_s the fluid's
+               approach speed, n_s the unit vector from the wall into its fluid neighbours.
+   The walls enter the fluid rows through their pressure only (a ghost-pressure Neumann
+   condition): with the wall velocity also in div u* the hydrostatic column came out 1.45x too
+   heavy, and with the plain Adami rows fluid driven at the bed went through it (the wall pressure
+   rises with the fluid's). Free-surface particles enter with p = 0. Solved by ``ppe_solver``:
+   ``explicit`` = the seed's Jacobi iteration p_k <- (b_k - sum_{j != k} a_kj p_j) / a_kk
+   (Hosseini et al. 2007, eq. 13; the wall rows updated in the same sweep), ``amg`` = BiCGSTAB
+   preconditioned by smoothed-aggregation AMG (pyamg), ``ilu`` = BiCGSTAB with incomplete LU,
+   ``direct`` = SuperLU; the iterative ones warm-started from the last pressure;
+4. corrector (eq. 16-17): u^{n+1} = u* - dt grad p_i / rho0, r^{n+1} = r^n + dt (u^n + u^{n+1}) / 2,
+   grad p by the renormalised difference B_i^-1 sum_j V_j (p_j - p_i) grad_i W_ij (Bonet & Lok
+   1999; ``isph_gradient = "corrected"``, the default) or seed eq. 5 (``"symmetric"``: the
+   surface layer, its kernel cut, then falls at ~g/3 and the still tank blew up within 40 steps);
+5. sort by cell, then Fickian particle shifting (Lind et al. 2012, sph_core.shifting).
+
+The PPE is solved at r^n rather than at seed 004's intermediate r* = r^n + dt u* (eq. 8): one
+neighbour search per step instead of two. The time step (no sound speed):
+    dt = min(isph_cfl h / max(|v|_max, v_ref), 0.25 sqrt(h / max|g + nu lap u|), 0.125 h^2 / nu),
+v_ref = isph_vref_factor sqrt(2 g H) (H the water height), the a-priori speed of Lind et al.
+(2012): without it a tank at rest steps at the force limit 0.25 sqrt(h/g), 7x larger (tried only
+before the wall rows above were settled, where it did not help; not re-measured since).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from typing import Any
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+from numba import njit, prange
+
+from .kernels import f_of_q, w_of_q
+from .neighbours import block_of, sort_by_cell
+from .particles import FLUID, N_SORTED_KDK, WALL
+from .shifting import shift_particles
+from .wcsph import (FASTMATH, ST_LEFT_DOMAIN, ST_NONFINITE, ST_REACHED_T, ST_STEP_LIMIT)
+
+PPE_SOLVERS = ("explicit", "amg", "ilu", "direct")
+FS_DEFAULT_THRESHOLD = {"density": 0.9, "divergence": 1.5}
+MAX_ROW = 64   # non-zeros per PPE row, generous: a full 2D support at h/dp 2 has ~50 neighbours
+
+
+@njit(parallel=True, cache=True, fastmath=FASTMATH)
+def free_surface_flags(ps, n, cells, prm, by_density, threshold, flag, rho_k):
+    """flag[i] = 1 for a free-surface fluid particle, 0 for an interior one, -1 for the rest;
+    rho_k[i] = sum_j m_j W_ij (fluid and wall, self included) of every fluid particle."""
+    x = ps.x
+    z = ps.z
+    m = ps.m
+    kind = ps.kind
+    cell = ps.cell
+    cell_start = cells.start
+    ncx = cells.ncx
+    h = prm.h
+    inv_h = 1.0 / h
+    s2 = 4.0 * h * h
+    aw = prm.alpha_w
+    af = prm.alpha_f
+    rho0 = prm.rho0
+    for i in prange(n):
+        flag[i] = -1
+        if kind[i] == FLUID:
+            sr = 0.0
+            sdiv = 0.0
+            cxl, cxh, czl, czh = block_of(cell[i], cells)
+            for zz in range(czl, czh + 1):
+                row = zz * ncx
+                for j in range(cell_start[row + cxl], cell_start[row + cxh + 1]):
+                    if kind[j] == FLUID or kind[j] == WALL:
+                        dx = x[i] - x[j]
+                        dz = z[i] - z[j]
+                        r2 = dx * dx + dz * dz
+                        if r2 < s2:
+                            q = math.sqrt(r2) * inv_h
+                            sr += m[j] * w_of_q(q, aw)
+                            sdiv += m[j] / rho0 * f_of_q(q, af) * r2
+            rho_k[i] = sr
+            if by_density:
+                flag[i] = 1 if sr <= threshold * rho0 else 0
+            else:
+                flag[i] = 1 if sdiv <= threshold else 0
+
+
+@njit(parallel=True, cache=True, fastmath=FASTMATH)
+def wall_state(ps, n, cells, prm, dt, wsum, dwall):
+    """Adami et al. (2012) for every wall particle s from its fluid neighbours f:
+    wsum[s] = sum_f W_sf, dwall[s] = sum_f W_sf rho_f (g - a_s) . r_sf / wsum (the hydrostatic
+    part of p_s), and the no-slip velocity vw_s = 2 v_s - sum_f v_f W_sf / wsum."""
+    x = ps.x
+    z = ps.z
+    vx = ps.vx
+    vz = ps.vz
+    ax = ps.ax
+    az = ps.az
+    rho = ps.rho
+    vwx = ps.vwx
+    vwz = ps.vwz
+    kind = ps.kind
+    cell = ps.cell
+    cell_start = cells.start
+    ncx = cells.ncx
+    h = prm.h
+    inv_h = 1.0 / h
+    s2 = 4.0 * h * h
+    aw = prm.alpha_w
+    for i in prange(n):
+        wsum[i] = 0.0
+        dwall[i] = 0.0
+        if kind[i] == WALL:
+            bx = prm.gx - ax[i]
+            bz = prm.gz - az[i]
+            sw = 0.0
+            sd = 0.0
+            svx = 0.0
+            svz = 0.0
+            nx = 0.0
+            nz = 0.0
+            cxl, cxh, czl, czh = block_of(cell[i], cells)
+            for zz in range(czl, czh + 1):
+                row = zz * ncx
+                for j in range(cell_start[row + cxl], cell_start[row + cxh + 1]):
+                    if kind[j] == FLUID:
+                        dx = x[i] - x[j]
+                        dz = z[i] - z[j]
+                        r2 = dx * dx + dz * dz
+                        if r2 < s2:
+                            w = w_of_q(math.sqrt(r2) * inv_h, aw)
+                            sw += w
+                            sd += rho[j] * (bx * dx + bz * dz) * w
+                            svx += vx[j] * w
+                            svz += vz[j] * w
+                            nx -= dx * w
+                            nz -= dz * w
+            # the no-penetration part: fluid approaching the wall (relative normal velocity
+            # u_n < 0, n from the wall into the fluid) must stop within the step, so the
+            # ghost pressure rises by rho |u_n| / dt (n . r_fs) over each neighbour f
+            nn = math.sqrt(nx * nx + nz * nz)
+            if nn > 0.0:
+                nx /= nn
+                nz /= nn
+                for zz in range(czl, czh + 1):
+                    row = zz * ncx
+                    for j in range(cell_start[row + cxl], cell_start[row + cxh + 1]):
+                        if kind[j] == FLUID:
+                            dx = x[i] - x[j]
+                            dz = z[i] - z[j]
+                            r2 = dx * dx + dz * dz
+                            if r2 < s2:
+                                un = (vx[j] - vx[i]) * nx + (vz[j] - vz[i]) * nz
+                                if un < 0.0:
+                                    w = w_of_q(math.sqrt(r2) * inv_h, aw)
+                                    sd -= rho[j] * un / dt * (-(dx * nx + dz * nz)) * w
+            wsum[i] = sw
+            if sw > 0.0:
+                dwall[i] = sd / sw
+                vwx[i] = 2.0 * vx[i] - svx / sw
+                vwz[i] = 2.0 * vz[i] - svz / sw
+            else:
+                ps.p[i] = 0.0
+                vwx[i] = vx[i]
+                vwz[i] = vz[i]
+
+
+@njit(parallel=True, cache=True, fastmath=FASTMATH)
+def predict(ps, n, cells, prm, dt):
+    """u* = u^n + dt (g + nu lap u) for the fluid (eq. 7); u^n kept in vxn, vzn. Returns
+    max |g + nu lap u|^2 (the force limit of the time step)."""
+    x = ps.x
+    z = ps.z
+    vx = ps.vx
+    vz = ps.vz
+    ax = ps.ax
+    az = ps.az
+    rho = ps.rho
+    m = ps.m
+    vxn = ps.vxn
+    vzn = ps.vzn
+    vwx = ps.vwx
+    vwz = ps.vwz
+    kind = ps.kind
+    cell = ps.cell
+    cell_start = cells.start
+    ncx = cells.ncx
+    h = prm.h
+    inv_h = 1.0 / h
+    s2 = 4.0 * h * h
+    eta2 = 0.01 * h * h
+    af = prm.alpha_f
+    nu4 = 4.0 * prm.nu
+    noslip = prm.noslip
+    for i in prange(n):
+        if kind[i] == FLUID:
+            fx = 0.0
+            fz = 0.0
+            cxl, cxh, czl, czh = block_of(cell[i], cells)
+            for zz in range(czl, czh + 1):
+                row = zz * ncx
+                for j in range(cell_start[row + cxl], cell_start[row + cxh + 1]):
+                    kj = kind[j]
+                    if j != i and (kj == FLUID or (kj == WALL and noslip)):
+                        dx = x[i] - x[j]
+                        dz = z[i] - z[j]
+                        r2 = dx * dx + dz * dz
+                        if r2 < s2:
+                            if kj == WALL:
+                                dvx = vx[i] - vwx[j]
+                                dvz = vz[i] - vwz[j]
+                            else:
+                                dvx = vx[i] - vx[j]
+                                dvz = vz[i] - vz[j]
+                            lam = (nu4 * r2 * m[j] / ((rho[i] + rho[j]) * (r2 + eta2))
+                                   * f_of_q(math.sqrt(r2) * inv_h, af))
+                            fx -= lam * dvx
+                            fz -= lam * dvz
+            ax[i] = fx + prm.gx
+            az[i] = fz + prm.gz
+    a2max = 0.0
+    for i in prange(n):
+        if kind[i] == FLUID:
+            vxn[i] = vx[i]
+            vzn[i] = vz[i]
+            vx[i] += dt * ax[i]
+            vz[i] += dt * az[i]
+            a2max = max(a2max, ax[i] * ax[i] + az[i] * az[i])
+    return a2max
+
+
+@njit(cache=True)
+def ppe_unknowns(ps, n, flag, wsum, idx):
+    """idx[i] = the unknown of slot i (interior fluid, wetted wall), -1 if none; returns the count."""
+    k = 0
+    for i in range(n):
+        if flag[i] == 0 or (ps.kind[i] == WALL and wsum[i] > 0.0):
+            idx[i] = k
+            k += 1
+        else:
+            idx[i] = -1
+    return k
+
+
+@njit(parallel=True, cache=True, fastmath=FASTMATH)
+def ppe_assemble(ps, n, cells, prm, dt, idx, wsum, dwall, wscale, indptr, indices, data, b,
+                 x0, slot, rho_k, rho_ref, relax):
+    """Fill the PPE rows (module docstring, step 3) in CSR with MAX_ROW slots per row (the
+    unused tail of a row is padding the caller compacts); b the right-hand side, x0 the warm
+    start (the last pressure), slot[k] the particle of unknown k. Returns the largest row length.
+    Wall rows are scaled by ``wscale`` (a typical fluid diagonal) for a balanced system."""
+    inv_dt = 1.0 / dt
+    longest = 0
+    for i in prange(n):
+        k = idx[i]
+        if k >= 0:
+            longest = max(longest, _assemble_row(ps, i, k, cells, prm, inv_dt, idx, wsum, dwall,
+                                                 wscale, indptr, indices, data, b, x0, slot,
+                                                 rho_k, rho_ref, relax))
+    return longest
+
+
+@njit(cache=True, fastmath=FASTMATH)
+def _assemble_row(ps, i, k, cells, prm, inv_dt, idx, wsum, dwall, wscale, indptr, indices, data,
+                  b, x0, slot, rho_k, rho_ref, relax):
+    """Row k (particle i) of the PPE; returns its length."""
+    x = ps.x
+    z = ps.z
+    vx = ps.vx
+    vz = ps.vz
+    p = ps.p
+    m = ps.m
+    rho = ps.rho
+    kind = ps.kind
+    cell = ps.cell
+    cell_start = cells.start
+    ncx = cells.ncx
+    h = prm.h
+    inv_h = 1.0 / h
+    s2 = 4.0 * h * h
+    eta2 = 0.01 * h * h
+    af = prm.alpha_f
+    aw = prm.alpha_w
+    slot[k] = i
+    x0[k] = p[i]
+    base = indptr[k]
+    cnt = 1          # position 0 of the row: the diagonal
+    indices[base] = k
+    if kind[i] == FLUID:
+        diag = 0.0
+        div = 0.0
+        cxl, cxh, czl, czh = block_of(cell[i], cells)
+        for zz in range(czl, czh + 1):
+            row = zz * ncx
+            for j in range(cell_start[row + cxl], cell_start[row + cxh + 1]):
+                kj = kind[j]
+                if j == i or not (kj == FLUID or kj == WALL):
+                    continue
+                dx = x[i] - x[j]
+                dz = z[i] - z[j]
+                r2 = dx * dx + dz * dz
+                if r2 >= s2:
+                    continue
+                fij = f_of_q(math.sqrt(r2) * inv_h, af)
+                # div u*_i = sum_j V_j (u*_j - u*_i) . grad_i W_ij, grad_i W_ij = -F r_ij, over
+                # the fluid: the walls' part is their ghost pressure (the Neumann condition)
+                if kj == FLUID:
+                    div -= m[j] / rho[j] * fij * ((vx[j] - vx[i]) * dx + (vz[j] - vz[i]) * dz)
+                rs = rho[i] + rho[j]
+                bij = 8.0 * m[j] / (rs * rs) * fij * r2 / (r2 + eta2)
+                diag += bij
+                kk = idx[j]
+                if kk >= 0 and cnt < MAX_ROW:
+                    indices[base + cnt] = kk
+                    data[base + cnt] = -bij
+                    cnt += 1
+        data[base] = diag
+        # density-invariance relaxation (Asai et al. 2012): a kernel density above the lattice's
+        # pushes apart, below pulls together, so volume errors do not accumulate
+        b[k] = -div * inv_dt + relax * (rho_k[i] - rho_ref) / rho_ref
+    else:  # wall: p_s - sum_f w_sf p_f = dwall_s, scaled
+        inv_sw = wscale / wsum[i]
+        data[base] = wscale
+        b[k] = wscale * dwall[i]
+        cxl, cxh, czl, czh = block_of(cell[i], cells)
+        for zz in range(czl, czh + 1):
+            row = zz * ncx
+            for j in range(cell_start[row + cxl], cell_start[row + cxh + 1]):
+                kk = idx[j]
+                if kind[j] == FLUID and kk >= 0:
+                    dx = x[i] - x[j]
+                    dz = z[i] - z[j]
+                    r2 = dx * dx + dz * dz
+                    if r2 < s2 and cnt < MAX_ROW:
+                        indices[base + cnt] = kk
+                        data[base + cnt] = -w_of_q(math.sqrt(r2) * inv_h, aw) * inv_sw
+                        cnt += 1
+    for c in range(cnt, MAX_ROW):
+        indices[base + c] = -1
+    return cnt
+
+
+@njit(cache=True)
+def compact_rows(m, indptr, indices, data, out_ptr):
+    """Drop the padding (-1 columns) of the m rows in place; out_ptr receives the CSR pointers."""
+    w = 0
+    out_ptr[0] = 0
+    for k in range(m):
+        for c in range(indptr[k], indptr[k + 1]):
+            if indices[c] >= 0:
+                indices[w] = indices[c]
+                data[w] = data[c]
+                w += 1
+        out_ptr[k + 1] = w
+    return w
+
+
+@njit(parallel=True, cache=True)
+def jacobi(indptr, indices, data, b, x, x2, m, tol, max_iter):
+    """The seed's explicit iteration (Hosseini et al. 2007): Jacobi sweeps on the CSR system
+    (diagonal first in each row) until |b - A x| <= tol |b|; returns (iterations, relative
+    residual). The residual of the sweep's input is a_kk (x_new - x)_k, so it costs nothing."""
+    bn = 0.0
+    for k in range(m):
+        bn += b[k] * b[k]
+    bn = math.sqrt(bn)
+    if bn == 0.0:
+        bn = 1.0
+    it = 0
+    rel = 1.0
+    while it < max_iter:
+        r2 = 0.0
+        for k in prange(m):
+            s = b[k]
+            for c in range(indptr[k] + 1, indptr[k + 1]):
+                s -= data[c] * x[indices[c]]
+            d = data[indptr[k]]
+            xn = s / d
+            r = d * (xn - x[k])
+            r2 += r * r
+            x2[k] = xn
+        for k in prange(m):
+            x[k] = x2[k]
+        it += 1
+        rel = math.sqrt(r2) / bn
+        if rel <= tol:
+            break
+    return it, rel
+
+
+@njit(parallel=True, cache=True)
+def scatter_pressure(ps, m, slot, sol, flag):
+    """p of every unknown from the solution; free-surface fluid p = 0. Walls keep a negative
+    solution (unlike wcsph.wall_pass's no-suction clamp): the corrector must see the pressures
+    the solve balanced, or the divergence it removed comes back at the surface corners."""
+    p = ps.p
+    for k in prange(m):
+        p[slot[k]] = sol[k]
+    for i in prange(flag.size):
+        if flag[i] == 1:
+            p[i] = 0.0
+
+
+@njit(parallel=True, cache=True, fastmath=FASTMATH)
+def correct(ps, n, cells, prm, dt, corrected):
+    """u^{n+1} = u* - dt (grad p / rho)_i (eq. 16), r^{n+1} = r^n + dt (u^n + u^{n+1}) / 2
+    (eq. 17); grad p by seed eq. 5 (symmetric), or ``corrected``: the renormalised difference
+    B_i^-1 sum_j V_j (p_j - p_i) grad_i W_ij (Bonet & Lok 1999), exact for a linear field on a
+    truncated support. Returns (#non-finite, #outside the tank box, max |v|^2)."""
+    x = ps.x
+    z = ps.z
+    vx = ps.vx
+    vz = ps.vz
+    ax = ps.ax
+    az = ps.az
+    p = ps.p
+    m = ps.m
+    rho = ps.rho
+    vxn = ps.vxn
+    vzn = ps.vzn
+    kind = ps.kind
+    cell = ps.cell
+    cell_start = cells.start
+    ncx = cells.ncx
+    h = prm.h
+    inv_h = 1.0 / h
+    s2 = 4.0 * h * h
+    af = prm.alpha_f
+    for i in prange(n):
+        if kind[i] == FLUID:
+            fx = 0.0
+            fz = 0.0
+            gpx = 0.0
+            gpz = 0.0
+            bxx = 0.0
+            bxz = 0.0
+            bzz = 0.0
+            cxl, cxh, czl, czh = block_of(cell[i], cells)
+            for zz in range(czl, czh + 1):
+                row = zz * ncx
+                for j in range(cell_start[row + cxl], cell_start[row + cxh + 1]):
+                    kj = kind[j]
+                    if j != i and (kj == FLUID or kj == WALL):
+                        dx = x[i] - x[j]
+                        dz = z[i] - z[j]
+                        r2 = dx * dx + dz * dz
+                        if r2 < s2:
+                            fij = f_of_q(math.sqrt(r2) * inv_h, af)
+                            # -(1/rho) grad p = sum_j m_j (p_i/rho_i^2 + p_j/rho_j^2) F r_ij
+                            pf = m[j] * (p[i] / (rho[i] * rho[i]) + p[j] / (rho[j] * rho[j]))
+                            fx += pf * fij * dx
+                            fz += pf * fij * dz
+                            # corrected: grad p = B^-1 sum_j V_j (p_j - p_i) grad_i W_ij
+                            vf = m[j] / rho[j] * fij
+                            gpx -= vf * (p[j] - p[i]) * dx
+                            gpz -= vf * (p[j] - p[i]) * dz
+                            bxx += vf * dx * dx
+                            bxz += vf * dx * dz
+                            bzz += vf * dz * dz
+            det = bxx * bzz - bxz * bxz
+            if corrected and det > 0.01:  # 1 on a full 2D lattice support
+                fx = -(bzz * gpx - bxz * gpz) / (det * rho[i])
+                fz = -(bxx * gpz - bxz * gpx) / (det * rho[i])
+            # the pressure acceleration; with the predictor's, (u^{n+1} - u^n) / dt
+            ax[i] = fx
+            az[i] = fz
+    n_bad = 0
+    n_out = 0
+    v2max = 0.0
+    for i in prange(n):
+        if kind[i] == FLUID:
+            u = vx[i] + dt * ax[i]
+            w = vz[i] + dt * az[i]
+            ax[i] = (u - vxn[i]) / dt
+            az[i] = (w - vzn[i]) / dt
+            xi = x[i] + 0.5 * dt * (u + vxn[i])
+            zi = z[i] + 0.5 * dt * (w + vzn[i])
+            vx[i] = u
+            vz[i] = w
+            x[i] = xi
+            z[i] = zi
+            v2 = u * u + w * w
+            if not np.isfinite(v2):
+                n_bad += 1
+            elif not (xi >= prm.fx0 and xi <= prm.fx1 and zi >= prm.fz0 and zi <= prm.fz1):
+                n_out += 1
+            v2max = max(v2max, v2)
+    return n_bad, n_out, v2max
+
+
+def solve_ppe(solver: str, m: int, ptr: np.ndarray, indices: np.ndarray, data: np.ndarray,
+              b: np.ndarray, x0: np.ndarray, tol: float, max_iter: int,
+              scratch: np.ndarray) -> tuple[np.ndarray, int, float]:
+    """Solve the m x m CSR system (diagonal first in each row) by ``solver`` (PPE_SOLVERS) from
+    the warm start ``x0`` (overwritten by ``explicit``); returns (solution, iterations,
+    relative residual |b - A x| / |b|)."""
+    if solver == "explicit":
+        it, rel = jacobi(ptr, indices, data, b, x0, scratch, m, tol, max_iter)
+        return x0, int(it), float(rel)
+    nnz = int(ptr[m])
+    a = sp.csr_matrix((data[:nnz], indices[:nnz], ptr[: m + 1]), shape=(m, m))
+    if solver == "direct":  # SuperLU: the reference the iterative solvers are checked by
+        sol = spla.spsolve(a.tocsc(), b)
+        it = 1
+    else:
+        if solver == "amg":
+            import pyamg  # only this solver needs it
+            pre = pyamg.smoothed_aggregation_solver(a, symmetry="nonsymmetric",
+                                                    max_coarse=200).aspreconditioner()
+        else:
+            ilu = spla.spilu(a.tocsc(), drop_tol=1e-4, fill_factor=5)
+            pre = spla.LinearOperator((m, m), ilu.solve)
+        count = [0]
+
+        def _count(_xk: np.ndarray) -> None:
+            count[0] += 1
+
+        sol, _info = spla.bicgstab(a, b, x0=x0, rtol=tol, atol=0.0, maxiter=max_iter, M=pre,
+                                   callback=_count)
+        it = count[0]
+    bn = float(np.linalg.norm(b)) or 1.0
+    return sol, int(it), float(np.linalg.norm(b - a @ sol)) / bn
+
+
+def isph_dt(v2max: float, a2max: float, prm: Any, v_ref: float = 0.0) -> float:
+    """dt = min(cfl h / max(|v|_max, v_ref), 0.25 sqrt(h / max|a*|), 0.125 h^2 / nu): no sound
+    speed; v_ref is the scene's own speed scale sqrt(2 g H) (Lind et al. 2012 take the step
+    from such an a-priori speed)."""
+    h = prm.h
+    dt = math.inf
+    v = max(math.sqrt(v2max), v_ref)
+    if v > 0.0:
+        dt = prm.cfl * h / v
+    if a2max > 0.0:
+        dt = min(dt, 0.25 * math.sqrt(h / math.sqrt(a2max)))
+    if prm.nu > 0.0:
+        dt = min(dt, 0.125 * h * h / prm.nu)
+    return dt
+
+
+class IsphStepper:
+    """The ISPH time loop of one Simulation: same call and returns as ``step.run``, plus the PPE
+    statistics (``ppe_iterations``, ``ppe_solves``, ``ppe_unknowns``, ``solve_time``)."""
+
+    def __init__(self, capacity: int, prm: Any, dp: float, solver: str = "amg",
+                 tolerance: float = 1e-5, max_iter: int = 20000, free_surface: str = "density",
+                 fs_threshold: float | None = None, shifting: bool = True,
+                 gradient: str = "corrected", v_ref: float = 0.0,
+                 density_relaxation: float = 0.0) -> None:
+        if solver not in PPE_SOLVERS:
+            raise ValueError(f"ppe_solver: one of {PPE_SOLVERS}, got {solver!r}")
+        self.prm = prm
+        self.solver = solver
+        self.tol = float(tolerance)
+        self.max_iter = int(max_iter)
+        self.by_density = free_surface == "density"
+        self.fs_threshold = float(fs_threshold if fs_threshold is not None
+                                  else FS_DEFAULT_THRESHOLD[free_surface])
+        self.shifting = bool(shifting) and prm.shift_a > 0.0
+        self.corrected = gradient == "corrected"
+        self.v_ref = float(v_ref)
+        # a typical fluid diagonal sum_j B_ij ~ (2 / rho0) sum_j V_j F_ij = 7 / (rho0 h^2): the
+        # scale of the wall rows
+        self.wscale = 7.0 / (prm.rho0 * prm.h * prm.h)
+        cap = int(capacity)
+        self.flag = np.zeros(cap, dtype=np.int8)
+        self.rho_k = np.zeros(cap)
+        self.rho_ref = 0.0
+        self.relax = float(density_relaxation)
+        # the relaxation's time scale: the nominal step cfl h / v_ref, not the actual dt (with
+        # 1/dt^2 a shrinking step strengthened it, which shrank the step further: the dam break
+        # blew up within 0.005 s)
+        self.dt_ref = prm.cfl * prm.h / v_ref if v_ref > 0.0 else 0.25 * math.sqrt(
+            prm.h / math.hypot(prm.gx, prm.gz))
+        self.wsum = np.zeros(cap)
+        self.dwall = np.zeros(cap)
+        self.idx = np.zeros(cap, dtype=np.int64)
+        self.slot = np.zeros(cap, dtype=np.int64)
+        self.indptr = np.arange(cap + 1, dtype=np.int64) * MAX_ROW
+        self.ptr = np.zeros(cap + 1, dtype=np.int64)
+        self.indices = np.zeros(cap * MAX_ROW, dtype=np.int64)
+        self.data = np.zeros(cap * MAX_ROW)
+        self.b = np.zeros(cap)
+        self.x0 = np.zeros(cap)
+        self.x2 = np.zeros(cap)
+        self.ppe_iterations = 0
+        self.ppe_solves = 0
+        self.ppe_unknowns = 0
+        self.ppe_max_residual = 0.0
+        self.solve_time = 0.0
+
+    # --------------------------------------------------------------- set-up
+    def initialise(self, ps: Any, ps2: Any, cells: Any, n: int) -> tuple[float, int]:
+        """Sort the initial state into ``ps2`` (the caller swaps); returns (dt, n)."""
+        n = sort_by_cell(ps, ps2, N_SORTED_KDK, n, cells)
+        g2 = self.prm.gx ** 2 + self.prm.gz ** 2
+        return isph_dt(0.0, g2, self.prm, self.v_ref), int(n)
+
+    # --------------------------------------------------------------- one step
+    def _solve(self, ps: Any, n: int, cells: Any, dt: float) -> None:
+        prm = self.prm
+        m = ppe_unknowns(ps, n, self.flag, self.wsum, self.idx)
+        longest = ppe_assemble(ps, n, cells, prm, dt, self.idx, self.wsum, self.dwall,
+                               self.wscale, self.indptr, self.indices, self.data, self.b, self.x0,
+                               self.slot, self.rho_k, self.rho_ref,
+                               self.relax / (self.dt_ref * self.dt_ref))
+        if longest >= MAX_ROW:  # a row lost terms: the particles are far denser than the lattice
+            raise RuntimeError(f"ISPH: a PPE row has more than {MAX_ROW - 1} neighbours")
+        compact_rows(m, self.indptr, self.indices, self.data, self.ptr)
+        tic = time.perf_counter()
+        sol, it, rel = solve_ppe(self.solver, m, self.ptr, self.indices, self.data, self.b[:m],
+                                 self.x0[:m], self.tol, self.max_iter, self.x2)
+        self.solve_time += time.perf_counter() - tic
+        self.ppe_iterations += int(it)
+        self.ppe_solves += 1
+        self.ppe_unknowns = int(m)
+        self.ppe_max_residual = max(self.ppe_max_residual, float(rel))
+        scatter_pressure(ps, m, self.slot, np.ascontiguousarray(sol), self.flag[:n])
+
+    def step(self, ps: Any, ps2: Any, cells: Any, n: int, dt: float) -> tuple[int, int, int, float, float]:
+        """One projection step from the sorted state ``ps``; the state ends sorted in ``ps2``.
+        Returns (n, n_bad, n_out, max |v|^2, max |a*|^2)."""
+        prm = self.prm
+        free_surface_flags(ps, n, cells, prm, self.by_density, self.fs_threshold, self.flag,
+                           self.rho_k)
+        if self.rho_ref == 0.0:  # the initial lattice's interior kernel density (~1.006 rho0)
+            inner = self.flag[:n] == 0
+            self.rho_ref = float(np.median(self.rho_k[:n][inner])) if inner.any() else prm.rho0
+        wall_state(ps, n, cells, prm, dt, self.wsum, self.dwall)
+        a2 = predict(ps, n, cells, prm, dt)
+        self._solve(ps, n, cells, dt)
+        n_bad, n_out, v2 = correct(ps, n, cells, prm, dt, self.corrected)
+        n = sort_by_cell(ps, ps2, N_SORTED_KDK, n, cells)
+        if self.shifting:
+            shift_particles(ps2, n, cells, prm, dt)
+        return int(n), int(n_bad), int(n_out), float(v2), float(a2)
+
+    def run(self, ps: Any, ps2: Any, cells: Any, n: int, t: float, dt: float, t_stop: float,
+            max_steps: int) -> tuple[float, float, int, int, int, int, float, int]:
+        """Steps until t reaches t_stop or max_steps were taken, or a guard trips; returns as
+        ``step.run``: (t, dt_next, steps, status, swapped, n_flagged, v_max, n)."""
+        swapped = 0
+        steps = 0
+        status = ST_REACHED_T
+        n_flag = 0
+        v2 = 0.0
+        while True:
+            if t >= t_stop:
+                status = ST_REACHED_T
+                break
+            if steps >= max_steps:
+                status = ST_STEP_LIMIT
+                break
+            dts = dt
+            last = t + dts >= t_stop
+            if last:
+                dts = t_stop - t
+            n, n_bad, n_out, v2, a2 = self.step(ps, ps2, cells, n, dts)
+            ps, ps2 = ps2, ps
+            swapped = 1 - swapped
+            t = t_stop if last else t + dts
+            steps += 1
+            if n_bad:
+                status, n_flag = ST_NONFINITE, n_bad
+                break
+            if n_out:
+                status, n_flag = ST_LEFT_DOMAIN, n_out
+                break
+            dt = isph_dt(v2, a2, self.prm, self.v_ref)
+        return t, dt, steps, status, swapped, n_flag, math.sqrt(v2), n
+
+    def stats(self) -> dict[str, Any]:
+        """PPE statistics since the start (for meta.json and the benches)."""
+        s = max(self.ppe_solves, 1)
+        return {"ppe_solver": self.solver, "ppe_solves": self.ppe_solves,
+                "ppe_iterations_per_step": self.ppe_iterations / s,
+                "ppe_unknowns": self.ppe_unknowns, "ppe_max_residual": self.ppe_max_residual,
+                "ppe_solve_time_s": round(self.solve_time, 3)}
