@@ -74,7 +74,7 @@ def still(scheme: dict, t_end: float) -> dict:
             "particle_steps_per_s": sim.n_particles * sim.steps / wall, **_ppe(sim)}
 
 
-def dambreak(scheme: dict, res: int = 20) -> dict:
+def dambreak_run(scheme: dict, res: int = 20) -> dict:
     t_end = 6.0 / math.sqrt(2 * 9.81 / A)
     dp = A / res
     base = dambreak_scene(a=A, dp=dp, t_end=t_end, tank_length=5 * A,
@@ -140,7 +140,7 @@ def main() -> None:
     schemes = [s for s in ({"kind": "wcsph"}, isph) if s["kind"] in a.schemes.split(",")]
     if "dambreak" in cases:
         for sch in schemes:
-            print(json.dumps(dambreak(sch)), flush=True)
+            print(json.dumps(dambreak_run(sch)), flush=True)
     if "obstacle" in cases:
         for sch in schemes:
             print(json.dumps(obstacle(sch, 0.5)), flush=True)

@@ -26,7 +26,7 @@ from scipy.signal import butter, sosfiltfilt
 from sph_core.scene import Scene, make_scene
 from sph_core.simulation import Simulation
 
-TANK_LENGTH = 1.6
+OBSTACLE_TANK_LENGTH = 1.6
 COLUMN = (0.4, 0.3)          # water column length, height [m]
 STRUCTURE = (0.9, 1.02, 0.75)  # front face x, back face x, top z [m]
 
@@ -38,7 +38,7 @@ def obstacle_scene(dp: float = 0.01, t_end: float = 1.5, scheme: dict | None = N
     constants.setdefault("alpha", 0.1)   # the dam-break value of cases.dambreak (WCSPH only)
     return make_scene({
         "name": "dambreak_obstacle", "dp": dp, "t_end": t_end,
-        "tank": {"x0": 0.0, "x1": TANK_LENGTH, "z0": 0.0, "z1": top},
+        "tank": {"x0": 0.0, "x1": OBSTACLE_TANK_LENGTH, "z0": 0.0, "z1": top},
         "water_blocks": [{"x0": 0.0, "x1": COLUMN[0], "z0": 0.0, "z1": COLUMN[1]}],
         "structures": [{"x0": x0, "x1": x1, "z0": 0.0, "z1": top}],
         "constants": constants,

@@ -25,7 +25,7 @@ from sph_core.scene import Scene, make_scene
 
 from .dambreak import DAMBREAK_ALPHA
 
-TANK_LENGTH = 1.61    # [m]
+LOBOVSKY_TANK_LENGTH = 1.61    # [m]
 TANK_HEIGHT = 0.6     # [m], the experiment's
 # the model's walls rise higher: in 2D the run-up jet on the far wall passes 0.6 m from t = 0.64 s
 # (dp 0.008, no wall viscosity) and particles over the top would be excluded, as in
@@ -38,7 +38,7 @@ LOBOVSKY_SENSOR1 = Path(__file__).resolve().parents[1] / "tests" / "data" / "lob
 
 
 def lobovsky_scene(dp: float = 0.004, t_end: float = 2.0, probe_every: float = 2.5e-4,
-                   snapshot_every: float = 0.0, tank_length: float = TANK_LENGTH,
+                   snapshot_every: float = 0.0, tank_length: float = LOBOVSKY_TANK_LENGTH,
                    wall_height: float = WALL_HEIGHT, **constants) -> Scene:
     """The H = 300 mm dam break with the far-wall sensors as a ``pressure_line`` named ``wall``
     (points on the wall face x = tank_length) and the wall's horizontal force (``force`` probe

@@ -12,7 +12,7 @@ import math
 import tomllib
 from collections import Counter
 from pathlib import Path
-from typing import Annotated, Literal, Union
+from typing import Annotated, Any, Literal, Union
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
@@ -191,6 +191,9 @@ class Constants(_Model):
         if not (0 < lo < 1 < hi):
             raise ValueError("density_band: must satisfy 0 < low < 1 < high")
         return self
+
+
+ISPH_H_OVER_DP = 1.4142   # h/dp of an ISPH scene that sets none (Scene._scheme_h)
 
 
 class Scheme(_Model):
@@ -396,6 +399,19 @@ class Scene(_Model):
     probes: list[Probe] = []
     open_boundaries: list[OpenBoundary] = []
     bodies: list[Body] = []
+
+    @model_validator(mode="before")
+    @classmethod
+    def _scheme_h(cls, data: Any) -> Any:
+        # ISPH was built and measured at h/dp sqrt 2; at the WCSPH default h/dp 2 its still tank
+        # (d/dp 10) reaches 0.045 m/s in 0.2 s against 0.009 (corner particles creep inward), so an
+        # ISPH scene without its own h_over_dp gets sqrt 2
+        if isinstance(data, dict):
+            scheme, cst = data.get("scheme") or {}, data.get("constants") or {}
+            kind = scheme.get("kind") if isinstance(scheme, dict) else getattr(scheme, "kind", None)
+            if kind == "isph" and isinstance(cst, dict) and "h_over_dp" not in cst:
+                data = {**data, "constants": {**cst, "h_over_dp": ISPH_H_OVER_DP}}
+        return data
 
     @model_validator(mode="after")
     def _consistent(self) -> "Scene":
