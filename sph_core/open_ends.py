@@ -23,7 +23,7 @@ from typing import Mapping
 
 import numpy as np
 
-from .absorption import absorption_gain, source_period
+from .absorption import absorption_filter, source_period
 from .boundary_data import (BoundaryData, BoundaryDataError, BoundaryNodes, BoundarySample,
                             still_sample, validate_sample)
 from .eos import GAMMA, hydrostatic_density
@@ -38,11 +38,12 @@ SIDES = ("left", "right")
 @dataclass
 class OpenState:
     """What a checkpoint keeps of the open ends beyond the particles: gauges, counters, the
-    samples at the window start."""
+    samples at the window start, the absorption filter's state."""
 
     eta_meas: np.ndarray
     counters: np.ndarray
     samples: dict[str, BoundarySample]
+    filt_x: np.ndarray
 
 
 class OpenBoundaries:
@@ -116,7 +117,8 @@ class OpenBoundaries:
             e.nx[b] = -1.0 if b == 0 else 1.0
             e.swl[b] = swl
             period = o.absorption_period or source_period(sources.get(o.side))
-            e.sqgd[b] = absorption_gain(o.absorption, c.g, depth, period)
+            e.sqgd[b], e.filt_tau[b], e.filt_c[b] = absorption_filter(
+                o.absorption, c.g, depth, abs(nd.x_gauge - nd.x_face), period)
             e.absorb[b] = o.absorb
             e.imposed[b] = o.elevation == "imposed"
             e.ghost[b] = buffer_pressure(o) == "extrapolated"
@@ -225,7 +227,8 @@ class OpenBoundaries:
     def state(self) -> OpenState | None:
         if not self.active:
             return None
-        return OpenState(self.ends.eta_meas.copy(), self.ends.counters.copy(), dict(self.samples))
+        return OpenState(self.ends.eta_meas.copy(), self.ends.counters.copy(), dict(self.samples),
+                         self.ends.filt_x.copy())
 
     def set_state(self, s: OpenState | None) -> None:
         if s is None:
@@ -233,6 +236,7 @@ class OpenBoundaries:
         self.ends.eta_meas[:] = s.eta_meas
         self.ends.counters[:] = s.counters
         self.samples = dict(s.samples)
+        self.ends.filt_x[:] = s.filt_x
 
 
 def buffer_pressure(o: OpenBoundary) -> str:
