@@ -82,7 +82,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--periods", type=float, default=5.0, help="periods measured after the ramp")
     ap.add_argument("--ramp-periods", type=float, default=1.0)
     ap.add_argument("--no-absorb", action="store_true", help="switch the seed 002 correction off")
-    ap.add_argument("--absorption", choices=ABSORPTION_KINDS, nargs="+", default=["linear"],
+    ap.add_argument("--absorption", choices=ABSORPTION_KINDS, nargs="+", default=["filter"],
                     help="gain of the correction (sph_core.absorption; several: one run each)")
     ap.add_argument("--h-over-dp", type=float, help="smoothing length / dp (default: the scene's)")
     ap.add_argument("--alpha-wall", type=float, help="wall viscosity factor (scene default)")
