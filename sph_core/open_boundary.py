@@ -14,8 +14,8 @@ Every step, for buffer particle i of end b (the window [t0, t1] holds the source
 interpolated linearly in time and linearly in z between the nodes):
     u_i = u(z_i, t) + du_b,  w_i = w(z_i, t),  x_i += dt u_i       (z_i fixed: layers stay level)
     du_b = n_x (eta_meas,b - eta_gauge,b(t)) G  if absorbing   (seed 002 correction; the gain G
-           in the ends' sqgd: sqrt(g/d) there, omega/(k d) by default, see sph_core.absorption;
-           or a causal filter of e following omega/(k d) per frequency, absorption "filter")
+           in the ends' sqgd: sqrt(g/d) there, omega/(k d) "linear", see sph_core.absorption;
+           by default a causal filter of e following omega/(k d) per frequency, "filter")
     surface z_s,b = swl + eta_b(t)  (elevation imposed)  or  swl + eta_meas,b  (extrapolated)
     active (interacts as fluid) iff z_i < z_s,b;  rho_i = rho0 (1 + rho0 g (z_s,b - z_i)/B)^(1/7)
     (hydrostatic below the imposed or measured surface; Tait EOS, same form as the initial state),
