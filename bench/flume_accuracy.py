@@ -3,6 +3,8 @@
     python bench/flume_accuracy.py --case III [--dp 0.01] [--periods 5] [--no-absorb]
     python bench/flume_accuracy.py --theory stokes --H 0.08 --T 2.0 --d 1.0 --dp 0.01
     python bench/flume_accuracy.py --theory stokes2 --H 0.02 --d 0.2 --kd 1.2 --absorption shallow
+    python bench/flume_accuracy.py --theory stream_function --H 0.02 --d 0.2 --dp 0.005 \
+        --kd 1.2 2.0 --absorption linear filter --h-over-dp 2 --alpha-wall 0   # one line each
 
 Runs one case of the seed 002 validation table (tests/data/wave_cases_seed002.csv, cases I-VI)
 or any regular wave through a flume one wavelength long (standing wave: half a wavelength, faces
@@ -13,7 +15,8 @@ of mid-flume with a fitted spatial decay of both waves: the coarse flume damps i
 fit without decay reads that as reflection), reflection_3g (the plain fit over mid-flume and L/8
 either side), reflection_harmonics (Mansard & Funke per harmonic, first and bound second, nine
 gauges with decay), none for the standing wave; absorption (the open ends' gain: linear
-omega/(k d) at the wave period, or the seed 002 shallow sqrt(g/d); sph_core.absorption), kd; wall_s, particles, steps, particle_steps_per_s,
+omega/(k d) at the wave period, the seed 002 shallow sqrt(g/d), or the filter following
+omega/(k d) per frequency; sph_core.absorption), kd; wall_s, particles, steps, particle_steps_per_s,
 boundary counts, the mean water level at mid-flume (mean_level_m), the change of the flume's
 water volume per length since the start (level_drift_m) and the gauges' mean level over the
 last period (level_last_period_m).
@@ -29,6 +32,7 @@ import sys
 from pathlib import Path
 
 from cases.wave_flume import flume_case
+from sph_core.absorption import ABSORPTION_KINDS
 from wave_client.theories import build_theory, wavenumber
 
 CASES_CSV = Path(__file__).resolve().parents[1] / "tests" / "data" / "wave_cases_seed002.csv"
@@ -50,7 +54,7 @@ def case_theory(theory: str, height: float, period: float, depth: float, ramp: f
 
 def run_flume_case(theory: str, height: float, period: float, depth: float, dp: float, periods: float,
                    ramp_periods: float = 1.0, absorb: bool = True, case: str | None = None,
-                   absorption: str = "linear") -> dict:
+                   absorption: str = "linear", **constants) -> dict:
     ramp = ramp_periods * period
     model = case_theory(theory, height, period, depth, ramp)
     if theory == "irregular":  # flume length and gauges from the peak wave
@@ -60,8 +64,8 @@ def run_flume_case(theory: str, height: float, period: float, depth: float, dp: 
     out = flume_case(model, height=height, period=period, depth=depth, wavelength=wavelength,
                      dp=dp, periods=periods, ramp=ramp, standing=theory == "standing",
                      absorb=(absorb, absorb), regular=theory != "irregular",
-                     name=f"flume_{case or theory}", absorption=absorption)
-    return {"case": case, "theory": theory, **out}
+                     name=f"flume_{case or theory}", absorption=absorption, **constants)
+    return {"case": case, "theory": theory, **constants, **out}
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -72,30 +76,38 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--H", type=float)
     ap.add_argument("--T", type=float)
     ap.add_argument("--d", type=float)
-    ap.add_argument("--kd", type=float, help="instead of --T: the period of linear waves of this "
-                                             "kd in depth --d")
+    ap.add_argument("--kd", type=float, nargs="+", help="instead of --T: the period of linear "
+                    "waves of this kd in depth --d (several: one run and line each)")
     ap.add_argument("--dp", type=float, help="particle spacing [m] (default: H/10)")
     ap.add_argument("--periods", type=float, default=5.0, help="periods measured after the ramp")
     ap.add_argument("--ramp-periods", type=float, default=1.0)
     ap.add_argument("--no-absorb", action="store_true", help="switch the seed 002 correction off")
-    ap.add_argument("--absorption", choices=("linear", "shallow"), default="linear",
-                    help="gain of the correction (sph_core.absorption)")
+    ap.add_argument("--absorption", choices=ABSORPTION_KINDS, nargs="+", default=["filter"],
+                    help="gain of the correction (sph_core.absorption; several: one run each)")
+    ap.add_argument("--h-over-dp", type=float, help="smoothing length / dp (default: the scene's)")
+    ap.add_argument("--alpha-wall", type=float, help="wall viscosity factor (scene default)")
     a = ap.parse_args(argv)
+    constants = {k: v for k, v in (("h_over_dp", a.h_over_dp), ("alpha_wall_factor", a.alpha_wall))
+                 if v is not None}
     if a.case:
         row = read_cases()[a.case]
         theory = row["theory"]
-        height, period, depth = float(row["H"]), float(row["T"]), float(row["d"])
+        height, depth = float(row["H"]), float(row["d"])
+        periods_s = [float(row["T"])]
     elif a.theory and a.H and a.d and (a.T or a.kd):
         theory, height, depth = a.theory, a.H, a.d
-        period = a.T if a.T else 2 * math.pi / math.sqrt(9.81 * a.kd / a.d * math.tanh(a.kd))
+        periods_s = [a.T] if a.T else [2 * math.pi / math.sqrt(9.81 * kd / a.d * math.tanh(kd))
+                                       for kd in a.kd]
         if theory.startswith("stokes") and theory not in THEORY_OF:
             THEORY_OF[theory] = ("stokes", {"order": int(theory[-1])})
     else:
         ap.error("give --case, or --theory with --H --d and --T or --kd")
     dp = a.dp if a.dp else height / 10.0
-    out = run_flume_case(theory, height, period, depth, dp, a.periods, a.ramp_periods, not a.no_absorb,
-                         a.case, a.absorption)
-    print(json.dumps(out), flush=True)
+    for period in periods_s:
+        for absorption in a.absorption:
+            out = run_flume_case(theory, height, period, depth, dp, a.periods, a.ramp_periods,
+                                 not a.no_absorb, a.case, absorption, **constants)
+            print(json.dumps(out), flush=True)
     return 0
 
 

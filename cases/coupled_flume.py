@@ -148,7 +148,8 @@ def _tank_end(c: FlumeCase, x_toe: float, dp: float) -> float:
 
 
 def _sph_scene(c: FlumeCase, dp: float, t_end: float, x_toe: float, gauges: dict[str, float],
-               name: str, absorb: bool) -> dict[str, Any]:
+               name: str, absorb: bool, constants: dict[str, Any] | None = None
+               ) -> dict[str, Any]:
     d = c.depth
     x1 = _tank_end(c, x_toe, dp)
     return {
@@ -170,18 +171,20 @@ def _sph_scene(c: FlumeCase, dp: float, t_end: float, x_toe: float, gauges: dict
         # dp = 0.02 (late start, absorption-only) a run-up jet threw a particle over the tank
         # top at t = 15.6 s; no-slip ran through. Measured at the flat gauge (dp = 0.01,
         # absorption-only): RMSE/H 4.95 % no-slip, 6.0 % free slip.
-        "constants": {"c0": 10.0 * math.sqrt(G * d), "wall_slip": "no_slip"},
+        "constants": {"c0": 10.0 * math.sqrt(G * d), "wall_slip": "no_slip", **(constants or {})},
         "output": {"probe_every": c.period / 20},
         "probes": [{"kind": "elevation", "name": n, "x": x} for n, x in gauges.items()],
         "open_boundaries": [{"side": "left", "elevation": "imposed", "absorb": absorb}],
     }
 
 
-def sph_zone_scene(c: FlumeCase, dp: float, absorb: bool = False) -> dict[str, Any]:
+def sph_zone_scene(c: FlumeCase, dp: float, absorb: bool = False,
+                   constants: dict[str, Any] | None = None) -> dict[str, Any]:
     """The SPH zone of the coupled flume (server scene): inlet at SPH x = 0 (model x_c),
-    clock from ``c.t_sph_start``."""
+    clock from ``c.t_sph_start``; ``constants`` override the scene's (e.g. h_over_dp)."""
     c = c.at(dp)
-    scene = _sph_scene(c, dp, c.t_end, c.x_flat, c.gauges, "coupled-flume-sph-zone", absorb)
+    scene = _sph_scene(c, dp, c.t_end, c.x_flat, c.gauges, "coupled-flume-sph-zone", absorb,
+                       constants)
     return {**scene, "t_start": round(c.t_sph_start, 6)}
 
 
@@ -299,12 +302,14 @@ def _gauges_csv(path: Path) -> tuple[np.ndarray, dict[str, np.ndarray]]:
 
 
 def run_coupled(c: FlumeCase, dp: float, out: Path, two_way: bool = True,
-                transport: str = "ws", absorb: str | None = None) -> dict[str, Any]:
+                transport: str = "ws", absorb: str | None = None,
+                constants: dict[str, Any] | None = None) -> dict[str, Any]:
     """The coupled flume over a real socket: in-process server, the client as `wavesph couple
     --model boussinesq --config <out>/wave_scene.toml [--absorb]` runs it. Figures and series.
 
     absorb: who absorbs the beach's reflection at the SPH inlet; exactly one absorber, or the
-    gain doubles (docs/ARCHITECTURE.md). Default: "none" for two-way, "client" otherwise.
+    gain doubles (docs/ARCHITECTURE.md). Default: "incident" for two-way (measured best,
+    docs/absorption.md), "client" otherwise. ``constants`` override the SPH scene's.
       "none": two-way only: the model's characteristic boundary takes SPH's reflected wave
         L = (eta - u_ref / r) / 2 and hands it back in the inlet data, so the inlet passes it.
       "client": `wavesph couple --absorb`; mismatch = the inlet gauge's reading minus the
@@ -320,7 +325,7 @@ def run_coupled(c: FlumeCase, dp: float, out: Path, two_way: bool = True,
         Measured (dp = 0.02, two-way, so also doubled): the SPH wave led the reference by
         0.25 rad and was 9 % low, RMSE/H 12 %. Kept to show it (bench --absorb sph).
     """
-    absorb = absorb or ("none" if two_way else "client")
+    absorb = absorb or ("incident" if two_way else "client")
     if absorb not in ("none", "client", "incident", "sph"):
         raise ValueError(f"absorb: 'none', 'client', 'incident' or 'sph', got {absorb!r}")
     import httpx
@@ -340,7 +345,7 @@ def run_coupled(c: FlumeCase, dp: float, out: Path, two_way: bool = True,
     tic = time.perf_counter()
     with InProcessServer(out) as srv, httpx.Client(base_url=f"http://127.0.0.1:{srv.port}",
                                                    timeout=60) as http:
-        r = http.post("/runs", json={"scene": sph_zone_scene(c, dp, absorb == "sph"),
+        r = http.post("/runs", json={"scene": sph_zone_scene(c, dp, absorb == "sph", constants),
                                      "mode": "coupled",
                                      "coupling": {"window_max": c.window, "z_ref": z_ref}})
         r.raise_for_status()

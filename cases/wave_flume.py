@@ -41,7 +41,7 @@ def wave_flume_scene(*, depth: float, wavelength: float, height: float, dp: floa
                      length: float | None = None, absorb: tuple[bool, bool] = (True, True),
                      right_elevation: str = "extrapolated", probe_every: float = 0.02,
                      c0: float | None = None, g: float = 9.81, name: str = "wave_flume",
-                     absorption: str = "linear", left_pressure: str | None = None,
+                     absorption: str = "filter", left_pressure: str | None = None,
                      scheme: dict | None = None,
                      **constants: Any) -> Scene:
     """A flat-bed flume [0, length] x [0, top] (floor z = 0, still water at z = depth) with open
@@ -126,7 +126,7 @@ def run_wave_flume(scene: Scene, model: Any, *, window: float, x_model_left: flo
 def flume_case(model: Any, *, height: float, period: float, depth: float, wavelength: float,
                dp: float, periods: float, ramp: float, standing: bool = False,
                absorb: tuple[bool, bool] = (True, True), window_per_period: int = 50,
-               regular: bool = True, name: str = "wave_flume", absorption: str = "linear",
+               regular: bool = True, name: str = "wave_flume", absorption: str = "filter",
                **constants: Any) -> dict[str, Any]:
     """Run one wave case and score it: the figures of ``bench/flume_accuracy.py``.
 

@@ -14,7 +14,8 @@ Every step, for buffer particle i of end b (the window [t0, t1] holds the source
 interpolated linearly in time and linearly in z between the nodes):
     u_i = u(z_i, t) + du_b,  w_i = w(z_i, t),  x_i += dt u_i       (z_i fixed: layers stay level)
     du_b = n_x (eta_meas,b - eta_gauge,b(t)) G  if absorbing   (seed 002 correction; the gain G
-           in the ends' sqgd: sqrt(g/d) there, omega/(k d) by default, see sph_core.absorption)
+           in the ends' sqgd: sqrt(g/d) there, omega/(k d) "linear", see sph_core.absorption;
+           by default a causal filter of e following omega/(k d) per frequency, "filter")
     surface z_s,b = swl + eta_b(t)  (elevation imposed)  or  swl + eta_meas,b  (extrapolated)
     active (interacts as fluid) iff z_i < z_s,b;  rho_i = rho0 (1 + rho0 g (z_s,b - z_i)/B)^(1/7)
     (hydrostatic below the imposed or measured surface; Tait EOS, same form as the initial state),
@@ -107,14 +108,26 @@ def window_weight(t, win_t):
 
 
 @njit(cache=True)
-def boundary_state(b, r, ends):
-    """(z_s, du) of end b: the surface the buffer uses and the absorption velocity correction."""
+def boundary_state(b, r, dt, ends):
+    """(z_s, du) of end b: the surface the buffer uses and the absorption velocity correction
+    du = n_x [G e + sum_j c_j x_j], e = eta_meas - eta_gauge, each x_j the mismatch low-passed
+    with time constant tau_j (advanced by dt here, exactly for e constant over the step; all
+    c_j = 0 for a plain gain; sph_core.absorption). A dry gauge counts as no mismatch."""
     eta_th = (1.0 - r) * ends.win_eta[b, 0] + r * ends.win_eta[b, 1]
     etag_th = (1.0 - r) * ends.win_etag[b, 0] + r * ends.win_etag[b, 1]
     em = ends.eta_meas[b]
     du = 0.0
-    if ends.absorb[b] and math.isfinite(em):
-        du = ends.nx[b] * (em - etag_th) * ends.sqgd[b]
+    if ends.absorb[b]:
+        e = em - etag_th if math.isfinite(em) else 0.0
+        du = ends.sqgd[b] * e
+        for j in range(ends.filt_c.shape[1]):
+            c = ends.filt_c[b, j]
+            if c != 0.0:
+                xj = ends.filt_x[b, j]
+                xj += (e - xj) * (1.0 - math.exp(-dt / ends.filt_tau[b, j]))
+                ends.filt_x[b, j] = xj
+                du += c * xj
+        du *= ends.nx[b]
     eta = eta_th
     if not ends.imposed[b] and math.isfinite(em):
         eta = em
@@ -242,8 +255,8 @@ def update_buffers(ps, n, t1, dt, ends, prm):
     if not ends.active:
         return n
     r = window_weight(t1, ends.win_t)
-    zs0, du0 = boundary_state(0, r, ends)
-    zs1, du1 = boundary_state(1, r, ends)
+    zs0, du0 = boundary_state(0, r, dt, ends)
+    zs1, du1 = boundary_state(1, r, dt, ends)
     ends.zs[0] = zs0
     ends.zs[1] = zs1
     buffer_update(ps, n, dt, r, zs0, du0, zs1, du1, ends, prm)

@@ -23,7 +23,7 @@ from typing import Mapping
 
 import numpy as np
 
-from .absorption import absorption_gain, source_period
+from .absorption import absorption_filter, source_period
 from .boundary_data import (BoundaryData, BoundaryDataError, BoundaryNodes, BoundarySample,
                             still_sample, validate_sample)
 from .eos import GAMMA, hydrostatic_density
@@ -38,11 +38,12 @@ SIDES = ("left", "right")
 @dataclass
 class OpenState:
     """What a checkpoint keeps of the open ends beyond the particles: gauges, counters, the
-    samples at the window start."""
+    samples at the window start, the absorption filter's state."""
 
     eta_meas: np.ndarray
     counters: np.ndarray
     samples: dict[str, BoundarySample]
+    filt_x: np.ndarray
     zs: np.ndarray | None = None   # the buffers' surfaces (None in checkpoints made before it)
 
 
@@ -118,7 +119,8 @@ class OpenBoundaries:
             e.swl[b] = swl
             e.zs[b] = swl   # at rest until the first update
             period = o.absorption_period or source_period(sources.get(o.side))
-            e.sqgd[b] = absorption_gain(o.absorption, c.g, depth, period)
+            e.sqgd[b], e.filt_tau[b], e.filt_c[b] = absorption_filter(
+                o.absorption, c.g, depth, abs(nd.x_gauge - nd.x_face), period)
             e.absorb[b] = o.absorb
             e.imposed[b] = o.elevation == "imposed"
             e.ghost[b] = buffer_pressure(o) == "extrapolated"
@@ -228,7 +230,7 @@ class OpenBoundaries:
         if not self.active:
             return None
         return OpenState(self.ends.eta_meas.copy(), self.ends.counters.copy(), dict(self.samples),
-                         self.ends.zs.copy())
+                         self.ends.filt_x.copy(), self.ends.zs.copy())
 
     def set_state(self, s: OpenState | None) -> None:
         if s is None:
@@ -238,6 +240,7 @@ class OpenBoundaries:
         if s.zs is not None:
             self.ends.zs[:] = s.zs
         self.samples = dict(s.samples)
+        self.ends.filt_x[:] = s.filt_x
 
 
 def buffer_pressure(o: OpenBoundary) -> str:

@@ -355,12 +355,14 @@ class OpenBoundary(_Model):
     normal (-1 left, +1 right). The gauge stands ``gauge_offset`` [m] inside the face (default 2h).
     ``absorption`` picks the correction's gain (``sph_core.absorption``): ``linear`` omega/(k d) at
     the wave period (``absorption_period``, else the source theory's period; sqrt(g/d) when
-    neither is known), ``shallow`` the seed 002 sqrt(g/d) at every kd."""
+    neither is known), ``shallow`` the seed 002 sqrt(g/d) at every kd, ``filter`` (default,
+    measured best: docs/absorption.md) a causal filter following omega/(k d) frequency by
+    frequency, delayed by the gauge's offset (exact at the wave period when one is known)."""
 
     side: Literal["left", "right"]
     elevation: Literal["imposed", "extrapolated"] = "imposed"
     absorb: bool = True
-    absorption: Literal["shallow", "linear"] = "linear"
+    absorption: Literal["shallow", "linear", "filter"] = "filter"
     absorption_period: float | None = Field(None, gt=0, description="wave period [s] of the "
                                             "linear absorption gain (None: the source's)")
     gauge_offset: float | None = Field(None, gt=0, description="boundary gauge distance inside the face [m]")

@@ -18,6 +18,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from .absorption import N_FILTER
 from .particles import (AX, AZ, DRHO, GPX, GPZ, GUX, GUZ, GWX, GWZ, M, P, RHO, RHON, VWX, VWZ, VX,
                         VXN, VZ, VZN, XN, ZN, X, Z)
 
@@ -146,6 +147,9 @@ class OpenEnds(NamedTuple):
     zs: np.ndarray        # [2] surface z_s of each buffer at its last update [m]
     counters: np.ndarray  # int64[2, 4]: C_IN, C_OUT, C_CREATED, C_REMOVED
     next_id: np.ndarray   # int64[1]: id of the next created particle
+    filt_tau: np.ndarray  # [2, N_FILTER] time constants of the absorption filter [s]
+    filt_c: np.ndarray    # [2, N_FILTER] its gains [1/s] (0: plain gain sqgd; sph_core.absorption)
+    filt_x: np.ndarray    # [2, N_FILTER] its state: the mismatch low-passed with each tau [m]
 
 
 def closed_ends(capacity: int, n_nodes: int = 2) -> OpenEnds:
@@ -157,4 +161,5 @@ def closed_ends(capacity: int, n_nodes: int = 2) -> OpenEnds:
                     np.tile(np.linspace(0.0, 1.0, n_nodes), (2, 1)), z2(),
                     np.zeros((2, 2, n_nodes)), np.zeros((2, 2, n_nodes)), np.zeros((2, 2)),
                     np.zeros((2, 2)), np.full(2, np.nan), z2(), np.zeros((2, 4), dtype=np.int64),
-                    np.zeros(1, dtype=np.int64))
+                    np.zeros(1, dtype=np.int64), np.ones((2, N_FILTER)),
+                    np.zeros((2, N_FILTER)), np.zeros((2, N_FILTER)))

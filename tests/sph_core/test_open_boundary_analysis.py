@@ -40,15 +40,15 @@ def test_seed_002_corrections_have_the_published_signs():
     v_out = v_th - (eta_th - eta_out,meas) sqrt(g/d)."""
     eta_th = np.array([[0.01, 0.01], [0.02, 0.02]])  # [end, window level]
     meas = np.array([0.03, 0.05])
-    zs_in, du_in = ob.boundary_state(0, 0.5, ends(eta_th, meas))
-    zs_out, du_out = ob.boundary_state(1, 0.5, ends(eta_th, meas))
+    zs_in, du_in = ob.boundary_state(0, 0.5, 1e-4, ends(eta_th, meas))
+    zs_out, du_out = ob.boundary_state(1, 0.5, 1e-4, ends(eta_th, meas))
     assert du_in == pytest.approx(-(0.03 - 0.01) * math.sqrt(G / D))
     assert du_out == pytest.approx(-(0.02 - 0.05) * math.sqrt(G / D))
     # inlet: imposed surface; outlet: extrapolated (measured) surface
     assert zs_in == pytest.approx(D + 0.01) and zs_out == pytest.approx(D + 0.05)
     # correction off, or a dry gauge (NaN): theory only
-    assert ob.boundary_state(0, 0.5, ends(eta_th, meas, absorb=False))[1] == 0.0
-    zs, du = ob.boundary_state(1, 0.5, ends(eta_th, np.array([np.nan, np.nan])))
+    assert ob.boundary_state(0, 0.5, 1e-4, ends(eta_th, meas, absorb=False))[1] == 0.0
+    zs, du = ob.boundary_state(1, 0.5, 1e-4, ends(eta_th, np.array([np.nan, np.nan])))
     assert du == 0.0 and zs == pytest.approx(D + 0.02)
 
 
