@@ -31,7 +31,7 @@ def warm_up(sim: Simulation) -> None:
     """Compile (or load) the time loop by a call that takes no step; its wall time is not
     counted as stepping."""
     if not kernels_cached():
-        print("compiling kernels (first run only, ~20 s) ...", file=sys.stderr, flush=True)
+        print("compiling kernels (first run only, ~1-2 min) ...", file=sys.stderr, flush=True)
     wall = sim.wall_time
     sim.advance_steps(0)
     sim.wall_time = wall
