@@ -41,14 +41,14 @@ import numpy as np  # noqa: E402
 
 from cases.dambreak import dambreak_scene, front_errors  # noqa: E402
 from cases.schemes import RIEMANN_VARIANTS  # noqa: E402
+from cases.sweeps import OLD_DEFAULTS  # noqa: E402
 
 # h/dp 2 without artificial viscosity against walls: the wave-decay study's best WCSPH options
 # (docs/wave_decay_study.md); every entry but the first uses them, so the schemes differ only in
 # the scheme
 BEST_WAVE = {"h_over_dp": 2.0, "alpha_wall_factor": 0.0}
-OLD_WCSPH = {"h_over_dp": 1.4142, "alpha_wall_factor": 1.0}
 ENTRIES: list[tuple[str, dict[str, Any]]] = [
-    ("wcsph_hsqrt2_wallav1", {"constants": OLD_WCSPH}),    # the defaults before this session
+    ("wcsph_hsqrt2_wallav1", {"constants": OLD_DEFAULTS}),  # the defaults before this session
     ("wcsph", {"constants": BEST_WAVE}),                   # = today's scene defaults
     *[(name, {"scheme": sch, "constants": BEST_WAVE}) for name, sch in RIEMANN_VARIANTS.items()],
     # ISPH runs at its own h/dp sqrt 2 (sph_core.scene.ISPH_H_OVER_DP); it refuses open ends, so

@@ -38,6 +38,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable, Iterable
 
+from sph_core.scene import ISPH_H_OVER_DP
+
 from .schemes import RIEMANN_VARIANTS
 
 # name -> sph_core.scene.Constants overrides, and "scheme": the scene's [scheme] table (every
@@ -64,7 +66,7 @@ METHODS: dict[str, dict[str, Any]] = {
     **{name: {"h_over_dp": 2.0, "alpha_wall_factor": 0.0, "scheme": sch}
        for name, sch in RIEMANN_VARIANTS.items()},
     # ISPH at its h/dp sqrt 2; it refuses open ends, so its flume points are "failed" with the reason
-    "isph_amg": {"h_over_dp": 1.4142, "alpha_wall_factor": 0.0,
+    "isph_amg": {"h_over_dp": ISPH_H_OVER_DP, "alpha_wall_factor": 0.0,
                  "scheme": {"kind": "isph", "ppe_solver": "amg"}},
 }
 # the coupled case's two ways to compute the same flume
