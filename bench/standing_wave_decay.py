@@ -3,7 +3,7 @@
     python bench/standing_wave_decay.py [--dp 0.02 0.01] [--h-over-dp 2] [--alpha 0.01]
         [--alpha-wall 1] [--slip no_slip|free_slip] [--delta 0.1] [--c0-factor 10] [--periods 6]
         [--cfl 0.25] [--nu 1e-6] [--shifting none|fickian] [--shift-a 2] [--shift-fs-div 1.8]
-        [--scheme wcsph|riemann] [--reconstruction muscl|none] [--limiter minmod|vanleer]
+        [--scheme wcsph|riemann|isph] [--reconstruction muscl|none] [--limiter minmod|vanleer]
         [--low-dissipation | --no-low-dissipation]
 
 The first sloshing mode of a tank half a wavelength long, the wave of bench/wave_decay.py

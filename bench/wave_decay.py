@@ -6,7 +6,7 @@
         [--cfl 0.25] [--integrator kdk|symplectic_pc] [--nu 1e-6] [--alpha-wall 1.0]
         [--shifting none|fickian] [--shift-a 2.0]
         [--shift-fs-div 1.8] [--flume-wavelengths 1]
-        [--scheme wcsph|riemann] [--reconstruction muscl|none] [--limiter minmod|vanleer]
+        [--scheme wcsph|riemann|isph] [--reconstruction muscl|none] [--limiter minmod|vanleer]
         [--low-dissipation | --no-low-dissipation]
 
 A flume one wavelength long with open ends driven by second-order Stokes theory (the wave of the

@@ -28,13 +28,16 @@ RIEMANN_VARIANTS: dict[str, dict[str, Any]] = {
 
 
 def add_scheme_arguments(ap: argparse.ArgumentParser) -> None:
-    """--scheme, --reconstruction, --limiter, --low-dissipation / --no-low-dissipation."""
-    ap.add_argument("--scheme", choices=["wcsph", "riemann"], default="wcsph",
+    """--scheme, --reconstruction, --limiter, --low-dissipation / --no-low-dissipation,
+    --ppe-solver."""
+    ap.add_argument("--scheme", choices=["wcsph", "riemann", "isph"], default="wcsph",
                     help="[scheme] kind (sph_core.scene.Scheme)")
     ap.add_argument("--reconstruction", choices=["muscl", "none"], help="riemann: reconstruction")
     ap.add_argument("--limiter", choices=["minmod", "vanleer"], help="riemann: MUSCL limiter")
     ap.add_argument("--low-dissipation", action=argparse.BooleanOptionalAction, default=None,
                     help="riemann: Zhang et al. 2017 dissipation limiter (scene default: on)")
+    ap.add_argument("--ppe-solver", choices=["explicit", "amg", "ilu", "direct"],
+                    help="isph: pressure Poisson solver (scene default: amg)")
 
 
 def scheme_from_args(a: argparse.Namespace) -> dict[str, Any]:
@@ -44,4 +47,6 @@ def scheme_from_args(a: argparse.Namespace) -> dict[str, Any]:
         out.update({k: v for k, v in {"reconstruction": a.reconstruction, "limiter": a.limiter,
                                       "low_dissipation": a.low_dissipation}.items()
                     if v is not None})
+    if a.scheme == "isph" and a.ppe_solver is not None:
+        out["ppe_solver"] = a.ppe_solver
     return out

@@ -29,7 +29,8 @@ from .boundary_data import (BoundaryData, BoundaryDataError, BoundaryNodes, Boun
 from .eos import GAMMA, hydrostatic_density
 from .open_boundary import INLET_IDLE
 from .particles import INLET, M, P, RHO, WALL, X, Z, ParticleSet
-from .scene import INLET_PRESSURE, OUTLET_PRESSURE, OpenBoundary, Scene
+from .scene import (INLET_PRESSURE, ISPH_INLET_PRESSURE, OUTLET_PRESSURE, OpenBoundary,
+                    Scene)
 from .state import OpenEnds, closed_ends
 
 SIDES = ("left", "right")
@@ -123,7 +124,7 @@ class OpenBoundaries:
                 o.absorption, c.g, depth, abs(nd.x_gauge - nd.x_face), period)
             e.absorb[b] = o.absorb
             e.imposed[b] = o.elevation == "imposed"
-            e.ghost[b] = buffer_pressure(o) == "extrapolated"
+            e.ghost[b] = buffer_pressure(o, scene.scheme.kind) == "extrapolated"
             e.x_gauge[b] = nd.x_gauge
             e.z_bed[b] = nd.z_bed
             e.z_top[b] = nd.z_top
@@ -243,11 +244,14 @@ class OpenBoundaries:
         self.ends.filt_x[:] = s.filt_x
 
 
-def buffer_pressure(o: OpenBoundary) -> str:
-    """How the buffer of open end ``o`` gets its pressure: ``hydrostatic`` or ``extrapolated``."""
+def buffer_pressure(o: OpenBoundary, scheme: str = "wcsph") -> str:
+    """How the buffer of open end ``o`` gets its pressure under the scene's scheme kind:
+    ``hydrostatic`` or ``extrapolated``."""
     if o.pressure is not None:
         return o.pressure
-    return OUTLET_PRESSURE if o.elevation == "extrapolated" else INLET_PRESSURE
+    if o.elevation == "extrapolated":
+        return OUTLET_PRESSURE
+    return ISPH_INLET_PRESSURE if scheme == "isph" else INLET_PRESSURE
 
 
 def flume_nodes(scene: Scene) -> dict[str, BoundaryNodes]:

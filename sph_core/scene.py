@@ -342,6 +342,12 @@ OUTLET_PRESSURE = "extrapolated"
 # through the floor at its bottom corner (case V, dp 0.02) and generated 5 % less amplitude
 # within 0.3 m of the face (docs/wave_decay_study.md).
 INLET_PRESSURE = "hydrostatic"
+# ... of an ISPH inlet: extrapolated. ISPH puts p = 0 on its surface particles' centres, dp/2 below
+# the surface, so its pressure is ~rho0 g dp/2 below the continuum hydrostatic one a hydrostatic
+# buffer holds; in the still open flume (d 0.3 m, dp 0.02, tests/sph_core/test_open_boundary.py)
+# that pushed the inlet's surface corner at 0.10 m/s within 0.1 s and the run blew up at 0.87 s;
+# extrapolated, the flume stays still (docs/schemes.md "ISPH with open ends").
+ISPH_INLET_PRESSURE = "extrapolated"
 
 
 class OpenBoundary(_Model):
@@ -370,8 +376,8 @@ class OpenBoundary(_Model):
         None, description="buffer pressure: hydrostatic below the buffer's surface, or "
                           "extrapolated from the fluid through mirrored ghost nodes; None: "
                           "OUTLET_PRESSURE (extrapolated) for an extrapolated elevation, else "
-                          "INLET_PRESSURE (hydrostatic); hydrostatic buffers extrapolate within "
-                          "h of their surface")
+                          "INLET_PRESSURE (hydrostatic; ISPH: ISPH_INLET_PRESSURE, extrapolated); "
+                          "hydrostatic buffers extrapolate within h of their surface")
 
 
 class Output(_Model):
@@ -448,13 +454,16 @@ class Scene(_Model):
             if x is not None and not (t.x0 <= x <= t.x1):
                 raise ValueError(f"probes.{i}.x: must lie inside the tank [{t.x0}, {t.x1}]")
         if self.scheme.kind == "isph":
-            # the ISPH step (sph_core.isph) has no open-end or rigid-body hooks yet
-            if self.open_boundaries:
-                raise ValueError("scheme.kind: isph does not support open_boundaries (yet); "
-                                 "use kind = \"wcsph\" for a scene with open ends")
-            if self.bodies:
-                raise ValueError("scheme.kind: isph does not support bodies (yet); "
-                                 "use kind = \"wcsph\" for a scene with rigid bodies")
+            # the ISPH step moves bodies with loads from the step's own pressure (explicit
+            # coupling): a free or hinged body lighter than its added mass is unstable so
+            # (measured: a floating box's heave load went 0.9, 1.3, 0.07, 5.1, -8.9 x its
+            # weight in the first five steps; a hinged flap left the tank at 0.15 s).
+            # Fixed and prescribed bodies are moving walls of the pressure equation.
+            for i, b in enumerate(self.bodies):
+                if b.motion in ("free", "hinged"):
+                    raise ValueError(f"bodies.{i}.motion: isph supports fixed and prescribed "
+                                     f"bodies only, got {b.motion!r} (use scheme kind "
+                                     "\"wcsph\" for free or hinged bodies)")
         bnames = [b.name for b in self.bodies]
         if len(set(bnames)) != len(bnames):
             raise ValueError(f"bodies: duplicate names {bnames}")

@@ -13,7 +13,8 @@ Every scene runs the same loop: the open inlet/outlet ends are a value (``self.o
 is one jitted call (``step.run``) up to the next output time (and, with open ends, the next window
 end); Python only handles boundary data, probes, snapshots, metadata and the progress callback.
 ISPH scenes (``scene.scheme.kind == "isph"``) step with ``isph.IsphStepper.run`` instead, a
-Python loop over jitted passes around a sparse pressure solve, with the same returns.
+Python loop over jitted passes around a sparse pressure solve, with the same returns and the same
+open-end hooks (its buffers and fluid keep density rho0).
 """
 
 from __future__ import annotations
@@ -113,6 +114,10 @@ class Simulation:
         self.bodies.attach(ps, c.rho0, dp)
         self.n_layers = layout.n_layers
         self.open.attach(ps, scene, self.b, layout.n_layers * dp)
+        if self.isph and self.open.active:  # incompressible buffers: constant density and mass
+            buf = (ps.kind[: ps.n] != FLUID) & (ps.kind[: ps.n] != WALL) & (ps.kind[: ps.n] >= 0)
+            ps.f[RHO, : ps.n][buf] = c.rho0
+            ps.f[M, : ps.n][buf] = c.rho0 * vol
         t = scene.tank
         wall = layout.n_layers * dp
         self.grid = CellGrid.covering(t.x0 - wall, t.x1 + wall, t.z0 - wall, t.z1, 2.0 * h,
@@ -124,7 +129,9 @@ class Simulation:
         fx0, fx1 = self.open.fluid_box(t.x0 - 0.5 * dp, t.x1 + 0.5 * dp, dp)
         lo, hi = c.density_band
         self.prm = Params(h=h, alpha_w=aw, alpha_f=5.0 * aw / (h * h), rho0=c.rho0, c0=self.c0,
-                          b=self.b, gamma=7.0, gx=0.0, gz=-c.g, alpha=c.alpha, nu=c.nu,
+                          b=self.b, gamma=7.0, gx=0.0, gz=-c.g, nu=c.nu,
+                          # ISPH has no artificial viscosity (the bodies' load pass reads alpha)
+                          alpha=0.0 if self.isph else c.alpha,
                           delta=c.delta, cfl=scheme.isph_cfl if self.isph else c.cfl,
                           rho_lo=lo, rho_hi=hi,
                           noslip=c.wall_slip == "no_slip", fx0=fx0, fx1=fx1,
@@ -143,7 +150,8 @@ class Simulation:
                                        scheme.isph_shifting, scheme.isph_gradient,
                                        v_ref=scheme.isph_vref_factor * math.sqrt(2.0 * c.g * scene.water_height),
                                        density_relaxation=scheme.isph_density_relaxation)
-            dt, n_new = self.stepper.initialise(ps.view, ps.view2, self.cells, ps.n)
+            dt, n_new = self.stepper.initialise(ps.view, ps.view2, self.cells, ps.n,
+                                                self.open.ends, self.bodies.state)
         else:
             dt, n_new = step.initialise(ps.view, ps.view2, self.cells, self.prm, self.open.ends,
                                        self.bodies.state, ps.n)
@@ -406,7 +414,8 @@ class Simulation:
         tic = time.perf_counter()
         if self.stepper is not None:
             t, dt, steps, status, swapped, n_flag, vmax, n = self.stepper.run(
-                ps.view, ps.view2, self.cells, ps.n, self.t, self.dt, t_stop, max_steps)
+                ps.view, ps.view2, self.cells, ends, self.bodies.state, ps.n, self.t, self.dt,
+                t_stop, max_steps)
         else:
             t, dt, steps, status, swapped, n_flag, vmax, n = step.run(
                 ps.view, ps.view2, self.cells, self.prm, ends, self.bodies.state, self.integrator,

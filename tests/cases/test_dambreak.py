@@ -33,10 +33,11 @@ def run_dambreak(resolution: int, **constants):
 
 
 # every scheme (the scene's [scheme] tables) runs the coarse case's tests
-SCHEMES = {"wcsph": None, "riemann": {"kind": "riemann"}}
+SCHEMES = {"wcsph": None, "riemann": {"kind": "riemann"}, "isph": {"kind": "isph"}}
 
 
-@pytest.fixture(scope="module", params=list(SCHEMES))
+# ISPH (a sparse solve per step) runs the case in minutes: slow
+@pytest.fixture(scope="module", params=["wcsph", "riemann", pytest.param("isph", marks=pytest.mark.slow)])
 def coarse(request):
     return run_dambreak(20, scheme=SCHEMES[request.param])
 
@@ -58,7 +59,15 @@ def test_mass_exactly_conserved_and_fluid_stays_in_tank(coarse):
     assert np.all((st["x"] >= tank.x0 - hd) & (st["x"] <= tank.x1 + hd) & (st["z"] >= tank.z0 - hd))
 
 
-def test_front_within_10_percent_of_koshizuka_oka(coarse):
+def _isph_xfail(request, reason: str) -> None:
+    """ISPH's measured shortfall on this case (docs/schemes.md "## ISPH"): strict xfail."""
+    if request.node.callspec.params["coarse"] == "isph":
+        request.applymarker(pytest.mark.xfail(strict=True, reason="ISPH (a/dp 20, h/dp sqrt 2): "
+                                              + reason + "; measured, not tuned away"))
+
+
+def test_front_within_10_percent_of_koshizuka_oka(coarse, request):
+    _isph_xfail(request, "max front error 15.0 % against Koshizuka & Oka")
     _, t, x, *_ = coarse
     table = martin_moyce_table(DATA / "dambreak_koshizuka_oka_1996.csv")
     keep = table[0] > 0  # T = 0 is the initial column itself
@@ -74,6 +83,7 @@ def test_front_within_10_percent_of_martin_moyce(coarse, request):
         request.applymarker(pytest.mark.xfail(strict=True, reason=(
             "Riemann SPH (MUSCL, van Leer, beta 1): max front error 11.6 % against Martin & "
             "Moyce at a/dp 20; measured, not tuned away")))
+    _isph_xfail(request, "max front error 14.8 % against Martin & Moyce (WCSPH 8.4 %)")
     _, t, x, *_ = coarse
     err = front_errors(t, x, A, t_max=3.0, table=martin_moyce_table(DATA / "dambreak_martin_moyce_1952.csv"))
     assert err["max_rel_error"] < 0.10, err
@@ -96,7 +106,8 @@ def test_finer_resolution_closer_to_martin_moyce(coarse, request):
     assert e40["rms_rel_error"] < e20["rms_rel_error"]
 
 
-def test_front_moves_monotonically_and_ahead_of_column(coarse):
+def test_front_moves_monotonically_and_ahead_of_column(coarse, request):
+    _isph_xfail(request, "the front jumps back by more than dp/2 (a fragmented surge)")
     _, t, x, *_ = coarse
     assert x[0] == pytest.approx(A - 0.5 * A / 20)      # the column's last particle row
     assert np.all(np.diff(x) > -0.5 * A / 20)            # no jumps back by more than dp/2

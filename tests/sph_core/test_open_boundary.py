@@ -1,6 +1,8 @@
 """Open boundaries in a small flume: still water stays still, particles cross both ways with
 exact bookkeeping, bad boundary data stop the run before any step, checkpoints are exact, and a
-pushed-window source drives the flume exactly like the source it was sampled from."""
+pushed-window source drives the flume exactly like the source it was sampled from. The physics
+tests run for every scheme (SCHEMES: the scene's [scheme] tables; ISPH steps with its own loop,
+sph_core.isph, around the same open-end hooks)."""
 
 from __future__ import annotations
 
@@ -20,10 +22,13 @@ from sph_core.simulation import Simulation
 D = 0.3          # still-water depth [m]; the tank floor is z = 0
 DP = 0.02
 G = 9.81
+SCHEMES = {"wcsph": {}, "riemann": {"kind": "riemann"}, "isph": {"kind": "isph"}}
+scheme_params = pytest.mark.parametrize("scheme", list(SCHEMES))
 
 
-def flume_scene(length: float = 0.6, integrator: str = "kdk", **extra) -> object:
-    return make_scene({
+def flume_scene(length: float = 0.6, integrator: str = "kdk", scheme: str = "wcsph",
+                **extra) -> object:
+    return make_scene({"scheme": SCHEMES[scheme],
         "dp": DP, "t_end": 10.0, "still_water_level": D,
         "tank": {"x0": 0.0, "x1": length, "z0": 0.0, "z1": D + 0.12},
         "water_blocks": [{"x0": 0.0, "x1": length, "z0": 0.0, "z1": D}],
@@ -46,19 +51,33 @@ class Oscillating:
         return BoundarySample(t, np.full(self.nodes.size, u), np.zeros(self.nodes.size), 0.0)
 
 
-def test_still_water_with_open_ends_stays_still():
-    sc = flume_scene()
-    fl = Simulation(sc)  # no sources: the open ends hold still water
+@pytest.fixture(scope="module", params=list(SCHEMES))
+def still_flume(request):
+    fl = Simulation(flume_scene(scheme=request.param))  # no sources: the ends hold still water
     fl.advance_to(1.0)
+    return fl
+
+
+def test_still_water_with_open_ends_stays_still(still_flume):
+    fl = still_flume
     st = fl.fluid_state()
     assert fl.n_fluid == fl.n_fluid0
     speed = np.hypot(st["vx"], st["vz"])
     assert speed.max() < 0.01 * math.sqrt(G * D)
+    for side, eta in fl.boundary_gauges().items():
+        assert eta is not None and abs(eta) < 0.5 * DP, side
+
+
+def test_still_water_with_open_ends_is_hydrostatic(still_flume, request):
+    if request.node.callspec.params["still_flume"] == "isph":
+        request.applymarker(pytest.mark.xfail(strict=True, reason=(
+            "ISPH: up to 6.9 % below rho0 g (d - z) in the lower half (0.1-1 s), as in its "
+            "closed tank: p = 0 sits on the surface particles' centres, dp/2 below the surface "
+            "(rho0 g dp/2 = 98 Pa at dp 0.02); docs/schemes.md '## ISPH'. Measured, not tuned")))
+    st = still_flume.fluid_state()
     low = st["z"] < 0.5 * D
     p_ref = 1000.0 * G * (D - st["z"][low])
     assert np.max(np.abs(st["p"][low] - p_ref) / p_ref) < 0.03
-    for side, eta in fl.boundary_gauges().items():
-        assert eta is not None and abs(eta) < 0.5 * DP, side
 
 
 def test_outlet_pressure_extrapolated_from_a_hydrostatic_column_is_hydrostatic():
@@ -81,10 +100,11 @@ def test_outlet_pressure_extrapolated_from_a_hydrostatic_column_is_hydrostatic()
                                atol=1e-6)
 
 
-@pytest.mark.parametrize("integrator", ["kdk", "symplectic_pc"])
-def test_oscillating_flow_crosses_both_ways_with_exact_mass_balance(integrator):
-    """Any integrator runs open ends: the same step skeleton calls the same buffer hooks."""
-    sc = flume_scene(integrator=integrator)
+@pytest.mark.parametrize("integrator, scheme", [("kdk", "wcsph"), ("symplectic_pc", "wcsph"),
+                                                ("kdk", "riemann"), ("kdk", "isph")])
+def test_oscillating_flow_crosses_both_ways_with_exact_mass_balance(integrator, scheme):
+    """Any integrator and scheme runs open ends: the same buffer hooks in each step skeleton."""
+    sc = flume_scene(integrator=integrator, scheme=scheme)
     nodes = flume_nodes(sc)
     fl = Simulation(sc, sources={s: Oscillating(n) for s, n in nodes.items()}, window=0.02)
     capacity = fl.particles.capacity
@@ -134,8 +154,9 @@ def test_bad_boundary_data_stop_the_run_and_keep_its_data(tmp_path, bad, match):
     assert len(rows) >= 6  # header + the probes of [0, 0.05] s are kept
 
 
-def test_checkpoint_restore_is_exact():
-    sc = flume_scene()
+@scheme_params
+def test_checkpoint_restore_is_exact(scheme):
+    sc = flume_scene(scheme=scheme)
     fl = Simulation(sc, sources={s: Oscillating(n) for s, n in flume_nodes(sc).items()})
     fl.advance_to(0.3)
     cp = fl.checkpoint()
@@ -151,8 +172,10 @@ def test_checkpoint_restore_is_exact():
         np.testing.assert_array_equal(first[k], again[k])
 
 
-def test_pushed_windows_drive_the_flume_like_the_source_they_sample():
-    sc = flume_scene()
+@scheme_params
+def test_pushed_windows_drive_the_flume_like_the_source_they_sample(scheme):
+    """The coupled path (the server pushes each window's data) against the pulled one."""
+    sc = flume_scene(scheme=scheme)
     nodes = flume_nodes(sc)
     theory = {s: Oscillating(n) for s, n in nodes.items()}
     a = Simulation(sc, sources=theory, window=0.05)
@@ -167,7 +190,8 @@ def test_pushed_windows_drive_the_flume_like_the_source_they_sample():
         np.testing.assert_array_equal(sa[k], sb[k])
 
 
-def test_inlet_with_a_beach_and_a_structure_keeps_running_and_counting():
+@scheme_params
+def test_inlet_with_a_beach_and_a_structure_keeps_running_and_counting(scheme):
     """Left inlet driving a shallow-water wave onto a 1:4 beach with a block on the bed; the right
     end is a wall. The run stays stable, water goes up the beach, the bookkeeping stays exact."""
     sc = make_scene({
@@ -178,6 +202,7 @@ def test_inlet_with_a_beach_and_a_structure_keeps_running_and_counting():
         "structures": [{"x0": 0.4, "x1": 0.5, "z0": 0.0, "z1": 0.06}],
         "constants": {"c0": 10.0 * math.sqrt(G * 0.2)},
         "open_boundaries": [{"side": "left", "elevation": "imposed"}],
+        "scheme": SCHEMES[scheme],
     })
     nodes = flume_nodes(sc)["left"]
     c = math.sqrt(G * 0.2)
