@@ -24,6 +24,12 @@ THEORY = {"standing": ("standing", {}), "linear": ("linear", {}),
           "stream_function": ("stream", {"n_fourier": 16})}
 
 
+# measured (docs/schemes.md "ISPH with open ends and bodies"): the open ends' buffers hold still
+# water and a through-flow, but a progressive wave makes jets at their surface corners
+ISPH_WAVE_FLUME = ("ISPH: unstable at t = 2.49 s (24 particles excluded before, then one over the "
+                   "tank top at the outlet end); measured, not tuned away")
+
+
 def cases() -> dict[str, dict]:
     with open(DATA) as fh:
         return {r["test"]: r for r in csv.DictReader(ln for ln in fh if not ln.startswith("#"))}
@@ -50,11 +56,15 @@ def test_case_table_wavelengths_are_linear_dispersion():
             assert 2 * math.pi / float(k) == pytest.approx(float(row["L"]), abs=0.006), test
 
 
-def test_case_V_coarse_flume_generates_the_wave():
+# the coarse case under every scheme; Riemann SPH and ISPH cost 2.5-10x WCSPH's time: slow
+@pytest.mark.parametrize("scheme", ["wcsph", pytest.param("riemann", marks=pytest.mark.slow),
+                                    pytest.param("isph", marks=[pytest.mark.slow, pytest.mark.xfail(
+                                        strict=True, reason=ISPH_WAVE_FLUME)])])
+def test_case_V_coarse_flume_generates_the_wave(scheme):
     """H/dp = 3, one period measured after a 1-period ramp and the travel to mid-flume: a coarse
     check that the inlet makes the right wave and the outlet lets it out. Bounds: twice and
     three times the goals that hold at H/dp >= 10 (5 %, below)."""
-    res = run_case("V", dp=0.02, periods=1.0)
+    res = run_case("V", dp=0.02, periods=1.0, scheme={"kind": scheme})
     assert res["rmse_over_H"] < 0.10, res
     assert res["reflection"] < 0.15, res
     counts = res["boundary_counts"]

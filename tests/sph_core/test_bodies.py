@@ -313,3 +313,53 @@ def test_wedge_entry_impulse_between_von_karman_and_wagner() -> None:
     sim = Simulation(wedge_scene(dp=0.01, constants=STUDY))
     for row in wedge_pressures(sim, TIMES, samples=3):
         assert row["impulse_von_karman"] < row["impulse_sph"] < row["impulse_wagner"]
+
+
+def _isph(scene_dict: dict):
+    """The scene under ISPH at its own default h/dp (sqrt 2)."""
+    d = {**scene_dict, "scheme": {"kind": "isph"}}
+    d["constants"] = {k: v for k, v in (d.get("constants") or {}).items() if k != "h_over_dp"}
+    return make_scene(d)
+
+
+@pytest.mark.xfail(strict=True, reason=(
+    "ISPH: the fixed box's heave load after the first step is 0.907 x rho0 g B d (0.89-0.90 "
+    "over 0.5 s): p = 0 sits on the surface particles' centres, dp/2 below the surface, a "
+    "deficit of (dp/2)/d = 10 % at a draft of 5 dp (docs/schemes.md '## ISPH'). Measured"))
+def test_isph_hydrostatic_load_on_a_fixed_box_is_archimedes() -> None:
+    """ISPH solves no pressure before its first step: the load is the first step's."""
+    d = floating_box_scene(dp=0.02, breadth=0.4, height=0.2, density=500.0).model_dump()
+    d["bodies"][0]["motion"] = "fixed"
+    sim = Simulation(_isph(d))
+    sim.advance_steps(1)
+    fx, fz, my = sim.bodies.state.load[0]
+    ref = 1000.0 * 9.81 * 0.4 * archimedes_draft(500.0, 0.2)
+    assert abs(fx) < 1e-3 * ref and abs(my) < 1e-3 * ref * 0.4   # symmetric (measured 1e-6)
+    assert fz == pytest.approx(ref, rel=0.02)
+
+
+def test_isph_prescribed_body_follows_its_series_and_checkpoint_restores_it() -> None:
+    """Under ISPH a prescribed body is a moving wall of the pressure equation; its motion is
+    exact and a restore repeats the run bit for bit (fluid included)."""
+    scene = _isph({
+        "dp": 0.02, "t_end": 0.2, "tank": {"x0": 0, "x1": 1.0, "z0": 0, "z1": 0.6},
+        "water_blocks": [{"x0": 0, "x1": 1.0, "z0": 0, "z1": 0.3}],
+        "output": {"probe_every": 0.02},
+        "bodies": [{"name": "plate", "shape": "box", "x0": 0.4, "x1": 0.6, "z0": 0.26,
+                    "z1": 0.36, "motion": "prescribed",
+                    "series": [(0.0, 0.0, 0.0, 0.0), (0.2, 0.02, -0.01, 0.05)]}]})
+    sim = Simulation(scene)
+    n0 = sim.n_fluid
+    sim.advance_to(0.1)
+    c = sim.checkpoint()
+    sim.advance_to(0.2)
+    q_end = sim.bodies.state.q[0].copy()
+    first = sim.fluid_state()
+    assert q_end == pytest.approx(np.array([0.5 + 0.02, 0.31 - 0.01, 0.05]), abs=1e-12)
+    assert sim.n_fluid == n0 and np.all(np.isfinite(sim.bodies.state.load[0]))
+    sim.restore(c)
+    sim.advance_to(0.2)
+    assert np.array_equal(sim.bodies.state.q[0], q_end)
+    again = sim.fluid_state()
+    for k in ("x", "z", "vx", "p"):
+        np.testing.assert_array_equal(first[k], again[k])

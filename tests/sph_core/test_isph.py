@@ -96,14 +96,17 @@ def test_solvers_recover_a_manufactured_solution():
         np.testing.assert_allclose(sol, x_true, atol=1e-7, err_msg=solver)
 
 
-def test_isph_accepts_open_ends_and_refuses_bodies_by_field():
+def test_isph_accepts_open_ends_and_fixed_bodies_and_refuses_free_ones_by_field():
     base = still_scene(10, 1.0).model_dump()
     # open ends run (tests/sph_core/test_open_boundary.py runs them under every scheme)
     assert make_scene({**base, "open_boundaries": [{"side": "left"}]}).scheme.kind == "isph"
     body = {"name": "b", "shape": "box", "x0": 0.2, "x1": 0.3, "z0": 0.3, "z1": 0.35,
             "motion": "fixed"}
-    with pytest.raises(SceneError, match="scheme.kind: isph does not support bodies"):
-        make_scene({**base, "bodies": [body]})
+    assert make_scene({**base, "bodies": [body]}).bodies[0].motion == "fixed"
+    for motion in ("free", "hinged"):
+        extra = {"mass": 1.0} if motion == "free" else {"mass": 1.0, "pivot": (0.25, 0.3)}
+        with pytest.raises(SceneError, match="bodies.0.motion: isph supports fixed and prescribed"):
+            make_scene({**base, "bodies": [{**body, "motion": motion, **extra}]})
 
 
 def test_short_isph_run_keeps_mass_and_records_ppe_stats():
