@@ -51,8 +51,9 @@ ENTRIES: list[tuple[str, dict[str, Any]]] = [
     ("wcsph_hsqrt2_wallav1", {"constants": OLD_DEFAULTS}),  # the defaults before this session
     ("wcsph", {"constants": BEST_WAVE}),                   # = today's scene defaults
     *[(name, {"scheme": sch, "constants": BEST_WAVE}) for name, sch in RIEMANN_VARIANTS.items()],
-    # ISPH runs at its own h/dp sqrt 2 (sph_core.scene.ISPH_H_OVER_DP); it refuses open ends, so
-    # its wave line reports wave_failed (the flume has open ends)
+    # ISPH runs at its own h/dp sqrt 2 (sph_core.scene.ISPH_H_OVER_DP); its wave flume is
+    # unstable (docs/schemes.md "ISPH with open ends and bodies"), so its wave line reports
+    # wave_failed with the UnstableError
     ("isph_amg", {"scheme": {"kind": "isph", "ppe_solver": "amg"}}),
     ("isph_explicit", {"scheme": {"kind": "isph", "ppe_solver": "explicit"}}),
 ]

@@ -65,7 +65,8 @@ METHODS: dict[str, dict[str, Any]] = {
                                    "shifting": "fickian"},
     **{name: {"h_over_dp": 2.0, "alpha_wall_factor": 0.0, "scheme": sch}
        for name, sch in RIEMANN_VARIANTS.items()},
-    # ISPH at its h/dp sqrt 2; it refuses open ends, so its flume points are "failed" with the reason
+    # ISPH at its h/dp sqrt 2; its wave flume is unstable (docs/schemes.md), so its flume points
+    # end "unstable" with the reason
     "isph_amg": {"h_over_dp": ISPH_H_OVER_DP, "alpha_wall_factor": 0.0,
                  "scheme": {"kind": "isph", "ppe_solver": "amg"}},
 }
