@@ -17,8 +17,14 @@ SCHEMES = {"wcsph": {}, "riemann": {"kind": "riemann"}, "isph": {"kind": "isph"}
 # surface particles at 0.024 m/s (limit 0.0157) on this scene (docs/schemes.md)
 
 
-# ISPH's 3.2 s at d/dp 25 costs minutes (a sparse solve per step): slow
-@pytest.fixture(scope="module", params=["wcsph", "riemann", pytest.param("isph", marks=pytest.mark.slow)])
+# ISPH's 3.2 s at d/dp 25 costs minutes (a sparse solve per step): slow; it does not hold the
+# tank that long (tests/sph_core/test_isph.py, docs/schemes.md "## ISPH")
+ISPH_STILL = ("ISPH: unstable at t = 2.89 s of 3.19 (12 particles excluded before, then one over "
+              "the tank top): its surface corners creep inward and break down at ~2 s; measured")
+
+
+@pytest.fixture(scope="module", params=["wcsph", "riemann", pytest.param("isph", marks=[
+    pytest.mark.slow, pytest.mark.xfail(strict=True, reason=ISPH_STILL)])])
 def still_run(request):
     scene = make_scene({
         "name": "still", "dp": DP, "t_end": 20 * math.sqrt(D / 9.81), "still_water_level": D,
