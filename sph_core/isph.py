@@ -48,7 +48,9 @@ Open ends: active buffer particles are Dirichlet neighbours of the PPE: their pr
 (open_boundary.py's rules; ISPH inlets extrapolate by default, scene.ISPH_INLET_PRESSURE) and
 moves to the right-hand side of the fluid and wall rows; they count in div u* (with their imposed
 velocity), the viscous term and the free-surface criterion as fluid neighbours (docs/schemes.md
-"ISPH with open ends").
+"ISPH with open ends and bodies"). Rigid bodies (fixed, prescribed) are WALL rows moving with
+the body; their loads come from the step's pressure after the solve (free and hinged bodies are
+refused by the scene: that explicit coupling is unstable for a body lighter than its added mass).
 
 The PPE is solved at r^n rather than at seed 004's intermediate r* = r^n + dt u* (eq. 8): one
 neighbour search per step instead of two. The time step (no sound speed):
@@ -352,7 +354,7 @@ def _assemble_row(ps, i, k, cells, prm, inv_dt, idx, wsum, dwall, wscale, indptr
                 # the fluid: the walls' part is their ghost pressure (the Neumann condition)
                 # fluid, or an open end's buffer with its imposed velocity (with an outlet's
                 # buffer in through its pressure only, the outlet's bottom corner drained:
-                # 1.4 m/s there at 0.7 s; docs/schemes.md "ISPH with open ends")
+                # 1.4 m/s there at 0.7 s; docs/schemes.md "ISPH with open ends and bodies")
                 if kj != WALL:
                     div -= m[j] / rho[j] * fij * ((vx[j] - vx[i]) * dx + (vz[j] - vz[i]) * dz)
                 rs = rho[i] + rho[j]

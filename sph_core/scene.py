@@ -346,7 +346,7 @@ INLET_PRESSURE = "hydrostatic"
 # the surface, so its pressure is ~rho0 g dp/2 below the continuum hydrostatic one a hydrostatic
 # buffer holds; in the still open flume (d 0.3 m, dp 0.02, tests/sph_core/test_open_boundary.py)
 # that pushed the inlet's surface corner at 0.10 m/s within 0.1 s and the run blew up at 0.87 s;
-# extrapolated, the flume stays still (docs/schemes.md "ISPH with open ends").
+# extrapolated, the flume stays still (docs/schemes.md "ISPH with open ends and bodies").
 ISPH_INLET_PRESSURE = "extrapolated"
 
 
