@@ -4,8 +4,8 @@ demo, cases and tests, the coupling benchmark): one place for the WebSocket opti
 Keepalive pings (found 2026-11-23, docs in protocol/PROTOCOL.md "Timeouts"): uvicorn's defaults
 (ping every 20 s, drop the client if its pong is 20 s late) dropped coupled runs on a loaded
 machine. A coupling client answers pings only when its asyncio loop runs, and it runs its wave
-model in that loop between frames; in the sweep's process the server's first window (numba
-compile) also competes for the GIL. A client blocked > 40 s lost its run ("client disconnected").
+model in that loop between frames: the Boussinesq model's cold numba compile blocked it 53 s in
+window 1 (load ~16), and a client blocked > 40 s lost its run ("client disconnected").
 The protocol has its own liveness rules (hello_timeout, idle_timeout, WORKING frames), so the
 server still pings (proxies see traffic) but never drops a client for a late pong by default.
 """
