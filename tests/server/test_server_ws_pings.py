@@ -1,11 +1,11 @@
 """WebSocket keepalive pings must not cost a busy client its run (found 2026-11-23).
 
 A coupling client answers the server's pings only while its asyncio loop runs; it runs its wave
-model in that loop between frames (and in the accuracy sweep shares the GIL with the server's
-first-window compile). uvicorn's defaults (ping every 20 s, pong due within 20 s) dropped such a
-client after > 40 s of blocking: run failed "client disconnected", client "connection lost at
-window 1/392". Here uvicorn's defaults are scaled 1/100 so the test takes seconds, and the
-client blocks its loop for BLOCK s in one window.
+model in that loop between frames (the accuracy sweep's Boussinesq model, compiling cold under
+load, blocked it 53 s in window 1). uvicorn's defaults (ping every 20 s, pong due within 20 s)
+dropped such a client: run failed "client disconnected", client "connection lost at window
+1/392". Here uvicorn's defaults are scaled 1/100 so the test takes seconds, and the client
+blocks its loop for BLOCK s in one window.
 """
 
 from __future__ import annotations
