@@ -60,6 +60,7 @@ sys.path.insert(0, str(ROOT))
 
 from protocol import (Bye, ClientSession, FrameDecoder, GetNodes, Hello, Nodes, Result, Set,  # noqa: E402
                       Solve, Welcome, decode_frame)
+from server.asgi import uvicorn_config  # noqa: E402
 from server.engine import EngineNodes, Measurement, SceneSummary  # noqa: E402
 from server.flume_engine import FlumeEngine  # noqa: E402
 from server.main import create_app  # noqa: E402
@@ -159,9 +160,9 @@ def serve(tmp: Path, null_nodes: int, ports: Any, solves: Any) -> None:
     _SOLVES = solves
     factory: Callable = (TimedFlumeEngine if not null_nodes
                          else lambda req, d: NullEngine(null_nodes, req.scene.t_end))
-    app = create_app(Settings(runs_dir=tmp, port=0, tcp_port=0), factory)
-    server = uvicorn.Server(uvicorn.Config(app, host="127.0.0.1", port=0, log_level="error",
-                                           ws_per_message_deflate=False))  # as `wavesph serve`
+    settings = Settings(runs_dir=tmp, port=0, tcp_port=0)
+    app = create_app(settings, factory)
+    server = uvicorn.Server(uvicorn_config(app, settings, log_level="error"))  # as `wavesph serve`
     thread = threading.Thread(target=server.run, daemon=True)
     thread.start()
     while not server.started:

@@ -350,7 +350,9 @@ def run_coupled(c: FlumeCase, dp: float, out: Path, two_way: bool = True,
                                      "coupling": {"window_max": c.window, "z_ref": z_ref}})
         r.raise_for_status()
         run = r.json()
-        info = wait_for_state(http, run["id"], {"waiting_for_client"} | TERMINAL, timeout=300)
+        # building the engine includes numba's cold compile of the step: 429 s measured at load
+        # ~15 on 2 cores (2026-11-23), past the 300 s waited before (the point ended "queued")
+        info = wait_for_state(http, run["id"], {"waiting_for_client"} | TERMINAL, timeout=1800)
         url = (f"ws://127.0.0.1:{srv.port}/runs/{run['id']}/couple" if transport == "ws"
                else f"tcp://127.0.0.1:{srv.tcp_port}")
         code = None  # the client's exit status as `wavesph couple` would give it

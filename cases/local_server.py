@@ -20,15 +20,14 @@ class InProcessServer:
                  **settings: Any) -> None:
         import uvicorn
 
+        from server.asgi import uvicorn_config
         from server.main import create_app
         from server.settings import Settings
 
         self.settings = Settings(host="127.0.0.1", port=0, tcp_port=0, runs_dir=runs_dir, **settings)
         self.app = (create_app(self.settings) if engine_factory is None
                     else create_app(self.settings, engine_factory))
-        self.server = uvicorn.Server(uvicorn.Config(  # socket options as `wavesph serve`
-            self.app, host="127.0.0.1", port=0, log_level=log_level, lifespan="on",
-            ws_max_size=self.settings.max_frame + 16, ws_per_message_deflate=False))
+        self.server = uvicorn.Server(uvicorn_config(self.app, self.settings, log_level=log_level))
         self.thread = threading.Thread(target=self.server.run, name="wavesph-server", daemon=True)
 
     def __enter__(self) -> "InProcessServer":

@@ -257,6 +257,7 @@ def _koshizuka_oka() -> tuple[Any, Any]:
 def _coupled(point: Point) -> dict[str, Any]:
     import contextlib
     import io
+    import shutil
     import tempfile
 
     from .coupled_flume import FlumeCase, reference_run, rmse_over_h, run_coupled, run_sph_only
@@ -264,21 +265,29 @@ def _coupled(point: Point) -> dict[str, Any]:
     c = FlumeCase(wavelengths=point.options.get("wavelengths", 2.0),
                   compare_periods=point.options.get("compare_periods", 2.0)).at(point.dp)
     log = io.StringIO()   # run_coupled reports a failed coupling on stderr: keep it as the reason
-    with tempfile.TemporaryDirectory(prefix="wavesph-sweep-") as tmp:
+    # the run's directory (meta.json, gauges, saved states) goes only when the point succeeded:
+    # a failed one keeps it to look into (or resume, POST /runs/{id}/resume on a server there)
+    tmp = Path(tempfile.mkdtemp(prefix="wavesph-sweep-"))
+    try:
         if point.method == "coupled":
             with contextlib.redirect_stderr(log):
-                res = run_coupled(c, point.dp, Path(tmp), two_way=True)
+                res = run_coupled(c, point.dp, tmp, two_way=True)
         elif point.method == "sph_only":
-            res = run_sph_only(c, point.dp, Path(tmp))
+            res = run_sph_only(c, point.dp, tmp)
         else:
             raise ValueError(f"coupled case: method must be one of {COUPLED_METHODS}")
+    except BaseException as exc:
+        exc.add_note(f"run data kept in {tmp}")
+        raise
     if res["state"] != "finished" or "t" not in res:
         failed = res.get("exit_code") == 1 or "unstable" not in str(res["status"])
         return {"H_over_dp": c.height / point.dp, "status": "failed" if failed else "unstable",
                 "reason": f"run ended {res['state']}: {res['status']}"
-                          + (f"; client: {log.getvalue().strip()[-300:]}" if log.getvalue() else ""),
+                          + (f"; client: {log.getvalue().strip()[-300:]}" if log.getvalue() else "")
+                          + f"; run data kept in {tmp}",
                 "wall_s": res["wall_s"],
                 "particles": res["particles"], "steps": res["steps"]}
+    shutil.rmtree(tmp, ignore_errors=True)
     t, eta = res["t"], res["eta"]["flat"]
     err = rmse_over_h(t, eta, reference_run(c, t)["flat"], c)
     return {"H_over_dp": c.height / point.dp, "error": err, "wall_s": res["wall_s"],

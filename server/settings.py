@@ -9,6 +9,7 @@ from pathlib import Path
 from pydantic import BaseModel, Field, ValidationError, model_validator
 
 ENV_PREFIX = "WAVESPH_"
+_NULLABLE = ("tcp_port", "token", "tcp_host", "ws_ping_interval", "ws_ping_timeout")  # "" -> None
 
 
 class Settings(BaseModel):
@@ -32,6 +33,12 @@ class Settings(BaseModel):
     idle_timeout: float = Field(600.0, gt=0, description="[s] between client frames")
     keepalive_every: float = Field(5.0, gt=0, description="[s] between WORKING frames while a "
                                    "reply takes long (clients with the KEEPALIVE capability)")
+    ws_ping_interval: float | None = Field(20.0, gt=0, description="[s] between WebSocket pings the "
+                                           "server sends (traffic that keeps proxies and NATs from "
+                                           "closing a quiet coupling connection); None: no pings")
+    ws_ping_timeout: float | None = Field(None, gt=0, description="[s] a WebSocket client whose pong "
+                                          "is this late is dropped; None (default): never, see "
+                                          "server/asgi.py (a dead client is found by idle_timeout)")
     client_wait_timeout: float = Field(3600.0, gt=0, description="[s] a coupled run waits for its client")
     meta_interval: float = Field(0.5, ge=0, description="[s] least time between meta.json rewrites")
     checkpoint_every: float = Field(60.0, gt=0, description="[s] wall time between saved states of "
@@ -61,7 +68,7 @@ class Settings(BaseModel):
         for name in cls.model_fields:
             raw = env.get(ENV_PREFIX + name.upper())
             if raw is not None:
-                values[name] = None if raw == "" and name in ("tcp_port", "token", "tcp_host") else raw
+                values[name] = None if raw == "" and name in _NULLABLE else raw
         values.update({k: v for k, v in overrides.items() if v is not None})
         return cls(**values)
 

@@ -40,6 +40,7 @@ def port_in_use(host: str, port: int) -> str | None:
 def main(args: argparse.Namespace) -> int:
     import uvicorn
 
+    from server.asgi import uvicorn_config
     from server.main import create_app
 
     try:
@@ -63,7 +64,5 @@ def main(args: argparse.Namespace) -> int:
     app = create_app(settings)
     print(f"wavesph serve: http://{settings.host}:{settings.port} (docs at /docs), TCP coupling "
           f"port {settings.tcp_port}, runs in {settings.runs_dir.resolve()}", file=sys.stderr)
-    uvicorn.run(app, host=settings.host, port=settings.port, log_level="info",
-                ws_max_size=settings.max_frame + 16,
-                ws_per_message_deflate=False)  # float64 arrays do not compress: deflate only costs time
+    uvicorn.Server(uvicorn_config(app, settings, log_level="info")).run()
     return 0

@@ -280,3 +280,28 @@ def test_wavesph_run_wave_option_warns_on_stderr(capsys):
         "water_blocks": [planned.water_blocks[0].model_copy(update={"x1": x1})]})
     _warn_if_expensive(long, 0.06, 2.0)
     assert "warning: this scene is predicted to cost" in capsys.readouterr().err
+
+
+def test_a_failed_coupled_point_keeps_its_run_directory(monkeypatch):
+    """The sweep runs a coupled point in a temporary directory: a failure keeps it (run dir,
+    meta.json, gauges, saved states) and says where."""
+    import cases.coupled_flume as coupled_flume
+
+    made = []
+
+    def fake_run(c, dp, out, two_way=True, **kw):  # the run's files, then the outcome
+        (out / "r1").mkdir()
+        (out / "r1" / "meta.json").write_text("{}")
+        made.append(out)
+        print("coupled flume: coupling failed: connection lost", file=sys.stderr)
+        return {"state": "failed", "status": "failed: client disconnected", "exit_code": 1,
+                "wall_s": 1.0, "particles": 10, "steps": 0}
+
+    monkeypatch.setattr(coupled_flume, "run_coupled", fake_run)
+    rec = sweeps._coupled(Point("coupled", "coupled", 0.03))
+    assert rec["status"] == "failed" and "client disconnected" in rec["reason"]
+    assert "connection lost" in rec["reason"]
+    assert rec["reason"].endswith(f"run data kept in {made[0]}")
+    assert (made[0] / "r1" / "meta.json").exists()
+    import shutil
+    shutil.rmtree(made[0])

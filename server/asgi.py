@@ -1,0 +1,29 @@
+"""The uvicorn configuration of every server start (`wavesph serve`, the in-process server of the
+demo, cases and tests, the coupling benchmark): one place for the WebSocket options.
+
+Keepalive pings (found 2026-11-23, docs in protocol/PROTOCOL.md "Timeouts"): uvicorn's defaults
+(ping every 20 s, drop the client if its pong is 20 s late) dropped coupled runs on a loaded
+machine. A coupling client answers pings only when its asyncio loop runs, and it runs its wave
+model in that loop between frames: the Boussinesq model's cold numba compile blocked it 53 s in
+window 1 (load ~16), and a client blocked > 40 s lost its run ("client disconnected").
+The protocol has its own liveness rules (hello_timeout, idle_timeout, WORKING frames), so the
+server still pings (proxies see traffic) but never drops a client for a late pong by default.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from server.settings import Settings
+
+
+def uvicorn_config(app: Any, settings: Settings, *, log_level: str = "info") -> Any:
+    """A ``uvicorn.Config`` serving ``app`` on ``settings.host:settings.port``."""
+    import uvicorn
+
+    return uvicorn.Config(
+        app, host=settings.host, port=settings.port, log_level=log_level, lifespan="on",
+        ws_max_size=settings.max_frame + 16,  # one frame = one message: header + payload
+        ws_per_message_deflate=False,  # float64 arrays do not compress: deflate only costs time
+        ws_ping_interval=settings.ws_ping_interval,
+        ws_ping_timeout=settings.ws_ping_timeout)
