@@ -129,7 +129,7 @@ def obstacle(scheme: dict, t_end: float) -> dict:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--quick", action="store_true", help="still water only, 0.3 s")
-    ap.add_argument("--solvers", default="explicit,amg,ilu,direct")
+    ap.add_argument("--solvers", default="explicit,amg,ilu,direct,bicgstab")
     ap.add_argument("--cases", default="still,dambreak,obstacle")
     ap.add_argument("--schemes", default="wcsph,isph")
     ap.add_argument("--solver", default=None, help="ISPH solver of dambreak/obstacle (default: the scene's)")

@@ -53,6 +53,7 @@ ENTRIES: list[tuple[str, dict[str, Any]]] = [
     *[(name, {"scheme": sch, "constants": BEST_WAVE}) for name, sch in RIEMANN_VARIANTS.items()],
     # ISPH runs at its own h/dp sqrt 2 (sph_core.scene.ISPH_H_OVER_DP); it refuses open ends, so
     # its wave line reports wave_failed (the flume has open ends)
+    ("isph_bicgstab", {"scheme": {"kind": "isph", "ppe_solver": "bicgstab"}}),  # the default
     ("isph_amg", {"scheme": {"kind": "isph", "ppe_solver": "amg"}}),
     ("isph_explicit", {"scheme": {"kind": "isph", "ppe_solver": "explicit"}}),
 ]

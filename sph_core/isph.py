@@ -31,9 +31,12 @@ on the sorted state at t^n (docs/schemes.md "## ISPH" has the measurements behin
    heavy, and with the plain Adami rows fluid driven at the bed went through it (the wall pressure
    rises with the fluid's). Free-surface particles enter with p = 0. Solved by ``ppe_solver``:
    ``explicit`` = the seed's Jacobi iteration p_k <- (b_k - sum_{j != k} a_kj p_j) / a_kk
-   (Hosseini et al. 2007, eq. 13; the wall rows updated in the same sweep), ``amg`` = BiCGSTAB
-   preconditioned by smoothed-aggregation AMG (pyamg), ``ilu`` = BiCGSTAB with incomplete LU,
-   ``direct`` = SuperLU; the iterative ones warm-started from the last pressure;
+   (Hosseini et al. 2007, eq. 13; the wall rows updated in the same sweep), ``bicgstab`` (the
+   default) = BiCGSTAB preconditioned by the diagonal, jitted, ``amg`` = BiCGSTAB preconditioned
+   by smoothed-aggregation AMG (pyamg), ``ilu`` = BiCGSTAB with incomplete LU, ``direct`` =
+   SuperLU; the iterative ones warm-started from the last pressure. The no-penetration part
+   stops the approach within ``isph_wall_stop`` steps (rho |u_n| d / (stop dt)); it and the
+   source scale as 1/dt, so ``IsphStepper.run`` never ends a run on a sliver step;
 4. corrector (eq. 16-17): u^{n+1} = u* - dt grad p_i / rho0, r^{n+1} = r^n + dt (u^n + u^{n+1}) / 2,
    grad p by the renormalised difference B_i^-1 sum_j V_j (p_j - p_i) grad_i W_ij (Bonet & Lok
    1999; ``isph_gradient = "corrected"``, the default) or seed eq. 5 (``"symmetric"``: the
@@ -580,6 +583,8 @@ def bicgstab_jacobi(indptr, indices, data, b, x, m, tol, max_iter, w):
         rv = 0.0
         for k in range(m):
             rv += rh[k] * v[k]
+        if rv == 0.0:  # breakdown with nothing left to gain: return the current iterate
+            break
         alpha = rho / rv
         sn = 0.0
         for k in range(m):
