@@ -434,7 +434,7 @@ def scatter_pressure(ps, m, slot, sol, flag):
 
 
 @njit(parallel=True, cache=True, fastmath=FASTMATH)
-def correct(ps, n, cells, prm, dt, corrected):
+def correct(ps, n, cells, prm, dt, corrected, dry_walls):
     """u^{n+1} = u* - dt (grad p / rho)_i (eq. 16), r^{n+1} = r^n + dt (u^n + u^{n+1}) / 2
     (eq. 17); grad p by seed eq. 5 (symmetric), or ``corrected``: the renormalised difference
     B_i^-1 sum_j V_j (p_j - p_i) grad_i W_ij (Bonet & Lok 1999), exact for a linear field on a
@@ -472,7 +472,10 @@ def correct(ps, n, cells, prm, dt, corrected):
                 row = zz * ncx
                 for j in range(cell_start[row + cxl], cell_start[row + cxh + 1]):
                     kj = kind[j]
-                    if j != i and (kj == FLUID or kj == WALL):
+                    # without dry_walls, a wall particle with p < 0 (the air side of a wetted
+                    # wall, above the free surface) is left out like air: with it, the surface
+                    # corners of still water crept away from the wall (docs/schemes.md)
+                    if j != i and (kj == FLUID or (kj == WALL and (dry_walls or p[j] >= 0.0))):
                         dx = x[i] - x[j]
                         dz = z[i] - z[j]
                         r2 = dx * dx + dz * dz
@@ -676,7 +679,7 @@ class IsphStepper:
                  tolerance: float = 1e-5, max_iter: int = 20000, free_surface: str = "density",
                  fs_threshold: float | None = None, shifting: bool = True,
                  gradient: str = "corrected", v_ref: float = 0.0,
-                 density_relaxation: float = 0.0, wall_stop: float = 1.0) -> None:
+                 density_relaxation: float = 0.0, wall_stop: float = 1.0, dry_walls: bool = False) -> None:
         if solver not in PPE_SOLVERS:
             raise ValueError(f"ppe_solver: one of {PPE_SOLVERS}, got {solver!r}")
         self.prm = prm
@@ -690,6 +693,7 @@ class IsphStepper:
         self.corrected = gradient == "corrected"
         self.v_ref = float(v_ref)
         self.wall_stop = float(wall_stop)
+        self.dry_walls = bool(dry_walls)
         # a typical fluid diagonal sum_j B_ij ~ (2 / rho0) sum_j V_j F_ij = 7 / (rho0 h^2): the
         # scale of the wall rows
         self.wscale = 7.0 / (prm.rho0 * prm.h * prm.h)
@@ -760,7 +764,7 @@ class IsphStepper:
         wall_state(ps, n, cells, prm, dt, self.wall_stop, self.wsum, self.dwall)
         a2 = predict(ps, n, cells, prm, dt)
         self._solve(ps, n, cells, dt)
-        n_bad, n_out, v2 = correct(ps, n, cells, prm, dt, self.corrected)
+        n_bad, n_out, v2 = correct(ps, n, cells, prm, dt, self.corrected, self.dry_walls)
         n = sort_by_cell(ps, ps2, N_SORTED_KDK, n, cells)
         if self.shifting:
             shift_particles(ps2, n, cells, prm, dt)

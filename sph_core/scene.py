@@ -257,6 +257,11 @@ class Scheme(_Model):
         "ISPH: fluid approaching a wall is stopped by a ghost-pressure rise rho |u_n| d / tau "
         "over this many steps, tau = isph_wall_stop dt (d the fluid's distance from the wall "
         "particle along the wall normal); 1: within one step"))
+    isph_dry_walls: bool = Field(False, description=(
+        "ISPH corrector: wall particles with a negative pressure (the air side of a wetted wall, "
+        "above the free surface) count in the pressure gradient (true, the original) or are left "
+        "out like air (false: with them the still-water surface corners crept away from the "
+        "wall and broke down at ~2.9 s)"))
     isph_shifting: bool = Field(True, description=(
         "ISPH: Fickian particle shifting (Lind et al. 2012) with Constants.shift_a after each step"))
 

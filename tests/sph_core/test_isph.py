@@ -173,14 +173,11 @@ def test_isph_still_water_bed_pressure_hydrostatic_without_drift():
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(strict=True, reason=(
-    "measured: the particles at the surface corners creep inward along the surface with a speed "
-    "that doubles about every 0.5 s (3 mm/s at 0.4 s, 14 mm/s at 1.8 s); at ~2 s the corner "
-    "breaks down and drops leave the tank (t = 2.7-2.8 s). WCSPH holds 20 sqrt(d/g) "
-    "(tests/sph_core/test_hydrostatic.py). Re-measured 2026-11-23 with the bicgstab default: "
-    "breaks down at 2.9 s; walls without suction, no shifting or no density relaxation break "
-    "down earlier. Open: docs/schemes.md '## ISPH'."))
 def test_isph_still_water_holds_20_sqrt_d_over_g():
+    """As WCSPH (tests/sph_core/test_hydrostatic.py). Held since the corrector leaves the wall
+    particles above the water (p < 0) out of the pressure gradient (isph_dry_walls = false);
+    with them the surface corners crept away from the wall and broke down at ~2.9 s
+    (docs/schemes.md "## ISPH", 2026-11-23)."""
     check_still(*run_still(20 * math.sqrt(D / 9.81)))
 
 
