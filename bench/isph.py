@@ -1,6 +1,11 @@
 """ISPH against WCSPH at the same dp (issue 13, item 1): one JSON object per line.
 
     PYTHONPATH=. NUMBA_NUM_THREADS=1 python bench/isph.py [--quick] [--solvers explicit,amg,ilu,direct]
+        [--cases still,dambreak,obstacle] [--schemes wcsph,isph] [--t-still 1.0]
+        [--variants '[{"isph_wall_stop": 0.5}, {"ppe_solver": "bicgstab"}]']
+
+``--variants``: ISPH [scheme] options, one run of each case per variant (in this one process,
+so the kernels compile once); each line then carries its ``variant``.
 
 Cases (coarse; every wall time is of this process on whatever load the machine has):
 - still: still water d = 0.25 m, d/dp = 25 (tests/sph_core/test_hydrostatic.py's tank) for
@@ -70,11 +75,12 @@ def still(scheme: dict, t_end: float) -> dict:
             "bed_p_error": float(np.mean(p[late]) / exact - 1.0),
             "bed_p_noise_pa": float(np.std(p[late])), "bed_p_noise_rel": float(np.std(p[late]) / exact),
             "eta_drift_m": float(eta[-1] - eta[0]), "steps": sim.steps,
+            "v_max_end": float(np.hypot(sim.fluid_state()["vx"], sim.fluid_state()["vz"]).max()),
             "mean_dt": t_end / sim.steps, "wall_s_per_sim_s": wall / t_end,
             "particle_steps_per_s": sim.n_particles * sim.steps / wall, **_ppe(sim)}
 
 
-def dambreak_run(scheme: dict, res: int = 20) -> dict:
+def dambreak_run(scheme: dict, res: int = 20, tag: str = "") -> dict:
     t_end = 6.0 / math.sqrt(2 * 9.81 / A)
     dp = A / res
     base = dambreak_scene(a=A, dp=dp, t_end=t_end, tank_length=5 * A,
@@ -98,6 +104,9 @@ def dambreak_run(scheme: dict, res: int = 20) -> dict:
     ko_err = front_errors(t, x, A, t_max=3.0, table=(ko[0][keep], ko[1][keep]))
     tp = np.array([r["t"] for r in sim.history])
     pw = np.array([np.nan if r["wall_p0"] is None else r["wall_p0"] for r in sim.history])
+    OUT.mkdir(parents=True, exist_ok=True)
+    np.savetxt(OUT / f"dambreak_{sim.scene.scheme.kind}{tag}.csv", np.column_stack([tp, pw]),
+               delimiter=",", header="t,p_wall_Pa", comments="")
     return {"case": "dambreak", "scheme": sim.scene.scheme.kind, "dp": dp,
             "front_error_mm": mm["max_rel_error"], "front_rms_mm": mm["rms_rel_error"],
             "front_error_ko": ko_err["max_rel_error"],
@@ -120,12 +129,34 @@ def obstacle(scheme: dict, t_end: float) -> dict:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--quick", action="store_true", help="still water only, 0.3 s")
-    ap.add_argument("--solvers", default="explicit,amg,ilu,direct")
+    ap.add_argument("--solvers", default="explicit,amg,ilu,direct,bicgstab")
     ap.add_argument("--cases", default="still,dambreak,obstacle")
     ap.add_argument("--schemes", default="wcsph,isph")
     ap.add_argument("--solver", default=None, help="ISPH solver of dambreak/obstacle (default: the scene's)")
+    ap.add_argument("--variants", default=None,
+                    help="JSON list of ISPH [scheme] option sets; replaces --solvers/--solver")
+    ap.add_argument("--t-still", type=float, default=None, help=f"still-water duration (default {T_STILL} s)")
     a = ap.parse_args()
-    t_still = 0.3 if a.quick else T_STILL
+    t_still = a.t_still or (0.3 if a.quick else T_STILL)
+    if a.variants:
+        variants = json.loads(a.variants)
+        cases = a.cases.split(",")
+        for sch in ({"kind": "wcsph"}, {"kind": "isph", "ppe_solver": "explicit"}):
+            Simulation(still_scene(sch, 0.01, res=5)).advance_to(0.01)
+        runs = {"still": lambda s: still(s, t_still),
+                "dambreak": lambda s: dambreak_run(s, tag="_" + "_".join(
+                    f"{k}{v}" for k, v in s.items() if k != "kind")),
+                "obstacle": lambda s: obstacle(s, 0.5)}
+        for case in cases:
+            if "wcsph" in a.schemes.split(","):
+                print(json.dumps(runs[case]({"kind": "wcsph"})), flush=True)
+            for v in variants:
+                try:
+                    out = runs[case]({"kind": "isph", **v})
+                except Exception as e:  # an unstable variant: say so and go on with the next
+                    out = {"case": case, "scheme": "isph", "error": f"{type(e).__name__}: {e}"}
+                print(json.dumps({**out, "variant": v}), flush=True)
+        return
     # warm-up: compile both schemes' kernels on a tiny tank
     for sch in ({"kind": "wcsph"}, {"kind": "isph", "ppe_solver": "explicit"}):
         Simulation(still_scene(sch, 0.01, res=5)).advance_to(0.01)

@@ -54,6 +54,7 @@ ENTRIES: list[tuple[str, dict[str, Any]]] = [
     # ISPH runs at its own h/dp sqrt 2 (sph_core.scene.ISPH_H_OVER_DP); its wave flume is
     # unstable (docs/schemes.md "ISPH with open ends and bodies"), so its wave line reports
     # wave_failed with the UnstableError
+    ("isph_bicgstab", {"scheme": {"kind": "isph", "ppe_solver": "bicgstab"}}),  # the default
     ("isph_amg", {"scheme": {"kind": "isph", "ppe_solver": "amg"}}),
     ("isph_explicit", {"scheme": {"kind": "isph", "ppe_solver": "explicit"}}),
 ]

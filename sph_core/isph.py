@@ -31,9 +31,12 @@ on the sorted state at t^n (docs/schemes.md "## ISPH" has the measurements behin
    heavy, and with the plain Adami rows fluid driven at the bed went through it (the wall pressure
    rises with the fluid's). Free-surface particles enter with p = 0. Solved by ``ppe_solver``:
    ``explicit`` = the seed's Jacobi iteration p_k <- (b_k - sum_{j != k} a_kj p_j) / a_kk
-   (Hosseini et al. 2007, eq. 13; the wall rows updated in the same sweep), ``amg`` = BiCGSTAB
-   preconditioned by smoothed-aggregation AMG (pyamg), ``ilu`` = BiCGSTAB with incomplete LU,
-   ``direct`` = SuperLU; the iterative ones warm-started from the last pressure;
+   (Hosseini et al. 2007, eq. 13; the wall rows updated in the same sweep), ``bicgstab`` (the
+   default) = BiCGSTAB preconditioned by the diagonal, jitted, ``amg`` = BiCGSTAB preconditioned
+   by smoothed-aggregation AMG (pyamg), ``ilu`` = BiCGSTAB with incomplete LU, ``direct`` =
+   SuperLU; the iterative ones warm-started from the last pressure. The no-penetration part
+   stops the approach within ``isph_wall_stop`` steps (rho |u_n| d / (stop dt)); it and the
+   source scale as 1/dt, so ``IsphStepper.run`` never ends a run on a sliver step;
 4. corrector (eq. 16-17): u^{n+1} = u* - dt grad p_i / rho0, r^{n+1} = r^n + dt (u^n + u^{n+1}) / 2,
    grad p by the renormalised difference B_i^-1 sum_j V_j (p_j - p_i) grad_i W_ij (Bonet & Lok
    1999; ``isph_gradient = "corrected"``, the default) or seed eq. 5 (``"symmetric"``: the
@@ -80,7 +83,7 @@ from .shifting import shift_particles
 from .wcsph import (FASTMATH, ST_CAPACITY, ST_LEFT_DOMAIN, ST_NONFINITE, ST_REACHED_T,
                     ST_STEP_LIMIT)
 
-PPE_SOLVERS = ("explicit", "amg", "ilu", "direct")
+PPE_SOLVERS = ("explicit", "amg", "ilu", "direct", "bicgstab")
 FS_DEFAULT_THRESHOLD = {"density": 0.9, "divergence": 1.5}
 MAX_ROW = 64   # non-zeros per PPE row, generous: a full 2D support at h/dp 2 has ~50 neighbours
 
@@ -127,10 +130,11 @@ def free_surface_flags(ps, n, cells, prm, by_density, threshold, flag, rho_k):
 
 
 @njit(parallel=True, cache=True, fastmath=FASTMATH)
-def wall_state(ps, n, cells, prm, dt, wsum, dwall):
+def wall_state(ps, n, cells, prm, dt, stop, wsum, dwall):
     """Adami et al. (2012) for every wall particle s from its fluid neighbours f:
     wsum[s] = sum_f W_sf, dwall[s] = sum_f W_sf rho_f (g - a_s) . r_sf / wsum (the hydrostatic
-    part of p_s), and the no-slip velocity vw_s = 2 v_s - sum_f v_f W_sf / wsum. Active buffer
+    part of p_s) plus the no-penetration part (module docstring; ``stop`` = isph_wall_stop),
+    and the no-slip velocity vw_s = 2 v_s - sum_f v_f W_sf / wsum. Active buffer
     particles of open ends count as f, with their known pressure moved into dwall (their sum
     W_sf p_f / wsum): the wall row then has unknowns for the fluid only."""
     x = ps.x
@@ -182,8 +186,9 @@ def wall_state(ps, n, cells, prm, dt, wsum, dwall):
                             nx -= dx * w
                             nz -= dz * w
             # the no-penetration part: fluid approaching the wall (relative normal velocity
-            # u_n < 0, n from the wall into the fluid) must stop within the step, so the
-            # ghost pressure rises by rho |u_n| / dt (n . r_fs) over each neighbour f
+            # u_n < 0, n from the wall into the fluid) must stop within tau, so the ghost
+            # pressure rises by rho |u_n| d / tau over each neighbour f, d = n . r_fs, with
+            # tau = stop dt (stop = isph_wall_stop steps, 1: within the step)
             nn = math.sqrt(nx * nx + nz * nz)
             if nn > 0.0:
                 nx /= nn
@@ -199,7 +204,8 @@ def wall_state(ps, n, cells, prm, dt, wsum, dwall):
                                 un = (vx[j] - vx[i]) * nx + (vz[j] - vz[i]) * nz
                                 if un < 0.0:
                                     w = w_of_q(math.sqrt(r2) * inv_h, aw)
-                                    sd -= rho[j] * un / dt * (-(dx * nx + dz * nz)) * w
+                                    d = -(dx * nx + dz * nz)
+                                    sd += rho[j] * (-un) * d / (stop * dt) * w
             wsum[i] = sw
             if sw > 0.0:
                 dwall[i] = sd / sw
@@ -455,7 +461,7 @@ def scatter_pressure(ps, m, slot, sol, flag):
 
 
 @njit(parallel=True, cache=True, fastmath=FASTMATH)
-def correct(ps, n, cells, prm, dt, corrected):
+def correct(ps, n, cells, prm, dt, corrected, dry_walls):
     """u^{n+1} = u* - dt (grad p / rho)_i (eq. 16), r^{n+1} = r^n + dt (u^n + u^{n+1}) / 2
     (eq. 17); grad p by seed eq. 5 (symmetric), or ``corrected``: the renormalised difference
     B_i^-1 sum_j V_j (p_j - p_i) grad_i W_ij (Bonet & Lok 1999), exact for a linear field on a
@@ -493,7 +499,10 @@ def correct(ps, n, cells, prm, dt, corrected):
                 row = zz * ncx
                 for j in range(cell_start[row + cxl], cell_start[row + cxh + 1]):
                     kj = kind[j]
-                    if j != i and 0 <= kj <= OUTLET:
+                    # without dry_walls, a wall particle with p < 0 (the air side of a wetted
+                    # wall, above the free surface) is left out like air: with it, the surface
+                    # corners of still water crept away from the wall (docs/schemes.md)
+                    if j != i and 0 <= kj <= OUTLET and (kj != WALL or dry_walls or p[j] >= 0.0):
                         dx = x[i] - x[j]
                         dz = z[i] - z[j]
                         r2 = dx * dx + dz * dz
@@ -541,6 +550,100 @@ def correct(ps, n, cells, prm, dt, corrected):
     return n_bad, n_out, v2max
 
 
+@njit(cache=True, fastmath=FASTMATH)
+def _spmv(indptr, indices, data, x, y, m):
+    for k in range(m):
+        s = 0.0
+        for c in range(indptr[k], indptr[k + 1]):
+            s += data[c] * x[indices[c]]
+        y[k] = s
+
+
+@njit(cache=True, fastmath=FASTMATH)
+def bicgstab_jacobi(indptr, indices, data, b, x, m, tol, max_iter, w):
+    """BiCGSTAB (van der Vorst 1992) preconditioned by the diagonal (first in each row), in
+    place on the warm start x; w is (8, >= m) scratch. No set-up and no Python per iteration:
+    on these small systems (10^3-10^4 unknowns, warm-started) that beats building an AMG
+    hierarchy every step. Returns (iterations, relative residual)."""
+    r = w[0]
+    rh = w[1]
+    p = w[2]
+    v = w[3]
+    ph = w[4]
+    sv = w[5]
+    sh = w[6]
+    t = w[7]
+    _spmv(indptr, indices, data, x, t, m)
+    bn = 0.0
+    rn = 0.0
+    for k in range(m):
+        r[k] = b[k] - t[k]
+        rh[k] = r[k]
+        p[k] = 0.0
+        v[k] = 0.0
+        bn += b[k] * b[k]
+        rn += r[k] * r[k]
+    bn = math.sqrt(bn)
+    if bn == 0.0:
+        bn = 1.0
+    rel = math.sqrt(rn) / bn
+    rho = 1.0
+    alpha = 1.0
+    omega = 1.0
+    it = 0
+    while rel > tol and it < max_iter:
+        rho1 = 0.0
+        for k in range(m):
+            rho1 += rh[k] * r[k]
+        if rho1 == 0.0 or omega == 0.0:  # breakdown: restart from the current residual
+            for k in range(m):
+                rh[k] = r[k]
+                p[k] = 0.0
+                v[k] = 0.0
+            rho = alpha = omega = 1.0
+            rho1 = 0.0
+            for k in range(m):
+                rho1 += r[k] * r[k]
+        beta = (rho1 / rho) * (alpha / omega)
+        rho = rho1
+        for k in range(m):
+            p[k] = r[k] + beta * (p[k] - omega * v[k])
+            ph[k] = p[k] / data[indptr[k]]
+        _spmv(indptr, indices, data, ph, v, m)
+        rv = 0.0
+        for k in range(m):
+            rv += rh[k] * v[k]
+        if rv == 0.0:  # breakdown with nothing left to gain: return the current iterate
+            break
+        alpha = rho / rv
+        sn = 0.0
+        for k in range(m):
+            sv[k] = r[k] - alpha * v[k]
+            sn += sv[k] * sv[k]
+        it += 1
+        if math.sqrt(sn) / bn <= tol:
+            for k in range(m):
+                x[k] += alpha * ph[k]
+            rel = math.sqrt(sn) / bn
+            break
+        for k in range(m):
+            sh[k] = sv[k] / data[indptr[k]]
+        _spmv(indptr, indices, data, sh, t, m)
+        ts = 0.0
+        tt = 0.0
+        for k in range(m):
+            ts += t[k] * sv[k]
+            tt += t[k] * t[k]
+        omega = ts / tt if tt > 0.0 else 0.0
+        rn = 0.0
+        for k in range(m):
+            x[k] += alpha * ph[k] + omega * sh[k]
+            r[k] = sv[k] - omega * t[k]
+            rn += r[k] * r[k]
+        rel = math.sqrt(rn) / bn
+    return it, rel
+
+
 def solve_ppe(solver: str, m: int, ptr: np.ndarray, indices: np.ndarray, data: np.ndarray,
               b: np.ndarray, x0: np.ndarray, tol: float, max_iter: int,
               scratch: np.ndarray) -> tuple[np.ndarray, int, float]:
@@ -549,6 +652,10 @@ def solve_ppe(solver: str, m: int, ptr: np.ndarray, indices: np.ndarray, data: n
     relative residual |b - A x| / |b|)."""
     if solver == "explicit":
         it, rel = jacobi(ptr, indices, data, b, x0, scratch, m, tol, max_iter)
+        return x0, int(it), float(rel)
+    if solver == "bicgstab":
+        work = scratch.reshape(-1)[: 8 * m].reshape(8, m) if scratch.size >= 8 * m else np.empty((8, m))
+        it, rel = bicgstab_jacobi(ptr, indices, data, b, x0, m, tol, max_iter, work)
         return x0, int(it), float(rel)
     nnz = int(ptr[m])
     a = sp.csr_matrix((data[:nnz], indices[:nnz], ptr[: m + 1]), shape=(m, m))
@@ -595,11 +702,11 @@ class IsphStepper:
     """The ISPH time loop of one Simulation: same call and returns as ``step.run``, plus the PPE
     statistics (``ppe_iterations``, ``ppe_solves``, ``ppe_unknowns``, ``solve_time``)."""
 
-    def __init__(self, capacity: int, prm: Any, dp: float, solver: str = "amg",
+    def __init__(self, capacity: int, prm: Any, dp: float, solver: str = "bicgstab",
                  tolerance: float = 1e-5, max_iter: int = 20000, free_surface: str = "density",
                  fs_threshold: float | None = None, shifting: bool = True,
                  gradient: str = "corrected", v_ref: float = 0.0,
-                 density_relaxation: float = 0.0) -> None:
+                 density_relaxation: float = 0.0, wall_stop: float = 1.0, dry_walls: bool = False) -> None:
         if solver not in PPE_SOLVERS:
             raise ValueError(f"ppe_solver: one of {PPE_SOLVERS}, got {solver!r}")
         self.prm = prm
@@ -612,6 +719,8 @@ class IsphStepper:
         self.shifting = bool(shifting) and prm.shift_a > 0.0
         self.corrected = gradient == "corrected"
         self.v_ref = float(v_ref)
+        self.wall_stop = float(wall_stop)
+        self.dry_walls = bool(dry_walls)
         # a typical fluid diagonal sum_j B_ij ~ (2 / rho0) sum_j V_j F_ij = 7 / (rho0 h^2): the
         # scale of the wall rows
         self.wscale = 7.0 / (prm.rho0 * prm.h * prm.h)
@@ -635,7 +744,7 @@ class IsphStepper:
         self.data = np.zeros(cap * MAX_ROW)
         self.b = np.zeros(cap)
         self.x0 = np.zeros(cap)
-        self.x2 = np.zeros(cap)
+        self.x2 = np.zeros(8 * cap)  # Jacobi's second vector, BiCGSTAB's eight
         self.ppe_iterations = 0
         self.ppe_solves = 0
         self.ppe_unknowns = 0
@@ -702,7 +811,7 @@ class IsphStepper:
         if self.rho_ref == 0.0:  # the initial lattice's interior kernel density (~1.006 rho0)
             inner = self.flag[:n] == 0
             self.rho_ref = float(np.median(self.rho_k[:n][inner])) if inner.any() else prm.rho0
-        wall_state(ps, n, cells, prm, dt, self.wsum, self.dwall)
+        wall_state(ps, n, cells, prm, dt, self.wall_stop, self.wsum, self.dwall)
         a2 = predict(ps, n, cells, prm, dt)
         self._solve(ps, n, cells, dt)
         if bd.active:
@@ -714,7 +823,7 @@ class IsphStepper:
             body_loads(ps, n, cells, prm, bd)
             bodies_kick_drift(bd, t, dt)
             bodies_kick(bd, t, dt)
-        n_bad, n_out, v2 = correct(ps, n, cells, prm, dt, self.corrected)
+        n_bad, n_out, v2 = correct(ps, n, cells, prm, dt, self.corrected, self.dry_walls)
         place_bodies(ps, n, bd)
         v2 = max(v2, bodies_v2max(bd))   # a fast body bounds dt as fluid does
         if ends.active:  # after the drift, as step.py's kdk step: buffers moved, crossings
@@ -748,8 +857,10 @@ class IsphStepper:
             # from the flow's, which the open ends' buffers then take over (extrapolated) and
             # the probes record. Measured: a 3.7e-5 s step after 2.3e-3 s ones raised the
             # fluid's largest pressure from 2.6 to 7.2 kPa; the open flume blew up within
-            # 0.015 s. So the last two steps share a remainder below 1.5 dt, and a round-off
-            # remainder (< 1e-6 dt) is not stepped.
+            # 0.015 s; in the closed dam break such steps before each probe record gave
+            # wall-pressure spikes of 10^5-10^7 Pa (docs/schemes.md). So the last two steps
+            # share a remainder below 1.5 dt, and a round-off remainder (< 1e-6 dt) is not
+            # stepped.
             rem = t_stop - t
             if rem <= 1e-6 * dt:
                 t = t_stop

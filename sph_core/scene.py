@@ -224,11 +224,11 @@ class Scheme(_Model):
         "riemann: Zhang, Hu & Adams (2017) limiter on the pressure dissipation, "
         "beta = min(eta max(U_L - U_R, 0)/c0, 1); false: beta = 1 (plain Godunov flux)"))
     low_dissipation_eta: float = Field(3.0, gt=0, description="riemann: eta of that limiter")
-    ppe_solver: Literal["explicit", "amg", "ilu", "direct"] = Field("amg", description=(
+    ppe_solver: Literal["explicit", "amg", "ilu", "direct", "bicgstab"] = Field("bicgstab", description=(
         "ISPH pressure Poisson solver: explicit = the seed's Jacobi iteration (Hosseini et al. "
         "2007); amg = BiCGSTAB preconditioned by smoothed-aggregation AMG (pyamg); ilu = "
         "BiCGSTAB preconditioned by incomplete LU (scipy); direct = sparse LU (SuperLU), the "
-        "reference"))
+        "reference; bicgstab = BiCGSTAB preconditioned by the diagonal, jitted (no set-up)"))
     ppe_tolerance: float = Field(1e-5, gt=0, lt=1, description=(
         "ISPH: relative residual |b - A p| / |b| at which the pressure solve stops"))
     ppe_max_iter: int = Field(20000, ge=1, description="ISPH: iteration cap of the pressure solve")
@@ -253,6 +253,15 @@ class Scheme(_Model):
         "ISPH: weight of the density-invariance term (rho_k - rho_ref)/(rho_ref dt^2) added to "
         "the divergence source (Asai et al. 2012); 0: the seed's divergence-free source alone "
         "(measured: the still-water surface then rises ~4 mm/s at d/dp 25; 0.01 holds it)"))
+    isph_wall_stop: float = Field(1.0, ge=1, description=(
+        "ISPH: fluid approaching a wall is stopped by a ghost-pressure rise rho |u_n| d / tau "
+        "over this many steps, tau = isph_wall_stop dt (d the fluid's distance from the wall "
+        "particle along the wall normal); 1: within one step"))
+    isph_dry_walls: bool = Field(False, description=(
+        "ISPH corrector: wall particles with a negative pressure (the air side of a wetted wall, "
+        "above the free surface) count in the pressure gradient (true, the original) or are left "
+        "out like air (false: with them the still-water surface corners crept away from the "
+        "wall and broke down at ~2.9 s)"))
     isph_shifting: bool = Field(True, description=(
         "ISPH: Fickian particle shifting (Lind et al. 2012) with Constants.shift_a after each step"))
 

@@ -149,7 +149,9 @@ class Simulation:
                                        scheme.free_surface, scheme.free_surface_threshold,
                                        scheme.isph_shifting, scheme.isph_gradient,
                                        v_ref=scheme.isph_vref_factor * math.sqrt(2.0 * c.g * scene.water_height),
-                                       density_relaxation=scheme.isph_density_relaxation)
+                                       density_relaxation=scheme.isph_density_relaxation,
+                                       wall_stop=scheme.isph_wall_stop,
+                                       dry_walls=scheme.isph_dry_walls)
             dt, n_new = self.stepper.initialise(ps.view, ps.view2, self.cells, ps.n,
                                                 self.open.ends, self.bodies.state)
         else:
