@@ -172,6 +172,11 @@ class Constants(_Model):
     shift_fs_div: float = Field(1.8, gt=0, lt=2, description=(
         "position divergence below which a particle counts as near the free surface (2D: 2 "
         "inside the fluid) and shifts only tangentially"))
+    kernel_correction: Literal["off", "all", "surface"] = Field("off", description=(
+        "kernel gradient correction of the momentum equation's pressure gradient (Bonet & Lok "
+        "1999, symmetric form; sph_core.kernel_correction): all = every fluid particle, "
+        "surface = blended in where the kernel is cut by the free surface (Schulze et al. "
+        "2025); wcsph scheme without bodies only"))
     wall_slip: Literal["no_slip", "free_slip"] = "no_slip"
     density_band: tuple[float, float] = Field((0.7, 1.3), description="sane rho/rho0 band")
     # A drop thrown off the surface (splash, run-up on a staircase bed) keeps few neighbours: its
@@ -455,6 +460,15 @@ class Scene(_Model):
             if self.bodies:
                 raise ValueError("scheme.kind: isph does not support bodies (yet); "
                                  "use kind = \"wcsph\" for a scene with rigid bodies")
+        if self.constants.kernel_correction != "off":
+            # the Riemann flux and ISPH have their own gradients; the body loads (bodies.py) and
+            # force probes take the uncorrected pair term
+            if self.scheme.kind != "wcsph":
+                raise ValueError("constants.kernel_correction: applies to [scheme] kind = "
+                                 "\"wcsph\" only")
+            if self.bodies:
+                raise ValueError("constants.kernel_correction: not with bodies (their loads "
+                                 "use the uncorrected pair term)")
         bnames = [b.name for b in self.bodies]
         if len(set(bnames)) != len(bnames):
             raise ValueError(f"bodies: duplicate names {bnames}")
