@@ -15,11 +15,20 @@ antisymmetric in i, j, so the fluid's total momentum is kept (a wall neighbour, 
 takes L_i). Variants (scene ``constants.kernel_correction``, Params.kgc):
 
 - ``all``: L_i for every fluid particle;
+- ``weighted``: gamma_i L_i for every fluid particle, gamma_i = sum_j V_j W_ij (self included)
+  the Shepard sum (1 in the bulk and beside walls, ~0.6 in the top row): our reading of the
+  "parameter-free weighting based on kernel support" of Schulze et al. 2025 (arXiv 2511.10064),
+  whose full text was not available here. Where the support is cut, M ~ gamma I, so gamma L ~ I
+  plus the anisotropic part: the truncation is left to the plain SPH surface, the disorder is
+  corrected;
 - ``surface``: localised near the free surface (in the spirit of Schulze et al. 2025,
-  arXiv 2511.10064, who correct only a band below the surface): L_i blended with the identity by
-  the particle's kernel completeness, the Shepard sum gamma_i = sum_j V_j W_ij (self included;
-  1 in the bulk and beside walls, ~0.6 in the top row): weight 1 below SURFACE_GAMMA_FULL, 0
-  above SURFACE_GAMMA_OFF, linear between. Deeper particles keep the plain gradient.
+  who correct only a band below the surface): L_i blended with the identity by the Shepard sum
+  gamma_i: weight 1 below SURFACE_GAMMA_FULL, 0 above SURFACE_GAMMA_OFF, linear between.
+  Deeper particles keep the plain gradient.
+
+Measured (docs/wave_decay_study.md, "Kernel gradient correction"): none of the three is stable
+enough to be the default in this WCSPH (still water loses particles through the bed with
+``all`` and ``surface``; ``weighted`` lowers the tank's decay but multiplies its particle noise).
 
 Where M_i is near singular (a splash particle with a few neighbours in a line) L_i = I: there
 the correction would amplify noise, not fix a truncation.
@@ -36,10 +45,11 @@ from .neighbours import block_of
 from .particles import FLUID, OUTLET, WALL
 
 # scene constants.kernel_correction -> Params.kgc
-KERNEL_CORRECTIONS = {"off": 0, "all": 1, "surface": 2}
+KERNEL_CORRECTIONS = {"off": 0, "all": 1, "surface": 2, "weighted": 3}
 KGC_OFF = 0
 KGC_ALL = 1
 KGC_SURFACE = 2
+KGC_WEIGHTED = 3
 # "surface": full correction where the Shepard sum is below GAMMA_FULL (within ~h of the surface
 # at h/dp 2), none above GAMMA_OFF (the bulk: disorder moves gamma by ~1 %)
 SURFACE_GAMMA_FULL = 0.9
@@ -71,6 +81,7 @@ def correction_matrices(ps, n, cells, prm):
     aw = prm.alpha_w
     w0 = w_of_q(0.0, aw)
     surface = prm.kgc == KGC_SURFACE
+    weighted = prm.kgc == KGC_WEIGHTED
     ramp = 1.0 / (SURFACE_GAMMA_OFF - SURFACE_GAMMA_FULL)
     for i in prange(n):
         ki = kind[i]
@@ -105,12 +116,19 @@ def correction_matrices(ps, n, cells, prm):
             tr = mxx + mzz
             if tr > 0.0 and det > MIN_DET_RATIO * tr * tr:
                 inv = 1.0 / det
-                wt = 1.0
                 if surface:
                     wt = min(max((SURFACE_GAMMA_OFF - gam) * ramp, 0.0), 1.0)
-                cxx = 1.0 + wt * (mzz * inv - 1.0)
-                cxz = -wt * mxz * inv
-                czz = 1.0 + wt * (mxx * inv - 1.0)
+                    cxx = 1.0 + wt * (mzz * inv - 1.0)
+                    cxz = -wt * mxz * inv
+                    czz = 1.0 + wt * (mxx * inv - 1.0)
+                else:
+                    if weighted:
+                        # gamma_i L_i: M ~ gamma I where the support is cut, so what stays
+                        # corrected there is the anisotropy, not the truncation
+                        inv *= min(gam, 1.0)
+                    cxx = mzz * inv
+                    cxz = -mxz * inv
+                    czz = mxx * inv
         lxx[i] = cxx
         lxz[i] = cxz
         lzz[i] = czz

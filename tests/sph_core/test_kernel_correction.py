@@ -9,7 +9,8 @@ import math
 import numpy as np
 import pytest
 
-from sph_core.kernel_correction import KGC_ALL, KGC_OFF, KGC_SURFACE, correction_matrices
+from sph_core.kernel_correction import (KGC_ALL, KGC_OFF, KGC_SURFACE, KGC_WEIGHTED,
+                                        correction_matrices)
 from sph_core.kernels import f_of_q, wendland_alpha
 from sph_core.neighbours import CellGrid
 from sph_core.particles import FLUID, M, N_FIELDS, P, RHO, WALL, X, Z
@@ -104,7 +105,24 @@ def test_surface_variant_corrects_the_top_rows_only():
     np.testing.assert_allclose(ps.lzz[:n][top], ps_all.lzz[:n][top], rtol=1e-12)
 
 
-@pytest.mark.parametrize("kgc", [KGC_ALL, KGC_SURFACE])
+def test_weighted_variant_leaves_the_truncation_and_corrects_the_disorder():
+    """gamma L: in the top row of a regular lattice close to the identity (the cut is left to the
+    plain SPH surface: |gamma L_zz - 1| well below |L_zz - 1|); in the jittered bulk gamma L = L
+    within the Shepard sum's ~1 % (the disorder is corrected)."""
+    ps_w, n, _, _ = _block(KGC_WEIGHTED, jitter=0.0)
+    ps_a, _, _, _ = _block(KGC_ALL, jitter=0.0)
+    fl = ps_w.kind[:n] == FLUID
+    top = fl & (ps_w.z[:n] > 8.75 * DP) & (ps_w.x[:n] > 4 * DP) & (ps_w.x[:n] < 12 * DP)
+    assert np.abs(ps_w.lzz[:n][top] - 1.0).max() < 0.5 * np.abs(ps_a.lzz[:n][top] - 1.0).min()
+    ps_w, n, _, _ = _block(KGC_WEIGHTED)
+    ps_a, _, _, _ = _block(KGC_ALL)
+    fl = ps_w.kind[:n] == FLUID
+    bulk = fl & (ps_w.z[:n] > 3 * DP) & (ps_w.z[:n] < 6 * DP) & (ps_w.x[:n] > 4 * DP) & (ps_w.x[:n] < 12 * DP)
+    np.testing.assert_allclose(ps_w.lxz[:n][bulk], ps_a.lxz[:n][bulk], rtol=0.03, atol=1e-3)
+    np.testing.assert_allclose(ps_w.lzz[:n][bulk], ps_a.lzz[:n][bulk], rtol=0.03)
+
+
+@pytest.mark.parametrize("kgc", [KGC_ALL, KGC_SURFACE, KGC_WEIGHTED])
 def test_corrected_pressure_term_keeps_the_total_momentum(kgc):
     """No walls, no gravity: the fluid's pair forces must cancel (sum m_i a_i = 0) with the
     correction as without it, while the accelerations themselves change."""
@@ -137,10 +155,17 @@ def test_scene_option_reaches_params_and_is_rejected_where_it_does_not_apply():
         make_scene({**base, "constants": {"kernel_correction": "all"}, "scheme": {"kind": "riemann"}})
 
 
-@pytest.mark.parametrize("mode", ["all", "surface"])
+# all / surface: still water loses a fluid particle through the bed within ~0.5-0.7 s (d 0.24,
+# dp 0.02; docs/wave_decay_study.md "Kernel gradient correction"): a known defect of the option,
+# kept as a strict xfail so that a fix shows
+_LEAKS = pytest.mark.xfail(strict=True, reason="still water leaks through the bed (docs)")
+
+
+@pytest.mark.parametrize("mode", [pytest.param("all", marks=_LEAKS),
+                                  pytest.param("surface", marks=_LEAKS), "weighted"])
 def test_still_water_with_kernel_correction_stays_still(mode):
     """A still tank (d 0.2 m, d/dp 10) with the correction on for 1.5 s: the water stays at rest
-    (max speed, net momentum) and the surface keeps its level."""
+    (max speed, net momentum), keeps every particle and the surface keeps its level."""
     from sph_core.scene import make_scene
     from sph_core.simulation import Simulation
 
@@ -155,6 +180,7 @@ def test_still_water_with_kernel_correction_stays_still(mode):
     st0 = sim.fluid_state()
     sim.advance_to(1.5)
     st = sim.fluid_state()
+    assert st["m"].size == st0["m"].size, f"{len(sim.excluded)} particle(s) excluded"
     vmax = np.sqrt(st["vx"] ** 2 + st["vz"] ** 2).max()
     assert vmax < 0.01 * math.sqrt(9.81 * d), f"max speed {vmax:.3g} m/s"
     mom = np.hypot(np.sum(st["m"] * st["vx"]), np.sum(st["m"] * st["vz"]))
