@@ -2,7 +2,7 @@
 is exact to round-off in the bulk and in the top rows cut by the free surface (where the plain
 SPH gradient is not); the "surface" variant leaves the bulk alone; the corrected pressure term
 of fluid_pass keeps the fluid's total momentum (pair terms antisymmetric); still water with the
-option on stays still."""
+option on does not stay still yet (strict xfails: the option is experimental)."""
 
 import math
 
@@ -155,14 +155,17 @@ def test_scene_option_reaches_params_and_is_rejected_where_it_does_not_apply():
         make_scene({**base, "constants": {"kernel_correction": "all"}, "scheme": {"kind": "riemann"}})
 
 
-# all / surface: still water loses a fluid particle through the bed within ~0.5-0.7 s (d 0.24,
-# dp 0.02; docs/wave_decay_study.md "Kernel gradient correction"): a known defect of the option,
-# kept as a strict xfail so that a fix shows
+# No variant holds still water yet (docs/wave_decay_study.md "Kernel gradient correction"):
+# all / surface lose a fluid particle through the bed within ~0.5-0.7 s, weighted reaches
+# 0.36 m/s of particle noise by 1.5 s. Known defects of the experimental option, kept as strict
+# xfails so that a fix shows.
 _LEAKS = pytest.mark.xfail(strict=True, reason="still water leaks through the bed (docs)")
+_NOISE = pytest.mark.xfail(strict=True, reason="particle noise grows in still water (docs)")
 
 
 @pytest.mark.parametrize("mode", [pytest.param("all", marks=_LEAKS),
-                                  pytest.param("surface", marks=_LEAKS), "weighted"])
+                                  pytest.param("surface", marks=_LEAKS),
+                                  pytest.param("weighted", marks=_NOISE)])
 def test_still_water_with_kernel_correction_stays_still(mode):
     """A still tank (d 0.2 m, d/dp 10) with the correction on for 1.5 s: the water stays at rest
     (max speed, net momentum), keeps every particle and the surface keeps its level."""
