@@ -1,6 +1,6 @@
 """What does each accuracy option cost per particle-step, under the same load?
 
-    python bench/option_cost.py [--dp 0.01] [--steps 2000] [--repeats 3]
+    python bench/option_cost.py [--dp 0.01] [--steps 2000] [--repeats 3] [--only WORD ...]
 
 The closed tank of cases.standing_wave (1.0 x 0.24 m of water, moving) stepped a fixed number
 of steps per variant; variants are interleaved and repeated so that a change of machine load hits
@@ -28,11 +28,15 @@ from sph_core.particles import FLUID, VX, VZ, X, Z  # noqa: E402
 from sph_core.scene import make_scene  # noqa: E402
 from sph_core.simulation import Simulation  # noqa: E402
 
+BASELINE = "baseline (defaults: h/dp 2, alpha_wall_factor 0)"
 VARIANTS = {
-    "baseline (defaults: h/dp 2, alpha_wall_factor 0)": {},
+    BASELINE: {},
     "h/dp sqrt(2)": {"h_over_dp": 1.4142},
     "alpha_wall_factor 1": {"alpha_wall_factor": 1.0},
     "shifting fickian": {"shifting": "fickian"},
+    "kernel_correction all": {"kernel_correction": "all"},
+    "kernel_correction surface": {"kernel_correction": "surface"},
+    "kernel_correction weighted": {"kernel_correction": "weighted"},
 }
 
 
@@ -59,8 +63,11 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--dp", type=float, default=0.01)
     ap.add_argument("--steps", type=int, default=2000)
     ap.add_argument("--repeats", type=int, default=3)
+    ap.add_argument("--only", nargs="+", default=None,
+                    help="run the baseline and the variants whose name contains one of these words")
     a = ap.parse_args(argv)
-    sims = {name: build(a.dp, cst) for name, cst in VARIANTS.items()}
+    sims = {name: build(a.dp, cst) for name, cst in VARIANTS.items()
+            if a.only is None or name == BASELINE or any(w in name for w in a.only)}
     for sim in sims.values():  # compile and settle
         sim.advance_steps(50)
     best = {name: 0.0 for name in sims}
@@ -74,7 +81,7 @@ def main(argv: list[str] | None = None) -> int:
             rate = sim.n_particles * (sim.steps - s0) / wall
             best[name] = max(best[name], rate)
             dt_step[name] = (sim.t - t0) / (sim.steps - s0)
-    base = best["baseline (h/dp 2)"]
+    base = best[BASELINE]
     for name, sim in sims.items():
         print(json.dumps({"variant": name, "particles": sim.n_particles,
                           "particle_steps_per_s": round(best[name]),

@@ -4,7 +4,7 @@
         [--settle-periods 0] [--inlet-pressure hydrostatic|extrapolated] [--no-outlet-absorb]
         [--h-over-dp 2.0] [--alpha 0.01] [--slip no_slip|free_slip] [--c0-factor 10] [--delta 0.1]
         [--cfl 0.25] [--integrator kdk|symplectic_pc] [--nu 1e-6] [--alpha-wall 1.0]
-        [--shifting none|fickian] [--shift-a 2.0]
+        [--shifting none|fickian] [--kernel-correction off|all|surface|weighted] [--shift-a 2.0]
         [--shift-fs-div 1.8] [--flume-wavelengths 1]
         [--scheme wcsph|riemann|isph] [--reconstruction muscl|none] [--limiter minmod|vanleer]
         [--low-dissipation | --no-low-dissipation]
@@ -72,13 +72,16 @@ def main(argv: list[str] | None = None) -> int:
                     help="outlet without the absorption correction (diagnostic: its reflection)")
     ap.add_argument("--inlet-pressure", choices=["hydrostatic", "extrapolated"],
                     help="inlet buffer pressure (scene default if unset)")
+    ap.add_argument("--kernel-correction", choices=["off", "all", "surface", "weighted"],
+                    help="kernel gradient correction of the pressure gradient")
     add_scheme_arguments(ap)
     a = ap.parse_args(argv)
     cst = {k: v for k, v in {"h_over_dp": a.h_over_dp, "alpha": a.alpha, "wall_slip": a.slip,
                              "delta": a.delta, "cfl": a.cfl, "nu": a.nu,
                              "integrator": a.integrator, "shifting": a.shifting,
                              "shift_a": a.shift_a, "shift_fs_div": a.shift_fs_div,
-                             "alpha_wall_factor": a.alpha_wall}.items() if v is not None}
+                             "alpha_wall_factor": a.alpha_wall,
+                             "kernel_correction": a.kernel_correction}.items() if v is not None}
     scheme = scheme_from_args(a)
     c0 = a.c0_factor * math.sqrt(9.81 * a.d)
     decays = []

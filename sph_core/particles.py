@@ -33,13 +33,16 @@ DRHO, VWX, VWZ = range(14, 17)
 # Riemann SPH with MUSCL (riemann.py): gradients of p, vx, vz of fluid and buffer particles,
 # recomputed before every force pass
 GPX, GPZ, GUX, GUZ, GWX, GWZ = range(17, 23)
-N_FIELDS = 23
+# kernel gradient correction (kernel_correction.py): the symmetric 2x2 matrix L of every fluid
+# and buffer particle (identity elsewhere), recomputed before every force pass
+LXX, LXZ, LZZ = range(23, 26)
+N_FIELDS = 26
 N_SORTED_KDK = 9
 N_SORTED_PC = 14
 
 FIELD_NAMES = ("x", "z", "vx", "vz", "ax", "az", "rho", "p", "m",
                "xn", "zn", "vxn", "vzn", "rhon", "drho", "vwx", "vwz",
-               "gpx", "gpz", "gux", "guz", "gwx", "gwz")
+               "gpx", "gpz", "gux", "guz", "gwx", "gwz", "lxx", "lxz", "lzz")
 
 
 @dataclass

@@ -172,6 +172,15 @@ class Constants(_Model):
     shift_fs_div: float = Field(1.8, gt=0, lt=2, description=(
         "position divergence below which a particle counts as near the free surface (2D: 2 "
         "inside the fluid) and shifts only tangentially"))
+    # experimental: none of the variants is stable enough for the default (still water loses
+    # particles through the bed with all / surface; weighted multiplies the particle noise;
+    # docs/wave_decay_study.md "Kernel gradient correction")
+    kernel_correction: Literal["off", "all", "surface", "weighted"] = Field("off", description=(
+        "kernel gradient correction of the momentum equation's pressure gradient (Bonet & Lok "
+        "1999, symmetric form; sph_core.kernel_correction), experimental: all = every fluid "
+        "particle, weighted = every fluid particle times its Shepard sum, surface = blended "
+        "in where the kernel is cut by the free surface (Schulze et al. 2025); wcsph scheme "
+        "without bodies only"))
     wall_slip: Literal["no_slip", "free_slip"] = "no_slip"
     density_band: tuple[float, float] = Field((0.7, 1.3), description="sane rho/rho0 band")
     # A drop thrown off the surface (splash, run-up on a staircase bed) keeps few neighbours: its
@@ -473,6 +482,15 @@ class Scene(_Model):
                     raise ValueError(f"bodies.{i}.motion: isph supports fixed and prescribed "
                                      f"bodies only, got {b.motion!r} (use scheme kind "
                                      "\"wcsph\" for free or hinged bodies)")
+        if self.constants.kernel_correction != "off":
+            # the Riemann flux and ISPH have their own gradients; the body loads (bodies.py) and
+            # force probes take the uncorrected pair term
+            if self.scheme.kind != "wcsph":
+                raise ValueError("constants.kernel_correction: applies to [scheme] kind = "
+                                 "\"wcsph\" only")
+            if self.bodies:
+                raise ValueError("constants.kernel_correction: not with bodies (their loads "
+                                 "use the uncorrected pair term)")
         bnames = [b.name for b in self.bodies]
         if len(set(bnames)) != len(bnames):
             raise ValueError(f"bodies: duplicate names {bnames}")

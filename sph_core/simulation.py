@@ -28,6 +28,7 @@ import numba
 import numpy as np
 
 from . import riemann, step, wcsph
+from .kernel_correction import KERNEL_CORRECTIONS
 from .isph import IsphStepper
 from .bodies import BodyLog, BodySet
 from .boundary_data import BoundaryData, BoundaryDataError, BoundarySample
@@ -138,7 +139,9 @@ class Simulation:
                           fz0=t.z0 - 0.5 * dp, fz1=t.z1, alpha_wall=c.alpha_wall_factor,
                           shift_a=(c.shift_a if (c.shifting == "fickian"
                                                  or (self.isph and scheme.isph_shifting)) else 0.0),
-                          shift_fs_div=c.shift_fs_div, **scheme_params(scene.scheme))
+                          shift_fs_div=c.shift_fs_div,
+                          kgc=KERNEL_CORRECTIONS[c.kernel_correction],
+                          **scheme_params(scene.scheme))
         self.integrator = wcsph.INTEGRATORS[c.integrator]
         self.passes_per_step = wcsph.PASSES_PER_STEP[c.integrator]
         self._counts = np.zeros(ps.capacity, dtype=np.int64)

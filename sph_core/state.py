@@ -19,8 +19,8 @@ from typing import NamedTuple
 import numpy as np
 
 from .absorption import N_FILTER
-from .particles import (AX, AZ, DRHO, GPX, GPZ, GUX, GUZ, GWX, GWZ, M, P, RHO, RHON, VWX, VWZ, VX,
-                        VXN, VZ, VZN, XN, ZN, X, Z)
+from .particles import (AX, AZ, DRHO, GPX, GPZ, GUX, GUZ, GWX, GWZ, LXX, LXZ, LZZ, M, P, RHO,
+                        RHON, VWX, VWZ, VX, VXN, VZ, VZN, XN, ZN, X, Z)
 
 
 class Particles(NamedTuple):
@@ -54,6 +54,9 @@ class Particles(NamedTuple):
     guz: np.ndarray
     gwx: np.ndarray
     gwz: np.ndarray
+    lxx: np.ndarray      # kernel gradient correction L (kernel_correction.py): symmetric 2x2
+    lxz: np.ndarray
+    lzz: np.ndarray
     kind: np.ndarray     # int8: particles.FLUID, WALL, INLET, ...
     ids: np.ndarray      # int64 identity, kept through sorts
     cell: np.ndarray     # int64 cell index of the slot (set by the sort)
@@ -63,7 +66,7 @@ def particles_view(f: np.ndarray, kind: np.ndarray, ids: np.ndarray, cell: np.nd
     """Named views of the storage ``f`` (no copy)."""
     return Particles(f, f[X], f[Z], f[VX], f[VZ], f[AX], f[AZ], f[RHO], f[P], f[M], f[XN], f[ZN],
                      f[VXN], f[VZN], f[RHON], f[DRHO], f[VWX], f[VWZ], f[GPX], f[GPZ], f[GUX], f[GUZ],
-                     f[GWX], f[GWZ], kind, ids, cell)
+                     f[GWX], f[GWZ], f[LXX], f[LXZ], f[LZZ], kind, ids, cell)
 
 
 class Cells(NamedTuple):
@@ -112,6 +115,9 @@ class Params(NamedTuple):
     riemann: bool = False
     limiter: int = 0     # MUSCL slope limiter (riemann.LIMITERS): 0 = no reconstruction
     rs_eta: float = 0.0  # Zhang et al. 2017 dissipation limiter eta (0: full dissipation)
+    # kernel gradient correction of the pressure gradient (scene constants.kernel_correction;
+    # kernel_correction.KERNEL_CORRECTIONS): 0 off, 1 all fluid particles, 2 near the surface
+    kgc: int = 0
 
 
 class OpenEnds(NamedTuple):

@@ -10,6 +10,8 @@ continuity + delta-SPH (Fourtakas et al. 2019 dynamic form, fluid-fluid and flui
     rho^H_ji = rho_H(z_j) - rho_H(z_i) = (rho_i g / c_i^2)(z_i - z_j),  c_i^2 = c0^2 (rho_i/rho0)^(gamma-1)
 momentum:
     dv_i/dt = sum_j m_j [(p_i + p_j)/(rho_i rho_j) + Pi_ij] F_ij r_ij                 (pressure, Monaghan AV)
+              (with a kernel gradient correction, kernel_correction.py, the pressure part's
+               F_ij r_ij is (L_i + L_j)/2 F_ij r_ij)
               - sum_j m_j 4 nu F_ij r^2 / ((rho_i + rho_j)(r^2 + 0.01 h^2)) v_ij + g   (Lo & Shao 2002)
     Pi_ij = -alpha c0 h (v_ij.r_ij) / (rho_bar (r^2 + 0.01 h^2)) if v_ij.r_ij < 0 else 0   (Monaghan 1992)
 walls (Adami, Hu & Adams 2012, eq. 22 of seed 004), from fluid neighbours f of wall particle s:
@@ -187,10 +189,19 @@ def fluid_pass(ps, n, cells, prm):
     guz = ps.guz
     gwx = ps.gwx
     gwz = ps.gwz
+    # kernel gradient correction (kernel_correction.py): the pressure term's grad_i W_ij becomes
+    # (L_i + L_j)/2 grad_i W_ij (L_i for a wall neighbour): antisymmetric, so momentum is kept
+    kgc = prm.kgc != 0
+    lxx = ps.lxx
+    lxz = ps.lxz
+    lzz = ps.lzz
     for i in prange(n):
         if kind[i] == FLUID:
             xi = x[i]
             zi = z[i]
+            lxxi = lxx[i]
+            lxzi = lxz[i]
+            lzzi = lzz[i]
             vxi = vx[i]
             vzi = vz[i]
             rhoi = rho[i]
@@ -265,6 +276,19 @@ def fluid_pass(ps, n, cells, prm):
                     if kj == WALL:
                         dvx = vxi - vwx[j]
                         dvz = vzi - vwz[j]
+                    if kgc:
+                        # the pressure part alone goes through L; viscosity keeps grad W
+                        if kj == WALL:
+                            cxx = lxxi
+                            cxz = lxzi
+                            czz = lzzi
+                        else:
+                            cxx = 0.5 * (lxxi + lxx[j])
+                            cxz = 0.5 * (lxzi + lxz[j])
+                            czz = 0.5 * (lzzi + lzz[j])
+                        fx += pf * fij * (cxx * dx + cxz * dz)
+                        fz += pf * fij * (cxz * dx + czz * dz)
+                        pf = 0.0
                     if visc:
                         vr = dvx * dx + dvz * dz
                         mden = mj / ((rhoi + rhoj) * (r2 + eta2))
