@@ -133,7 +133,14 @@ class ParticleSet:
     def restore(self, c: Checkpoint) -> None:
         if c.n > self.capacity:
             raise ValueError("checkpoint: more particles than this set's capacity")
-        self.f[:, : c.n] = c.f
+        rows = c.f.shape[0]
+        # a checkpoint of an older version has fewer rows: the ones it lacks are per-step
+        # scratch (gradients, correction matrices), recomputed before they are read
+        if not N_SORTED_PC <= rows <= N_FIELDS:
+            raise ValueError(f"checkpoint: {rows} particle fields, this version reads "
+                             f"{N_SORTED_PC}..{N_FIELDS}")
+        self.f[:rows, : c.n] = c.f
+        self.f[rows:, : c.n] = 0.0
         self.kind[: c.n] = c.kind
         self.kind[c.n:] = INACTIVE
         self.ids[: c.n] = c.ids
