@@ -42,6 +42,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from cases.wave_decay import amplitude_profile, convergence_orders, separated_decay  # noqa: E402
 from cases.schemes import add_scheme_arguments, scheme_from_args  # noqa: E402
+from sph_core.absorption import ABSORPTION_KINDS, ABSORPTION_TRANSFERS  # noqa: E402
 from wave_client.theories import build_theory  # noqa: E402
 
 
@@ -55,7 +56,18 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--settle-periods", type=float, default=0.0,
                     help="extra periods between the front's passage and the analysed window")
     ap.add_argument("--flume-wavelengths", type=float, default=1.0,
-                    help="flume length in wavelengths (gauges stay within 3/4 of the first)")
+                    help="flume length in wavelengths")
+    ap.add_argument("--gauge-wavelengths", type=float, default=0.75,
+                    help="gauges from 2h past the inlet to this many wavelengths")
+    ap.add_argument("--long", action="store_true",
+                    help="the long flume: 3 wavelengths, 36 gauges over 2.25, window after the "
+                         "outlet's reflection has come back to the inlet (its pattern, period "
+                         "L/2, averages out of the fitted decay)")
+    ap.add_argument("--n-gauges", type=int, default=12, help="number of elevation gauges")
+    ap.add_argument("--absorption", choices=ABSORPTION_KINDS, help="both ends' correction "
+                    "(scene default if unset)")
+    ap.add_argument("--transfer", choices=ABSORPTION_TRANSFERS,
+                    help="the correction's ideal gain (scene default if unset)")
     ap.add_argument("--h-over-dp", type=float, help="smoothing length / dp (scene default if unset)")
     ap.add_argument("--alpha", type=float, help="artificial viscosity coefficient")
     ap.add_argument("--slip", choices=["no_slip", "free_slip"], help="wall (bed) condition")
@@ -80,6 +92,10 @@ def main(argv: list[str] | None = None) -> int:
                              "shift_a": a.shift_a, "shift_fs_div": a.shift_fs_div,
                              "alpha_wall_factor": a.alpha_wall}.items() if v is not None}
     scheme = scheme_from_args(a)
+    if a.long:
+        a.flume_wavelengths, a.gauge_wavelengths, a.n_gauges = 3.0, 2.25, 36
+    ends = {k: v for k, v in {"absorption": a.absorption,
+                              "absorption_transfer": a.transfer}.items() if v is not None}
     c0 = a.c0_factor * math.sqrt(9.81 * a.d)
     decays = []
     for dp in a.dp:
@@ -88,7 +104,9 @@ def main(argv: list[str] | None = None) -> int:
                                  periods=a.periods, flume_wavelengths=a.flume_wavelengths,
                                  inlet_pressure=a.inlet_pressure, settle_periods=a.settle_periods,
                                  outlet_absorb=not a.no_outlet_absorb,
-                                 c0=c0, scheme=scheme, **cst)
+                                 gauge_wavelengths=a.gauge_wavelengths, n_gauges=a.n_gauges,
+                                 wait_reflection=a.long,
+                                 c0=c0, scheme=scheme, **ends, **cst)
         length = float(model.length)
         decays.append(prof.decay_per_m)
         sep_decay, sep_k, sep_kr = separated_decay(prof.x, prof.amp, prof.k)
@@ -97,6 +115,7 @@ def main(argv: list[str] | None = None) -> int:
                           "inlet_pressure": a.inlet_pressure, "settle_periods": a.settle_periods,
                           "outlet_absorb": not a.no_outlet_absorb,
                           "flume_wavelengths": a.flume_wavelengths,
+                          "gauge_wavelengths": a.gauge_wavelengths, "long": a.long, **ends,
                           "wavelength_m": round(length, 4),
                           "x": prof.x.tolist(),
                           "amplitude_ratio": [round(float(r), 4) for r in prof.ratio],

@@ -356,13 +356,19 @@ class OpenBoundary(_Model):
     ``absorption`` picks the correction's gain (``sph_core.absorption``): ``linear`` omega/(k d) at
     the wave period (``absorption_period``, else the source theory's period; sqrt(g/d) when
     neither is known), ``shallow`` the seed 002 sqrt(g/d) at every kd, ``filter`` (default,
-    measured best: docs/absorption.md) a causal filter following omega/(k d) frequency by
-    frequency, delayed by the gauge's offset (exact at the wave period when one is known)."""
+    measured best: docs/absorption.md) a causal filter following the ideal gain frequency by
+    frequency, delayed by the gauge's offset (exact at the wave period when one is known).
+    ``absorption_transfer`` is that ideal gain: ``piston`` (default) Biesel's transfer function
+    of a depth-uniform wave maker, ``flux`` omega/(k d) (low by 19 % at kd 2)."""
 
     side: Literal["left", "right"]
     elevation: Literal["imposed", "extrapolated"] = "imposed"
     absorb: bool = True
     absorption: Literal["shallow", "linear", "filter"] = "filter"
+    absorption_transfer: Literal["piston", "flux"] = Field(
+        "piston", description="ideal gain of the depth-uniform correction: Biesel's piston "
+                              "transfer function, or the depth-mean velocity omega/(k d) "
+                              "(sph_core.absorption.transfer_gain)")
     absorption_period: float | None = Field(None, gt=0, description="wave period [s] of the "
                                             "linear absorption gain (None: the source's)")
     gauge_offset: float | None = Field(None, gt=0, description="boundary gauge distance inside the face [m]")
