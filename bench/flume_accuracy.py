@@ -54,7 +54,8 @@ def case_theory(theory: str, height: float, period: float, depth: float, ramp: f
 
 def run_flume_case(theory: str, height: float, period: float, depth: float, dp: float, periods: float,
                    ramp_periods: float = 1.0, absorb: bool = True, case: str | None = None,
-                   absorption: str = "linear", transfer: str = "piston", **constants) -> dict:
+                   absorption: str = "linear", transfer: str = "piston",
+                   surface: str = "gauge", **constants) -> dict:
     ramp = ramp_periods * period
     model = case_theory(theory, height, period, depth, ramp)
     if theory == "irregular":  # flume length and gauges from the peak wave
@@ -65,7 +66,7 @@ def run_flume_case(theory: str, height: float, period: float, depth: float, dp: 
                      dp=dp, periods=periods, ramp=ramp, standing=theory == "standing",
                      absorb=(absorb, absorb), regular=theory != "irregular",
                      name=f"flume_{case or theory}", absorption=absorption,
-                     absorption_transfer=transfer, **constants)
+                     absorption_transfer=transfer, right_surface=surface, **constants)
     return {"case": case, "theory": theory, **constants, **out}
 
 
@@ -88,6 +89,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--transfer", choices=ABSORPTION_TRANSFERS, nargs="+", default=["piston"],
                     help="ideal gain of the correction: Biesel's piston transfer function or "
                          "the depth-mean velocity omega/(k d) (several: one run each)")
+    ap.add_argument("--surface", choices=["gauge", "face"], default="gauge",
+                    help="the outlet buffer's surface: the gauge's reading, or the theory's "
+                         "elevation at the face plus the gauge's mismatch")
     ap.add_argument("--h-over-dp", type=float, help="smoothing length / dp (default: the scene's)")
     ap.add_argument("--alpha-wall", type=float, help="wall viscosity factor (scene default)")
     a = ap.parse_args(argv)
@@ -112,7 +116,7 @@ def main(argv: list[str] | None = None) -> int:
             for transfer in a.transfer:
                 out = run_flume_case(theory, height, period, depth, dp, a.periods,
                                      a.ramp_periods, not a.no_absorb, a.case, absorption,
-                                     transfer, **constants)
+                                     transfer, a.surface, **constants)
                 print(json.dumps(out), flush=True)
     return 0
 

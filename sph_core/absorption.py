@@ -1,22 +1,22 @@
 """Gain of the open ends' active absorption (seed 002 correction): du = n_x G (eta_meas - eta_gauge).
 
 The buffer adds one velocity du, uniform over the depth, to the source's profile: it is a piston
-wave maker that must emit the wave cancelling the unwanted one the gauge sees. A linear
-progressive wave eta = a cos(k x - omega t) in depth d carries the volume flux
-    q = int_{-d}^{0} u dz = (omega / k) eta        (mass: d eta/dt + dq/dx = 0)
-(equivalently, the depth mean of u = a omega cosh k(z + d) / sinh kd cos(...) is a omega/(k d)).
-A depth-uniform velocity carrying that flux is
-    U = q / d = (omega / (k d)) eta = (c / d) eta,   c = omega / k the phase speed,
-so the gain that emits (or swallows) exactly the wave the gauge measures is
-    G(omega) = omega / (k d) = sqrt(g/d) sqrt(tanh(kd) / kd)            ("linear"),
-which tends to the seed-002 shallow-water gain sqrt(g/d) as kd -> 0 ("shallow") and falls
-below it with kd: sqrt(g/d) over-drives the absorber by 1 / sqrt(tanh(kd)/kd) - 1 = 1.5 % at
-kd 0.3, 9 % at 0.75, 20 % at 1.2, 44 % at 2. A gain G' = rho G re-emits a wave (rho - 1)/(rho + 1)
-of the absorbed one: 0.7 / 4.2 / 9 / 18 % at those kd (the evanescent modes of a real piston are
-ignored: the buffer is one kernel support wide, well inside the near field, and the gauge 2h
-inside the face reads them too). Schaeffer & Klopman (2000) apply c(omega)/d frequency by
-frequency with a digital filter; "linear" evaluates it at the source's wave period (the peak
-period of a spectrum), exact for regular waves.
+wave maker that must emit the wave cancelling the unwanted one the gauge sees. An outgoing Airy
+wave eta = a cos(k x - omega t) in depth d has u(z) = a omega cosh k(z + d) / sinh kd; at the
+end the fluid's velocity is the source's profile plus U, and the field radiated by the end is a
+progressive wave (mode cosh k(z + d)) plus evanescent modes, which carry nothing away. The end
+swallows the wave iff U and u(z) have the same projection on the progressive mode:
+    G(omega) = U / a = omega (sinh 2kd + 2kd) / (4 sinh^2 kd) = omega / (H/S)      ("piston",
+Biesel's (1951) transfer function of a piston wave maker, H/S = 4 sinh^2 kd/(sinh 2kd + 2kd);
+Schaeffer & Klopman 2000 absorb with it), -> sqrt(g/d) as kd -> 0 (seed 002's shallow-water
+gain, "shallow"), 0.92 sqrt(g/d) at kd 0.76, 0.86 at 1.2, 0.83 at 2 (a minimum; deep water
+omega/2). The "flux" gain omega/(k d) = sqrt(g/d) sqrt(tanh kd / kd) (the wave's depth-mean
+velocity: the uniform U carrying its volume flux) ignores that the evanescent modes carry flux
+at the end too: it is low by 0.3 % at kd 0.76, 3.6 % at 1.2, 19 % at kd 2, a reflection of
+(rho - 1)/(rho + 1) = 0.3 / 1.8 / 8.7 % of the absorbed wave (measured at kd 2, H/dp 4: 8.6 %;
+docs/absorption.md). It was the transfer before 2026-11-23 and stays as an option
+(``transfer = "flux"``). "linear" evaluates the transfer gain at the source's wave period (the
+peak period of a spectrum), exact for regular waves.
 
 "filter" (Schaeffer & Klopman 2000 in spirit) follows G(omega) frequency by frequency with a
 causal filter on the mismatch e = eta_meas - eta_gauge,
@@ -25,14 +25,14 @@ fitted (least squares, then reweighted towards the largest error) to the ideal r
     H(omega) = G(omega) exp(-i k(omega) delta)
 over kd in FILTER_KD_BAND. delta is the gauge's distance inside the face: the outgoing wave the
 end must swallow passes the gauge delta/c before it reaches the face, so the ideal correction is
-the gauge's reading delayed by that much. A causal filter cannot follow a real, falling G(omega)
-exactly (its phase follows its magnitude); the delay makes the fit closer (Schaeffer &
-Klopman's point about a gauge away from the paddle). With a known wave period the fit is made
-exact there (a regular wave's own frequency gets the linear gain, delayed), and the rest of the
-band (harmonics, a spectrum's flanks) gets the fit: a causal three-pole filter keeps the gain
-error's reflection at 5-9 % over kd 0.3-2 (4 poles: 4-9 %, but D ~ 1.7 sqrt(g/d) amplifies the
-gauge's noise). At omega -> 0 the gain D + sum c_j is 0.7-1 sqrt(g/d) (holding it at sqrt(g/d)
-doubles the error in the band).
+the gauge's reading delayed by that much. A causal filter cannot follow G(omega) exactly (its
+phase follows its magnitude); the delay makes the fit closer (Schaeffer & Klopman's point about
+a gauge away from the paddle). With a known wave period the fit is made exact there (a regular
+wave's own frequency gets the transfer gain, delayed), and the rest of the band (harmonics, a
+spectrum's flanks) gets the fit: a causal three-pole filter keeps the gain error's reflection
+at 2.5-4.7 % over kd 0.3-2 for the piston gain, whose G(omega) varies by 0.83-1 sqrt(g/d) over
+the band (5-9 % for the flux gain, which falls to 0.69 sqrt(g/d)). At omega -> 0 the gain
+D + sum c_j is 0.9-0.95 sqrt(g/d) (piston).
 """
 
 from __future__ import annotations

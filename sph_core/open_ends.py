@@ -124,6 +124,7 @@ class OpenBoundaries:
                 o.absorption_transfer)
             e.absorb[b] = o.absorb
             e.imposed[b] = o.elevation == "imposed"
+            e.surface_at_face[b] = o.surface == "face"
             e.ghost[b] = buffer_pressure(o) == "extrapolated"
             e.x_gauge[b] = nd.x_gauge
             e.z_bed[b] = nd.z_bed

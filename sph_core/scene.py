@@ -365,6 +365,10 @@ class OpenBoundary(_Model):
     elevation: Literal["imposed", "extrapolated"] = "imposed"
     absorb: bool = True
     absorption: Literal["shallow", "linear", "filter"] = "filter"
+    surface: Literal["gauge", "face"] = Field(
+        "gauge", description="an extrapolated end's buffer surface: the boundary gauge's "
+                             "reading, or the source's elevation at the face plus the gauge's "
+                             "mismatch (the target wave carried over the gauge offset)")
     absorption_transfer: Literal["piston", "flux"] = Field(
         "piston", description="ideal gain of the depth-uniform correction: Biesel's piston "
                               "transfer function, or the depth-mean velocity omega/(k d) "
