@@ -55,7 +55,7 @@ def case_theory(theory: str, height: float, period: float, depth: float, ramp: f
 def run_flume_case(theory: str, height: float, period: float, depth: float, dp: float, periods: float,
                    ramp_periods: float = 1.0, absorb: bool = True, case: str | None = None,
                    absorption: str = "linear", transfer: str = "piston",
-                   surface: str = "gauge", **constants) -> dict:
+                   surface: str = "face", **constants) -> dict:
     ramp = ramp_periods * period
     model = case_theory(theory, height, period, depth, ramp)
     if theory == "irregular":  # flume length and gauges from the peak wave
@@ -89,7 +89,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--transfer", choices=ABSORPTION_TRANSFERS, nargs="+", default=["piston"],
                     help="ideal gain of the correction: Biesel's piston transfer function or "
                          "the depth-mean velocity omega/(k d) (several: one run each)")
-    ap.add_argument("--surface", choices=["gauge", "face"], default="gauge",
+    ap.add_argument("--surface", choices=["gauge", "face"], default="face",
                     help="the outlet buffer's surface: the gauge's reading, or the theory's "
                          "elevation at the face plus the gauge's mismatch")
     ap.add_argument("--h-over-dp", type=float, help="smoothing length / dp (default: the scene's)")

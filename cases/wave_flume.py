@@ -43,7 +43,7 @@ def wave_flume_scene(*, depth: float, wavelength: float, height: float, dp: floa
                      c0: float | None = None, g: float = 9.81, name: str = "wave_flume",
                      absorption: str = "filter", left_pressure: str | None = None,
                      scheme: dict | None = None, absorption_transfer: str = "piston",
-                     right_surface: str = "gauge",
+                     right_surface: str = "face",
                      **constants: Any) -> Scene:
     """A flat-bed flume [0, length] x [0, top] (floor z = 0, still water at z = depth) with open
     ends and elevation gauges mid-flume and L/16 apart within L/4 of it.
@@ -130,7 +130,7 @@ def flume_case(model: Any, *, height: float, period: float, depth: float, wavele
                dp: float, periods: float, ramp: float, standing: bool = False,
                absorb: tuple[bool, bool] = (True, True), window_per_period: int = 50,
                regular: bool = True, name: str = "wave_flume", absorption: str = "filter",
-               absorption_transfer: str = "piston", right_surface: str = "gauge",
+               absorption_transfer: str = "piston", right_surface: str = "face",
                **constants: Any) -> dict[str, Any]:
     """Run one wave case and score it: the figures of ``bench/flume_accuracy.py``.
 

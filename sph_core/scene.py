@@ -366,7 +366,7 @@ class OpenBoundary(_Model):
     absorb: bool = True
     absorption: Literal["shallow", "linear", "filter"] = "filter"
     surface: Literal["gauge", "face"] = Field(
-        "gauge", description="an extrapolated end's buffer surface: the boundary gauge's "
+        "face", description="an extrapolated end's buffer surface: the boundary gauge's "
                              "reading, or the source's elevation at the face plus the gauge's "
                              "mismatch (the target wave carried over the gauge offset)")
     absorption_transfer: Literal["piston", "flux"] = Field(
