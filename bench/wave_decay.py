@@ -5,9 +5,15 @@
         [--h-over-dp 2.0] [--alpha 0.01] [--slip no_slip|free_slip] [--c0-factor 10] [--delta 0.1]
         [--cfl 0.25] [--integrator kdk|symplectic_pc] [--nu 1e-6] [--alpha-wall 1.0]
         [--shifting none|fickian] [--shift-a 2.0]
-        [--shift-fs-div 1.8] [--flume-wavelengths 1]
+        [--shift-fs-div 1.8] [--flume-wavelengths 1] [--gauge-wavelengths 0.75] [--n-gauges 12]
+        [--long] [--absorption filter|linear|shallow] [--transfer piston|flux]
         [--scheme wcsph|riemann] [--reconstruction muscl|none] [--limiter minmod|vanleer]
         [--low-dissipation | --no-low-dissipation]
+
+--long: a flume 3 wavelengths long, 36 gauges over 2.25 wavelengths, the window after the
+outlet's reflection has come back to the inlet: resolves the decay to ~0.1 %/m (dp 0.02: fitted
+2.56, separated 2.58 %/m; a fit over the default 0.75 L span moves by ~1 %/m with the outlet's
+reflection pattern; docs/absorption.md), ~5x the particle-steps of the default flume.
 
 A flume one wavelength long with open ends driven by second-order Stokes theory (the wave of the
 coupled flume, cases/coupled_flume.py, by default), gauges from 2h past the inlet to 3/4 of the
