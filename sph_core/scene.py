@@ -350,7 +350,9 @@ class OpenBoundary(_Model):
 
     Buffer particles take the velocity of a boundary-data source (see ``sph_core.boundary_data``).
     ``elevation``: ``imposed`` takes the source's elevation (inlet of seed 002); ``extrapolated``
-    takes the one measured by the boundary gauge inside the fluid (outlet). ``absorb`` applies the
+    takes the one measured by the boundary gauge inside the fluid (outlet): with ``surface``
+    "face" (default) the source's elevation at the face plus the gauge's mismatch, with "gauge"
+    the gauge's reading itself (2h inside the face: it lags the wave at the buffer). ``absorb`` applies the
     seed 002 correction u = u_theory + n_x (eta_measured - eta_theory) sqrt(g/d), n_x the outward
     normal (-1 left, +1 right). The gauge stands ``gauge_offset`` [m] inside the face (default 2h).
     ``absorption`` picks the correction's gain (``sph_core.absorption``): ``linear`` omega/(k d) at
