@@ -32,7 +32,7 @@ import sys
 from pathlib import Path
 
 from cases.wave_flume import flume_case
-from sph_core.absorption import ABSORPTION_KINDS
+from sph_core.absorption import ABSORPTION_KINDS, ABSORPTION_TRANSFERS
 from wave_client.theories import build_theory, wavenumber
 
 CASES_CSV = Path(__file__).resolve().parents[1] / "tests" / "data" / "wave_cases_seed002.csv"
@@ -54,7 +54,8 @@ def case_theory(theory: str, height: float, period: float, depth: float, ramp: f
 
 def run_flume_case(theory: str, height: float, period: float, depth: float, dp: float, periods: float,
                    ramp_periods: float = 1.0, absorb: bool = True, case: str | None = None,
-                   absorption: str = "linear", **constants) -> dict:
+                   absorption: str = "linear", transfer: str = "piston",
+                   surface: str = "face", **constants) -> dict:
     ramp = ramp_periods * period
     model = case_theory(theory, height, period, depth, ramp)
     if theory == "irregular":  # flume length and gauges from the peak wave
@@ -64,7 +65,8 @@ def run_flume_case(theory: str, height: float, period: float, depth: float, dp: 
     out = flume_case(model, height=height, period=period, depth=depth, wavelength=wavelength,
                      dp=dp, periods=periods, ramp=ramp, standing=theory == "standing",
                      absorb=(absorb, absorb), regular=theory != "irregular",
-                     name=f"flume_{case or theory}", absorption=absorption, **constants)
+                     name=f"flume_{case or theory}", absorption=absorption,
+                     absorption_transfer=transfer, right_surface=surface, **constants)
     return {"case": case, "theory": theory, **constants, **out}
 
 
@@ -84,6 +86,12 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--no-absorb", action="store_true", help="switch the seed 002 correction off")
     ap.add_argument("--absorption", choices=ABSORPTION_KINDS, nargs="+", default=["filter"],
                     help="gain of the correction (sph_core.absorption; several: one run each)")
+    ap.add_argument("--transfer", choices=ABSORPTION_TRANSFERS, nargs="+", default=["piston"],
+                    help="ideal gain of the correction: Biesel's piston transfer function or "
+                         "the depth-mean velocity omega/(k d) (several: one run each)")
+    ap.add_argument("--surface", choices=["gauge", "face"], default="face",
+                    help="the outlet buffer's surface: the gauge's reading, or the theory's "
+                         "elevation at the face plus the gauge's mismatch")
     ap.add_argument("--h-over-dp", type=float, help="smoothing length / dp (default: the scene's)")
     ap.add_argument("--alpha-wall", type=float, help="wall viscosity factor (scene default)")
     a = ap.parse_args(argv)
@@ -105,9 +113,11 @@ def main(argv: list[str] | None = None) -> int:
     dp = a.dp if a.dp else height / 10.0
     for period in periods_s:
         for absorption in a.absorption:
-            out = run_flume_case(theory, height, period, depth, dp, a.periods, a.ramp_periods,
-                                 not a.no_absorb, a.case, absorption, **constants)
-            print(json.dumps(out), flush=True)
+            for transfer in a.transfer:
+                out = run_flume_case(theory, height, period, depth, dp, a.periods,
+                                     a.ramp_periods, not a.no_absorb, a.case, absorption,
+                                     transfer, a.surface, **constants)
+                print(json.dumps(out), flush=True)
     return 0
 
 

@@ -5,9 +5,15 @@
         [--h-over-dp 2.0] [--alpha 0.01] [--slip no_slip|free_slip] [--c0-factor 10] [--delta 0.1]
         [--cfl 0.25] [--integrator kdk|symplectic_pc] [--nu 1e-6] [--alpha-wall 1.0]
         [--shifting none|fickian] [--kernel-correction off|all|surface|weighted] [--shift-a 2.0]
-        [--shift-fs-div 1.8] [--flume-wavelengths 1]
+        [--shift-fs-div 1.8] [--flume-wavelengths 1] [--gauge-wavelengths 0.75] [--n-gauges 12]
+        [--long] [--absorption filter|linear|shallow] [--transfer piston|flux]
         [--scheme wcsph|riemann|isph] [--reconstruction muscl|none] [--limiter minmod|vanleer]
         [--low-dissipation | --no-low-dissipation]
+
+--long: a flume 3 wavelengths long, 36 gauges over 2.25 wavelengths, the window after the
+outlet's reflection has come back to the inlet: resolves the decay to ~0.1 %/m (dp 0.02: fitted
+2.56, separated 2.58 %/m; a fit over the default 0.75 L span moves by ~1 %/m with the outlet's
+reflection pattern; docs/absorption.md), ~5x the particle-steps of the default flume.
 
 A flume one wavelength long with open ends driven by second-order Stokes theory (the wave of the
 coupled flume, cases/coupled_flume.py, by default), gauges from 2h past the inlet to 3/4 of the
@@ -42,6 +48,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from cases.wave_decay import amplitude_profile, convergence_orders, separated_decay  # noqa: E402
 from cases.schemes import add_scheme_arguments, scheme_from_args  # noqa: E402
+from sph_core.absorption import ABSORPTION_KINDS, ABSORPTION_TRANSFERS  # noqa: E402
 from wave_client.theories import build_theory  # noqa: E402
 
 
@@ -55,7 +62,18 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--settle-periods", type=float, default=0.0,
                     help="extra periods between the front's passage and the analysed window")
     ap.add_argument("--flume-wavelengths", type=float, default=1.0,
-                    help="flume length in wavelengths (gauges stay within 3/4 of the first)")
+                    help="flume length in wavelengths")
+    ap.add_argument("--gauge-wavelengths", type=float, default=0.75,
+                    help="gauges from 2h past the inlet to this many wavelengths")
+    ap.add_argument("--long", action="store_true",
+                    help="the long flume: 3 wavelengths, 36 gauges over 2.25, window after the "
+                         "outlet's reflection has come back to the inlet (its pattern, period "
+                         "L/2, averages out of the fitted decay)")
+    ap.add_argument("--n-gauges", type=int, default=12, help="number of elevation gauges")
+    ap.add_argument("--absorption", choices=ABSORPTION_KINDS, help="both ends' correction "
+                    "(scene default if unset)")
+    ap.add_argument("--transfer", choices=ABSORPTION_TRANSFERS,
+                    help="the correction's ideal gain (scene default if unset)")
     ap.add_argument("--h-over-dp", type=float, help="smoothing length / dp (scene default if unset)")
     ap.add_argument("--alpha", type=float, help="artificial viscosity coefficient")
     ap.add_argument("--slip", choices=["no_slip", "free_slip"], help="wall (bed) condition")
@@ -83,6 +101,10 @@ def main(argv: list[str] | None = None) -> int:
                              "alpha_wall_factor": a.alpha_wall,
                              "kernel_correction": a.kernel_correction}.items() if v is not None}
     scheme = scheme_from_args(a)
+    if a.long:
+        a.flume_wavelengths, a.gauge_wavelengths, a.n_gauges = 3.0, 2.25, 36
+    ends = {k: v for k, v in {"absorption": a.absorption,
+                              "absorption_transfer": a.transfer}.items() if v is not None}
     c0 = a.c0_factor * math.sqrt(9.81 * a.d)
     decays = []
     for dp in a.dp:
@@ -91,7 +113,9 @@ def main(argv: list[str] | None = None) -> int:
                                  periods=a.periods, flume_wavelengths=a.flume_wavelengths,
                                  inlet_pressure=a.inlet_pressure, settle_periods=a.settle_periods,
                                  outlet_absorb=not a.no_outlet_absorb,
-                                 c0=c0, scheme=scheme, **cst)
+                                 gauge_wavelengths=a.gauge_wavelengths, n_gauges=a.n_gauges,
+                                 wait_reflection=a.long,
+                                 c0=c0, scheme=scheme, **ends, **cst)
         length = float(model.length)
         decays.append(prof.decay_per_m)
         sep_decay, sep_k, sep_kr = separated_decay(prof.x, prof.amp, prof.k)
@@ -100,6 +124,7 @@ def main(argv: list[str] | None = None) -> int:
                           "inlet_pressure": a.inlet_pressure, "settle_periods": a.settle_periods,
                           "outlet_absorb": not a.no_outlet_absorb,
                           "flume_wavelengths": a.flume_wavelengths,
+                          "gauge_wavelengths": a.gauge_wavelengths, "long": a.long, **ends,
                           "wavelength_m": round(length, 4),
                           "x": prof.x.tolist(),
                           "amplitude_ratio": [round(float(r), 4) for r in prof.ratio],

@@ -55,20 +55,34 @@ def amplitude_profile(model: Any, *, ramp: float, height: float, period: float, 
                       dp: float, periods: float = 4.0, n_gauges: int = 12,
                       flume_wavelengths: float = 1.0, inlet_pressure: str | None = None,
                       settle_periods: float = 0.0, outlet_absorb: bool = True,
+                      gauge_wavelengths: float = 0.75, absorption: str = "filter",
+                      absorption_transfer: str = "piston", wait_reflection: bool = False,
                       **constants: Any) -> AmplitudeProfile:
     """Run the flume driven by ``model`` (its start-up ramp lasting ``ramp`` s) and measure
     the amplitude ratio along it (``constants`` override the scene's, e.g. alpha). The flume is
-    ``flume_wavelengths`` long; the gauges stay within 3/4 of a wavelength of the inlet. The
-    window starts ``settle_periods`` periods after the front has passed the last gauge."""
+    ``flume_wavelengths`` long; the gauges stay within ``gauge_wavelengths`` of the inlet
+    (3/4 by default: a one-wavelength flume). The window starts ``settle_periods`` periods
+    after the front has passed the last gauge, or with ``wait_reflection`` after the front's
+    reflection from the outlet has come back to the inlet (the separated fit assumes a steady
+    reflected wave). ``absorption``, ``absorption_transfer``: both ends' correction
+    (scene.OpenBoundary)."""
     length = float(model.length)
-    xs = np.round(np.linspace(2.0 * math.sqrt(2.0) * dp, 0.75 * length, n_gauges), 4)
+    if not 0.0 < gauge_wavelengths < flume_wavelengths:
+        raise ValueError(f"gauge_wavelengths ({gauge_wavelengths}) must lie inside the flume "
+                         f"({flume_wavelengths} wavelengths)")
+    xs = np.round(np.linspace(2.0 * math.sqrt(2.0) * dp, gauge_wavelengths * length, n_gauges),
+                  4)
     # the ramped front and one period past the last gauge
-    t0 = ramp + xs[-1] / group_velocity(length, period, depth) + (1.0 + settle_periods) * period
+    cg = group_velocity(length, period, depth)
+    travel = 2.0 * flume_wavelengths * length if wait_reflection else xs[-1]
+    t0 = ramp + travel / cg + (1.0 + settle_periods) * period
     scene = wave_flume_scene(depth=depth, wavelength=length, height=height, dp=dp,
                              t_end=t0 + periods * period, length=flume_wavelengths * length,
                              absorb=(True, outlet_absorb),
                              right_elevation="extrapolated", probe_every=period / 40,
-                             name="wave_decay", left_pressure=inlet_pressure, **constants)
+                             name="wave_decay", left_pressure=inlet_pressure,
+                             absorption=absorption, absorption_transfer=absorption_transfer,
+                             **constants)
     probes = [ElevationProbe(kind="elevation", name=f"g{i}", x=float(x)) for i, x in enumerate(xs)]
     scene = scene.model_copy(update={"probes": probes})
     res = run_wave_flume(scene, model, window=period / 50)

@@ -42,7 +42,8 @@ def wave_flume_scene(*, depth: float, wavelength: float, height: float, dp: floa
                      right_elevation: str = "extrapolated", probe_every: float = 0.02,
                      c0: float | None = None, g: float = 9.81, name: str = "wave_flume",
                      absorption: str = "filter", left_pressure: str | None = None,
-                     scheme: dict | None = None,
+                     scheme: dict | None = None, absorption_transfer: str = "piston",
+                     right_surface: str = "face",
                      **constants: Any) -> Scene:
     """A flat-bed flume [0, length] x [0, top] (floor z = 0, still water at z = depth) with open
     ends and elevation gauges mid-flume and L/16 apart within L/4 of it.
@@ -66,9 +67,11 @@ def wave_flume_scene(*, depth: float, wavelength: float, height: float, dp: floa
         "probes": probes, "scheme": scheme or {},
         "open_boundaries": [
             {"side": "left", "elevation": "imposed", "absorb": absorb[0],
-             "absorption": absorption, "pressure": left_pressure},
+             "absorption": absorption, "absorption_transfer": absorption_transfer,
+             "pressure": left_pressure},
             {"side": "right", "elevation": right_elevation, "absorb": absorb[1],
-             "absorption": absorption}],
+             "absorption": absorption, "absorption_transfer": absorption_transfer,
+             "surface": right_surface}],
     })
 
 
@@ -127,6 +130,7 @@ def flume_case(model: Any, *, height: float, period: float, depth: float, wavele
                dp: float, periods: float, ramp: float, standing: bool = False,
                absorb: tuple[bool, bool] = (True, True), window_per_period: int = 50,
                regular: bool = True, name: str = "wave_flume", absorption: str = "filter",
+               absorption_transfer: str = "piston", right_surface: str = "face",
                **constants: Any) -> dict[str, Any]:
     """Run one wave case and score it: the figures of ``bench/flume_accuracy.py``.
 
@@ -152,6 +156,7 @@ def flume_case(model: Any, *, height: float, period: float, depth: float, wavele
                              t_end=t_start + periods * period, length=length, absorb=absorb,
                              right_elevation="imposed" if standing else "extrapolated",
                              probe_every=period / 40, name=name, absorption=absorption,
+                             absorption_transfer=absorption_transfer, right_surface=right_surface,
                              **constants)
     x_left = -0.5 * scene.tank.x1 if standing else 0.0
     res = run_wave_flume(scene, model, window=period / window_per_period, x_model_left=x_left)
@@ -184,7 +189,9 @@ def flume_case(model: Any, *, height: float, period: float, depth: float, wavele
             "periods": periods,
             "rmse_over_H": rmse_over_height(res.eta["mid"][sel], res.theory["mid"][sel], height),
             "reflection": refl, "reflection_3g": refl_3g, "reflection_harmonics": refl_h,
-            "absorb": list(absorb), "absorption": absorption, "kd": round(kd, 4),
+            "absorb": list(absorb), "absorption": absorption,
+            "absorption_transfer": absorption_transfer, "right_surface": right_surface,
+            "kd": round(kd, 4),
             "wall_s": round(res.wall_s, 2),
             "particles": res.particles, "steps": res.steps,
             "particle_steps_per_s": round(res.particles * res.steps / max(res.wall_s, 1e-9)),

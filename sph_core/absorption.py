@@ -1,22 +1,22 @@
 """Gain of the open ends' active absorption (seed 002 correction): du = n_x G (eta_meas - eta_gauge).
 
 The buffer adds one velocity du, uniform over the depth, to the source's profile: it is a piston
-wave maker that must emit the wave cancelling the unwanted one the gauge sees. A linear
-progressive wave eta = a cos(k x - omega t) in depth d carries the volume flux
-    q = int_{-d}^{0} u dz = (omega / k) eta        (mass: d eta/dt + dq/dx = 0)
-(equivalently, the depth mean of u = a omega cosh k(z + d) / sinh kd cos(...) is a omega/(k d)).
-A depth-uniform velocity carrying that flux is
-    U = q / d = (omega / (k d)) eta = (c / d) eta,   c = omega / k the phase speed,
-so the gain that emits (or swallows) exactly the wave the gauge measures is
-    G(omega) = omega / (k d) = sqrt(g/d) sqrt(tanh(kd) / kd)            ("linear"),
-which tends to the seed-002 shallow-water gain sqrt(g/d) as kd -> 0 ("shallow") and falls
-below it with kd: sqrt(g/d) over-drives the absorber by 1 / sqrt(tanh(kd)/kd) - 1 = 1.5 % at
-kd 0.3, 9 % at 0.75, 20 % at 1.2, 44 % at 2. A gain G' = rho G re-emits a wave (rho - 1)/(rho + 1)
-of the absorbed one: 0.7 / 4.2 / 9 / 18 % at those kd (the evanescent modes of a real piston are
-ignored: the buffer is one kernel support wide, well inside the near field, and the gauge 2h
-inside the face reads them too). Schaeffer & Klopman (2000) apply c(omega)/d frequency by
-frequency with a digital filter; "linear" evaluates it at the source's wave period (the peak
-period of a spectrum), exact for regular waves.
+wave maker that must emit the wave cancelling the unwanted one the gauge sees. An outgoing Airy
+wave eta = a cos(k x - omega t) in depth d has u(z) = a omega cosh k(z + d) / sinh kd; at the
+end the fluid's velocity is the source's profile plus U, and the field radiated by the end is a
+progressive wave (mode cosh k(z + d)) plus evanescent modes, which carry nothing away. The end
+swallows the wave iff U and u(z) have the same projection on the progressive mode:
+    G(omega) = U / a = omega (sinh 2kd + 2kd) / (4 sinh^2 kd) = omega / (H/S)      ("piston",
+Biesel's (1951) transfer function of a piston wave maker, H/S = 4 sinh^2 kd/(sinh 2kd + 2kd);
+Schaeffer & Klopman 2000 absorb with it), -> sqrt(g/d) as kd -> 0 (seed 002's shallow-water
+gain, "shallow"), 0.92 sqrt(g/d) at kd 0.76, 0.86 at 1.2, 0.83 at 2 (a minimum; deep water
+omega/2). The "flux" gain omega/(k d) = sqrt(g/d) sqrt(tanh kd / kd) (the wave's depth-mean
+velocity: the uniform U carrying its volume flux) ignores that the evanescent modes carry flux
+at the end too: it is low by 0.3 % at kd 0.76, 3.6 % at 1.2, 19 % at kd 2, a reflection of
+(rho - 1)/(rho + 1) = 0.3 / 1.8 / 8.7 % of the absorbed wave (measured at kd 2, H/dp 4: 8.6 %;
+docs/absorption.md). It was the transfer before 2026-11-23 and stays as an option
+(``transfer = "flux"``). "linear" evaluates the transfer gain at the source's wave period (the
+peak period of a spectrum), exact for regular waves.
 
 "filter" (Schaeffer & Klopman 2000 in spirit) follows G(omega) frequency by frequency with a
 causal filter on the mismatch e = eta_meas - eta_gauge,
@@ -25,14 +25,14 @@ fitted (least squares, then reweighted towards the largest error) to the ideal r
     H(omega) = G(omega) exp(-i k(omega) delta)
 over kd in FILTER_KD_BAND. delta is the gauge's distance inside the face: the outgoing wave the
 end must swallow passes the gauge delta/c before it reaches the face, so the ideal correction is
-the gauge's reading delayed by that much. A causal filter cannot follow a real, falling G(omega)
-exactly (its phase follows its magnitude); the delay makes the fit closer (Schaeffer &
-Klopman's point about a gauge away from the paddle). With a known wave period the fit is made
-exact there (a regular wave's own frequency gets the linear gain, delayed), and the rest of the
-band (harmonics, a spectrum's flanks) gets the fit: a causal three-pole filter keeps the gain
-error's reflection at 5-9 % over kd 0.3-2 (4 poles: 4-9 %, but D ~ 1.7 sqrt(g/d) amplifies the
-gauge's noise). At omega -> 0 the gain D + sum c_j is 0.7-1 sqrt(g/d) (holding it at sqrt(g/d)
-doubles the error in the band).
+the gauge's reading delayed by that much. A causal filter cannot follow G(omega) exactly (its
+phase follows its magnitude); the delay makes the fit closer (Schaeffer & Klopman's point about
+a gauge away from the paddle). With a known wave period the fit is made exact there (a regular
+wave's own frequency gets the transfer gain, delayed), and the rest of the band (harmonics, a
+spectrum's flanks) gets the fit: a causal three-pole filter keeps the gain error's reflection
+at 2.5-4.7 % over kd 0.3-2 for the piston gain, whose G(omega) varies by 0.83-1 sqrt(g/d) over
+the band (5-9 % for the flux gain, which falls to 0.69 sqrt(g/d)). At omega -> 0 the gain
+D + sum c_j is 0.9-0.95 sqrt(g/d) (piston).
 """
 
 from __future__ import annotations
@@ -43,6 +43,10 @@ from typing import Any
 import numpy as np
 
 ABSORPTION_KINDS = ("shallow", "linear", "filter")
+# what the ideal gain G(omega) is: "piston" Biesel's transfer function of a depth-uniform
+# wave maker (the default: it is what the buffer's correction is), "flux" the depth-mean
+# velocity omega/(k d) of the wave (the gain before 2026-11-23; 8.7 % reflection at kd 2)
+ABSORPTION_TRANSFERS = ("piston", "flux")
 # the filter's time constants tau_j in units of sqrt(d/g), and the kd band it is fitted over
 FILTER_TAUS = (0.3, 1.0, 3.0)  # 4 fit closer, but D ~ 1.8 sqrt(g/d) amplifies gauge noise
 FILTER_KD_BAND = (0.2, 2.5)
@@ -67,13 +71,35 @@ def linear_wavenumber(omega: float, depth: float, g: float = 9.81) -> float:
     return k
 
 
-def absorption_gain(kind: str, g: float, depth: float, period: float | None = None) -> float:
+def transfer_gain(omega: np.ndarray | float, kd: np.ndarray | float,
+                  transfer: str = "piston") -> np.ndarray | float:
+    """Ideal gain G(omega) [1/s] of a depth-uniform correction, for wavenumber kd = k(omega) d.
+
+    ``piston`` (Biesel 1951; Schaeffer & Klopman 2000 use it for a piston absorber): a uniform
+    velocity U radiates a progressive wave of amplitude a = U (H/S)/omega plus evanescent modes,
+    H/S = 4 sinh^2 kd / (sinh 2kd + 2kd); projecting U and the outgoing wave's Airy velocity
+    onto the progressive mode cosh k(z + d), the end swallows the wave without reflection iff
+        G = U/a = omega (sinh 2kd + 2kd) / (4 sinh^2 kd).
+    ``flux``: omega/(k d), the depth-mean velocity per unit elevation (its shallow limit is the
+    same sqrt(g/d)); it ignores that the evanescent modes of the piston carry flux too, and is
+    low by 0.3 % at kd 0.76, 3.6 % at 1.2, 19 % at kd 2 (8.7 % reflection, as measured)."""
+    if transfer not in ABSORPTION_TRANSFERS:
+        raise ValueError(f"absorption_transfer: one of {ABSORPTION_TRANSFERS}, got {transfer!r}")
+    if transfer == "flux":
+        return omega / kd
+    return omega * (np.sinh(2.0 * kd) + 2.0 * kd) / (4.0 * np.sinh(kd) ** 2)
+
+
+def absorption_gain(kind: str, g: float, depth: float, period: float | None = None,
+                    transfer: str = "piston") -> float:
     """Gain G [1/s] of the depth-uniform correction du = n_x G (eta_meas - eta_gauge).
 
-    ``shallow``: sqrt(g/d) (seed 002). ``linear``: omega/(k d) at the wave ``period`` [s]
-    (module docstring); with no period known it is the shallow gain, its kd -> 0 limit."""
+    ``shallow``: sqrt(g/d) (seed 002). ``linear``: the ``transfer`` gain (``transfer_gain``) at
+    the wave ``period`` [s]; with no period known it is the shallow gain, its kd -> 0 limit."""
     if kind not in ABSORPTION_KINDS:
         raise ValueError(f"absorption: one of {ABSORPTION_KINDS}, got {kind!r}")
+    if transfer not in ABSORPTION_TRANSFERS:
+        raise ValueError(f"absorption_transfer: one of {ABSORPTION_TRANSFERS}, got {transfer!r}")
     if not (depth > 0 and g > 0):
         raise ValueError(f"depth ({depth}) and g ({g}) must be > 0")
     shallow = math.sqrt(g / depth)
@@ -82,7 +108,7 @@ def absorption_gain(kind: str, g: float, depth: float, period: float | None = No
     if not (math.isfinite(period) and period > 0):
         raise ValueError(f"absorption period: must be a positive number of seconds, got {period}")
     omega = 2.0 * math.pi / period
-    return omega / (linear_wavenumber(omega, depth, g) * depth)
+    return float(transfer_gain(omega, linear_wavenumber(omega, depth, g) * depth, transfer))
 
 
 def source_period(source: Any) -> float | None:
@@ -97,14 +123,16 @@ def source_period(source: Any) -> float | None:
 
 
 def absorption_filter(kind: str, g: float, depth: float, delay: float = 0.0,
-                      period: float | None = None) -> tuple[float, np.ndarray, np.ndarray]:
+                      period: float | None = None, transfer: str = "piston"
+                      ) -> tuple[float, np.ndarray, np.ndarray]:
     """(D [1/s], tau [s], c [1/s]) of the correction du = n_x [D e + sum_j c_j x_j] with
     dx_j/dt = (e - x_j)/tau_j (module docstring). ``shallow``/``linear``: D = absorption_gain,
-    c = 0 (a plain gain). ``filter``: fitted to G(omega) exp(-i k delay) over FILTER_KD_BAND,
+    c = 0 (a plain gain). ``filter``: fitted to G(omega) exp(-i k delay) over FILTER_KD_BAND
+    (G the ``transfer`` gain),
     exact at ``period`` when given; ``delay`` [m] is the gauge's distance inside the face."""
     tau = np.asarray(FILTER_TAUS) * math.sqrt(depth / g)
     if kind != "filter":
-        return absorption_gain(kind, g, depth, period), tau, np.zeros(N_FILTER)
+        return absorption_gain(kind, g, depth, period, transfer), tau, np.zeros(N_FILTER)
     if not (depth > 0 and g > 0 and delay >= 0):
         raise ValueError(f"depth ({depth}), g ({g}) must be > 0, delay ({delay}) >= 0")
     kd = np.geomspace(*FILTER_KD_BAND, 200)
@@ -114,7 +142,7 @@ def absorption_filter(kind: str, g: float, depth: float, delay: float = 0.0,
         kd = np.append(kd, linear_wavenumber(omega0, depth, g) * depth)
         weight = np.append(weight, 1e3)  # exact at the wave's own frequency
     omega = np.sqrt(g * kd * np.tanh(kd) / depth)
-    target = omega / kd * np.exp(-1j * kd * delay / depth)  # G(omega) = omega/(k d), delayed
+    target = transfer_gain(omega, kd, transfer) * np.exp(-1j * kd * delay / depth)  # delayed
     cols = np.column_stack([np.ones(kd.size)] + [1.0 / (1.0 + 1j * omega * t) for t in tau])
     a = cols / target[:, None]  # relative error: the reflection is set by H_fit/H - 1
     band = np.ones(kd.size)
@@ -130,11 +158,11 @@ def absorption_filter(kind: str, g: float, depth: float, delay: float = 0.0,
 
 
 def filter_reflection(d_gain: float, tau: np.ndarray, c: np.ndarray, g: float, depth: float,
-                      delay: float, kd: np.ndarray) -> np.ndarray:
+                      delay: float, kd: np.ndarray, transfer: str = "piston") -> np.ndarray:
     """Reflection |(1 - rho)/(1 + rho)| of a correction (D, tau, c) at wavenumbers kd against the
     ideal H(omega) = G(omega) exp(-i k delay), rho = H_filter / H (the gain error alone)."""
     kd = np.asarray(kd, dtype=float)
     omega = np.sqrt(g * kd * np.tanh(kd) / depth)
     h_fit = d_gain + sum(cj / (1.0 + 1j * omega * tj) for cj, tj in zip(c, tau))
-    rho = h_fit / (omega / kd * np.exp(-1j * kd * delay / depth))
+    rho = h_fit / (transfer_gain(omega, kd, transfer) * np.exp(-1j * kd * delay / depth))
     return np.abs((1.0 - rho) / (1.0 + rho))

@@ -14,9 +14,11 @@ Every step, for buffer particle i of end b (the window [t0, t1] holds the source
 interpolated linearly in time and linearly in z between the nodes):
     u_i = u(z_i, t) + du_b,  w_i = w(z_i, t),  x_i += dt u_i       (z_i fixed: layers stay level)
     du_b = n_x (eta_meas,b - eta_gauge,b(t)) G  if absorbing   (seed 002 correction; the gain G
-           in the ends' sqgd: sqrt(g/d) there, omega/(k d) "linear", see sph_core.absorption;
-           by default a causal filter of e following omega/(k d) per frequency, "filter")
-    surface z_s,b = swl + eta_b(t)  (elevation imposed)  or  swl + eta_meas,b  (extrapolated)
+           in the ends' sqgd: sqrt(g/d) there, Biesel's piston gain at the period "linear", see
+           sph_core.absorption; by default a causal filter of e following it per frequency)
+    surface z_s,b = swl + eta_b(t)  (elevation imposed)  or, extrapolated, swl + eta_meas,b (surface
+    "gauge") or swl + eta_b(t) + (eta_meas,b - eta_gauge,b(t)) (surface "face": the source's
+    elevation at the face plus the gauge's mismatch)
     active (interacts as fluid) iff z_i < z_s,b;  rho_i = rho0 (1 + rho0 g (z_s,b - z_i)/B)^(1/7)
     (hydrostatic below the imposed or measured surface; Tait EOS, same form as the initial state),
     or, at an end with ghost extrapolation (OpenEnds.ghost; seed 002's outlet), and at a
@@ -130,7 +132,9 @@ def boundary_state(b, r, dt, ends):
         du *= ends.nx[b]
     eta = eta_th
     if not ends.imposed[b] and math.isfinite(em):
-        eta = em
+        # measured surface: the gauge's reading, or carried to the face by the source (the
+        # target wave's own phase over the gauge offset; only the mismatch is read at the gauge)
+        eta = eta_th + (em - etag_th) if ends.surface_at_face[b] else em
     zs = ends.swl[b] + eta
     # the surface never leaves the tank (validated data; a measured one could overshoot)
     zs = min(max(zs, ends.z_bed[b]), ends.z_top[b])

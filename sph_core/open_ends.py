@@ -121,9 +121,11 @@ class OpenBoundaries:
             e.zs[b] = swl   # at rest until the first update
             period = o.absorption_period or source_period(sources.get(o.side))
             e.sqgd[b], e.filt_tau[b], e.filt_c[b] = absorption_filter(
-                o.absorption, c.g, depth, abs(nd.x_gauge - nd.x_face), period)
+                o.absorption, c.g, depth, abs(nd.x_gauge - nd.x_face), period,
+                o.absorption_transfer)
             e.absorb[b] = o.absorb
             e.imposed[b] = o.elevation == "imposed"
+            e.surface_at_face[b] = o.surface == "face"
             e.ghost[b] = buffer_pressure(o, scene.scheme.kind) == "extrapolated"
             e.x_gauge[b] = nd.x_gauge
             e.z_bed[b] = nd.z_bed

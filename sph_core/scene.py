@@ -374,19 +374,31 @@ class OpenBoundary(_Model):
 
     Buffer particles take the velocity of a boundary-data source (see ``sph_core.boundary_data``).
     ``elevation``: ``imposed`` takes the source's elevation (inlet of seed 002); ``extrapolated``
-    takes the one measured by the boundary gauge inside the fluid (outlet). ``absorb`` applies the
+    takes the one measured by the boundary gauge inside the fluid (outlet): with ``surface``
+    "face" (default) the source's elevation at the face plus the gauge's mismatch, with "gauge"
+    the gauge's reading itself (2h inside the face: it lags the wave at the buffer). ``absorb`` applies the
     seed 002 correction u = u_theory + n_x (eta_measured - eta_theory) sqrt(g/d), n_x the outward
     normal (-1 left, +1 right). The gauge stands ``gauge_offset`` [m] inside the face (default 2h).
     ``absorption`` picks the correction's gain (``sph_core.absorption``): ``linear`` omega/(k d) at
     the wave period (``absorption_period``, else the source theory's period; sqrt(g/d) when
     neither is known), ``shallow`` the seed 002 sqrt(g/d) at every kd, ``filter`` (default,
-    measured best: docs/absorption.md) a causal filter following omega/(k d) frequency by
-    frequency, delayed by the gauge's offset (exact at the wave period when one is known)."""
+    measured best: docs/absorption.md) a causal filter following the ideal gain frequency by
+    frequency, delayed by the gauge's offset (exact at the wave period when one is known).
+    ``absorption_transfer`` is that ideal gain: ``piston`` (default) Biesel's transfer function
+    of a depth-uniform wave maker, ``flux`` omega/(k d) (low by 19 % at kd 2)."""
 
     side: Literal["left", "right"]
     elevation: Literal["imposed", "extrapolated"] = "imposed"
     absorb: bool = True
     absorption: Literal["shallow", "linear", "filter"] = "filter"
+    surface: Literal["gauge", "face"] = Field(
+        "face", description="an extrapolated end's buffer surface: the boundary gauge's "
+                             "reading, or the source's elevation at the face plus the gauge's "
+                             "mismatch (the target wave carried over the gauge offset)")
+    absorption_transfer: Literal["piston", "flux"] = Field(
+        "piston", description="ideal gain of the depth-uniform correction: Biesel's piston "
+                              "transfer function, or the depth-mean velocity omega/(k d) "
+                              "(sph_core.absorption.transfer_gain)")
     absorption_period: float | None = Field(None, gt=0, description="wave period [s] of the "
                                             "linear absorption gain (None: the source's)")
     gauge_offset: float | None = Field(None, gt=0, description="boundary gauge distance inside the face [m]")

@@ -156,6 +156,9 @@ class OpenEnds(NamedTuple):
     filt_tau: np.ndarray  # [2, N_FILTER] time constants of the absorption filter [s]
     filt_c: np.ndarray    # [2, N_FILTER] its gains [1/s] (0: plain gain sqgd; sph_core.absorption)
     filt_x: np.ndarray    # [2, N_FILTER] its state: the mismatch low-passed with each tau [m]
+    # bool[2]: a measured (extrapolated) surface is the source's elevation at the face plus the
+    # gauge's mismatch (else the gauge's reading itself; scene.OpenBoundary.surface)
+    surface_at_face: np.ndarray
 
 
 def closed_ends(capacity: int, n_nodes: int = 2) -> OpenEnds:
@@ -168,4 +171,4 @@ def closed_ends(capacity: int, n_nodes: int = 2) -> OpenEnds:
                     np.zeros((2, 2, n_nodes)), np.zeros((2, 2, n_nodes)), np.zeros((2, 2)),
                     np.zeros((2, 2)), np.full(2, np.nan), z2(), np.zeros((2, 4), dtype=np.int64),
                     np.zeros(1, dtype=np.int64), np.ones((2, N_FILTER)),
-                    np.zeros((2, N_FILTER)), np.zeros((2, N_FILTER)))
+                    np.zeros((2, N_FILTER)), np.zeros((2, N_FILTER)), b2())
