@@ -8,8 +8,7 @@ resampled at the experiment's 20 kHz.
 
 Prints one JSON object:
 - walls: ``excluded`` (fluid particles removed: through a wall, over the top, density band),
-  each with where and why (the first 5), ``splash_resets`` (jet tips and drops below the
-  density band set to rho0 instead, Simulation._splash_to_rest), and ``status``;
+  each with where and why (the first 5), and ``status``;
 - sensor 1: the first impact's peak [Pa] and its time, for the experiment and for SPH sampled
   two ways (``Sensors``: the fluid's pressure interpolated at the wall face, and the wall
   particles' own pressure), each raw and after a centred moving average of
@@ -212,9 +211,6 @@ def main() -> None:
            "t": round(sim.t, 5), "excluded": len(sim.excluded),
            "excluded_first": [{k: (round(v, 5) if isinstance(v, float) else v) for k, v in e.items()}
                               for e in sim.excluded[:5]],
-           "splash_resets": len(sim.splash_resets),
-           "splash_resets_first": [{k: (round(v, 5) if isinstance(v, float) else v)
-                                    for k, v in e.items()} for e in sim.splash_resets[:5]],
            "fluid_particles": sim.n_fluid, "particles": sim.n_particles, "steps": sim.steps,
            "wall_s": round(wall_s, 1), "step_wall_s": round(sim.wall_time, 1),
            "particle_steps_per_s": round(sim.n_particles * sim.steps / max(sim.wall_time, 1e-9)),

@@ -46,10 +46,6 @@ from .state import Params
 STEPS_PER_CALL = 200  # steps per jitted call between progress callbacks
 # cells per kernel support radius 2h (neighbours.py): 2 = cells of side h, a 5 x 5 search block
 CELLS_PER_SUPPORT = 2
-# a fluid particle below the density band whose kernel sum sum_j V_j W_ij (fluid and wall) is
-# under this is splash (a jet tip, a drop): set to rho0 rather than excluded. A particle of a
-# flat free surface has 0.69 at h/dp 2 (0.77 at h/dp 1.41), one inside the fluid 1.
-SPLASH_FILL = 0.5
 
 
 def scheme_params(scheme: Scheme) -> dict[str, Any]:
@@ -162,7 +158,6 @@ class Simulation:
         self.fluid_mass0 = self.fluid_mass()
         self.n_fluid0 = self.n_fluid
         self.excluded: list[dict[str, Any]] = []  # particles removed: density band, left the tank
-        self.splash_resets: list[dict[str, Any]] = []  # splash below the band set to rho0
         # probes
         self._points = [p for p in scene.probes if isinstance(p, PointProbe)]
         self._elev = [p for p in scene.probes if isinstance(p, ElevationProbe)]
@@ -282,7 +277,6 @@ class Simulation:
                 "wall_time_s": round(self.wall_time, 3), "dt": self.dt,
                 "n_particles": self.n_particles, "n_fluid": self.n_fluid,
                 "excluded": len(self.excluded), "excluded_particles": self.excluded[-20:],
-                "splash_resets": len(self.splash_resets),
                 "c0": self.c0, "h": self.h, "integrator": self.scene.constants.integrator,
                 "scheme": self.scene.scheme.kind,
                 **(self.stepper.stats() if self.stepper is not None else {}),
@@ -461,39 +455,6 @@ class Simulation:
             self.writer.update_meta(**self._meta_fields())
         return True
 
-    def _splash_to_rest(self, bad: np.ndarray, low: np.ndarray, x: np.ndarray, z: np.ndarray,
-                        rho: np.ndarray, ids: np.ndarray) -> np.ndarray:
-        """Of the out-of-band fluid particles ``bad`` (indices into the fluid selection), set
-        those below the band whose kernel support is mostly empty (sum_j V_j W_ij below
-        SPLASH_FILL: a jet tip or a drop in the air, not the fluid's interior) to rest density
-        rho0 (p = 0, the free surface's pressure) and log them in ``self.splash_resets``;
-        return the others, to be excluded. The continuity density of a particle with a
-        truncated support drifts down as a thin jet stretches (tension the air cannot
-        give: docs/wall_pressure.md, 2026-11-23)."""
-        cand = bad[low[bad]]
-        if cand.size == 0:
-            return bad
-        ps = self.particles
-        n = ps.n
-        act = ps.kind[:n] != INACTIVE
-        xa, za = ps.f[X, :n][act], ps.f[Z, :n][act]
-        vol = ps.f[M, :n][act] / ps.f[RHO, :n][act]
-        slots = np.nonzero(ps.mask(FLUID))[0][cand]
-        fill = np.empty(cand.size)
-        for k, s in enumerate(slots):
-            q = np.hypot(xa - ps.f[X, s], za - ps.f[Z, s]) / self.h
-            t = np.clip(1.0 - 0.5 * q, 0.0, None)
-            fill[k] = np.sum(vol * self.prm.alpha_w * t**4 * (2.0 * q + 1.0))
-        splash = fill < SPLASH_FILL
-        rho0 = self.scene.constants.rho0
-        ps.f[RHO, slots[splash]] = rho0
-        ps.f[P, slots[splash]] = 0.0
-        self.splash_resets += [{"id": int(ids[c]), "t": self.t, "step": self.steps,
-                                "x": float(x[c]), "z": float(z[c]), "rho": float(rho[c]),
-                                "fill": round(float(f), 3)}
-                               for c, f in zip(cand[splash], fill[splash])]
-        return np.setdiff1d(bad, cand[splash])
-
     def _stopped(self, status: int, n_flag: int) -> None:
         """The jitted loop stopped early: exclude out-of-band particles if the scene allows (the
         caller's loop then goes on), else fail the run as unstable with its cause."""
@@ -506,8 +467,7 @@ class Simulation:
             lo, hi = self.scene.constants.density_band
             rho0 = self.scene.constants.rho0
             bad = np.nonzero((rho < lo * rho0) | (rho > hi * rho0))[0]
-            bad = self._splash_to_rest(bad, rho < lo * rho0, x, z, rho, ids)
-            if bad.size == 0 or self._exclude(bad, ids, x, z, rho, "density out of band"):
+            if self._exclude(bad, ids, x, z, rho, "density out of band"):
                 return
             cause += f" [{lo}, {hi}] rho0 (after {len(self.excluded)} excluded)"
         elif status == wcsph.ST_LEFT_DOMAIN:
@@ -547,7 +507,6 @@ class Simulation:
         ps.restore(c)
         self.t, self.dt, self.steps = c.t, c.dt, c.steps
         self.excluded = [e for e in self.excluded if e["step"] <= c.steps]
-        self.splash_resets = [e for e in self.splash_resets if e["step"] <= c.steps]
         if (c.cell is not None and c.cell_start is not None
                 and c.cell_start.size == self.cells.start.size):
             ps.cell[: c.n] = c.cell

@@ -10,7 +10,7 @@ import pytest
 
 import wavesph_cli
 from cases.dambreak import dambreak_scene
-from sph_core.particles import FLUID, RHO, VZ, X, Z
+from sph_core.particles import FLUID, VZ, X, Z
 from sph_core.scene import make_scene
 from sph_core.simulation import Simulation, UnstableError
 
@@ -187,40 +187,6 @@ def test_particle_thrown_beside_a_side_wall_stays_in_the_tank(integrator, h_over
     assert not sim.excluded
     assert z_max > z0 + 0.5 * dp           # it did leave the surface row (by 1.9-2.5 cm)
     assert gap_min > 0.0                   # no fluid centre behind a wall face
-
-
-@pytest.mark.parametrize("integrator", ["kdk", "symplectic_pc"])
-def test_splash_below_the_band_is_set_to_rest_not_excluded(integrator):
-    """A drop in the air below the density band (a stretched jet's tip) is set to rho0 and
-    stays; a particle inside the fluid below the band is still excluded (exclude_limit 0: the
-    run stops)."""
-    def sim_with(where):
-        scene = make_scene({
-            "dp": 0.02, "t_end": 0.05, "still_water_level": 0.1,
-            "tank": {"x0": 0, "x1": 0.4, "z0": 0, "z1": 0.3},
-            "water_blocks": [{"x0": 0, "x1": 0.4, "z0": 0, "z1": 0.1}],
-            "constants": {"exclude_limit": 0.0, "integrator": integrator}})
-        sim = Simulation(scene)
-        ps = sim.particles
-        fluid = np.nonzero(ps.mask(FLUID))[0]
-        x, z = ps.field(X), ps.field(Z)
-        k = int(fluid[np.argmin(np.hypot(x[fluid] - 0.2, z[fluid] - where))])
-        if where > 0.1:     # lift the surface particle into the air, out of the others' reach
-            ps.f[Z, k] = 0.25
-        ps.f[RHO, k] = 0.65 * scene.constants.rho0
-        return sim, int(ps.ids[k])
-
-    sim, pid = sim_with(0.2)
-    sim.advance_to(0.02)
-    assert [e["id"] for e in sim.splash_resets] == [pid] and not sim.excluded
-    assert sim.splash_resets[0]["fill"] < 0.5 and sim.splash_resets[0]["rho"] < 700.0
-    k = np.nonzero(sim.particles.ids[: sim.particles.n] == pid)[0][0]
-    assert sim.particles.kind[k] == FLUID
-    assert sim.particles.f[RHO, k] == pytest.approx(1000.0, abs=5.0)
-    sim, _ = sim_with(0.05)
-    with pytest.raises(UnstableError, match="density"):
-        sim.advance_to(0.02)
-    assert not sim.splash_resets
 
 
 def test_dry_gauge_reports_dry(tmp_path):
