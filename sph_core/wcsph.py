@@ -252,8 +252,6 @@ def fluid_pass(ps, n, cells, prm):
                                                        inv_c0, eta,
                                                        wall_rs if kj == WALL else 1.0)
                         cont += 2.0 * vol * fij * r * (ui - ustar)
-                        if kj == WALL:  # no tension across a wall (as max(p_i, 0) below)
-                            pstar = max(pstar, 0.0)
                         pf = 2.0 * vol * pstar * inv_rhoi
                     else:
                         cont -= vol * fij * (dvx * dx + dvz * dz)
