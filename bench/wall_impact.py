@@ -16,6 +16,8 @@ Prints one JSON object:
   ``dry_ms_first_100ms``: how long the fluid probe saw no fluid in the 0.1 s after arrival;
   ``mean_5_50ms_pa``: the mean load 5-50 ms after arrival (after the spike; dry counts as 0);
   ``noise_rms``: RMS of (raw - the 1 ms moving average) over the 0.25 s after arrival;
+  ``sensor1_*_windows``: SPH / experiment ratios of the peak after 1-10 ms moving averages and
+  of the impulse over 5-50 ms after arrival (docs/wall_pressure.md, 2026-11-23);
 - cost: steps, wall time (say whether the machine was loaded), particle-steps/s.
 
     python bench/wall_impact.py --dp 0.004 --t-end 2.0 [--h-over-dp 2] [--c0-factor 10]
@@ -73,6 +75,23 @@ def impact_figures(t: np.ndarray, p: np.ndarray, average: float) -> dict:
             "peak_avg_pa": round(float(avg[ka]), 1), "peak_avg_t_s": round(float(t[ka]), 5),
             "noise_rms_pa": round(float(np.sqrt(np.mean(hp[nwin] ** 2))), 1),
             "mean_5_50ms_pa": round(float(np.mean(q[(t >= t_arr + 0.005) & (t <= t_arr + 0.05)])), 1)}
+
+
+def window_and_impulse(t: np.ndarray, p: np.ndarray, te: np.ndarray, pe: np.ndarray) -> dict:
+    """SPH / experiment ratios of sensor 1's first peak after centred moving averages of 1, 2,
+    5 and 10 ms (the SPH spike rings with a period ~4 d/c0; the experiment's event is a 2 ms
+    rise and a slow decay) and of the pressure impulse from arrival over 5, 10, 20, 50 ms."""
+    def impulse(tt: np.ndarray, pp: np.ndarray, span: float) -> float:
+        ta = impact_figures(tt, pp, 0.0)["arrival_s"]
+        sel = (tt >= ta) & (tt <= ta + span)
+        return float(np.trapezoid(np.nan_to_num(pp[sel]), tt[sel]))
+    if impact_figures(t, p, 0.0).get("arrival_s") is None:
+        return {}
+    return {"peak_ratio_window_ms": {f"{1e3 * w:g}": round(impact_figures(t, p, w)["peak_avg_pa"]
+                                                          / impact_figures(te, pe, w)["peak_avg_pa"], 3)
+                                     for w in (1e-3, 2e-3, 5e-3, 10e-3)},
+            "impulse_ratio_ms": {f"{1e3 * w:g}": round(impulse(t, p, w) / impulse(te, pe, w), 3)
+                                 for w in (5e-3, 10e-3, 20e-3, 50e-3)}}
 
 
 class Sensors:
@@ -218,6 +237,8 @@ def main() -> None:
            "sensor1_experiment": impact_figures(te, pe, avg),
            "sensor1_probe": impact_figures(t, probe[:, 0], avg),
            "sensor1_wall": impact_figures(t, wall[:, 0], avg)}
+    out["sensor1_probe_windows"] = window_and_impulse(t, probe[:, 0], te, pe)
+    out["sensor1_wall_windows"] = window_and_impulse(t, wall[:, 0], te, pe)
     e, s = out["sensor1_experiment"], out["sensor1_probe"]
     if e.get("peak_pa") and s.get("peak_pa"):
         out["peak_ratio_probe"] = round(s["peak_pa"] / e["peak_pa"], 3)

@@ -322,7 +322,8 @@ def _particle_loads(ps, n, cells, prm, bd):
                         if r2 < s2:
                             fij = f_of_q(math.sqrt(r2) * inv_h, af)
                             rhoi = rho[i]
-                            pf = mj * (p[i] + pj) / (rhoi * rhoj)
+                            # fluid_pass's fluid-wall pair: no tension across a wall
+                            pf = mj * (max(p[i], 0.0) + pj) / (rhoi * rhoj)
                             pax = 0.0
                             paz = 0.0
                             if noslip:

@@ -129,7 +129,8 @@ def fluid_neighbour_counts(ps, n, cells, h, counts):
 @njit(cache=True)
 def wall_force(ps, cells, slots, xm, zm, h, alpha_f):
     """(F_x, F_z, M_y) the fluid exerts on the wall particles ``slots``: minus the pressure pair
-    forces m_f m_s (p_f + p_s)/(rho_f rho_s) F_fs r_fs of wcsph.fluid_pass; M_y about (xm, zm)."""
+    forces m_f m_s (max(p_f, 0) + p_s)/(rho_f rho_s) F_fs r_fs of wcsph.fluid_pass (no tension
+    across a wall); M_y about (xm, zm)."""
     x = ps.x
     z = ps.z
     kind = ps.kind
@@ -157,7 +158,7 @@ def wall_force(ps, cells, slots, xm, zm, h, alpha_f):
                     dz = z[j] - zs
                     r2 = dx * dx + dz * dz
                     if r2 < s2:
-                        pf = c_s * ps.m[j] * (ps.p[j] + p_s) / ps.rho[j]
+                        pf = c_s * ps.m[j] * (max(ps.p[j], 0.0) + p_s) / ps.rho[j]
                         fij = f_of_q(math.sqrt(r2) / h, alpha_f)
                         # force on the fluid particle is +pf F r_fs; the wall gets the reaction
                         sx -= pf * fij * dx

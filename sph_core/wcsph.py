@@ -266,8 +266,10 @@ def fluid_pass(ps, n, cells, prm):
                         pf = 2.0 * vol * pstar * inv_rhoi
                     else:
                         cont -= vol * fij * (dvx * dx + dvz * dz)
-                        # m_j (p_i + p_j) / (rho_i rho_j), with the divisions shared per pair
-                        pf = vol * (pi + p[j]) * inv_rhoi
+                        # m_j (p_i + p_j) / (rho_i rho_j), with the divisions shared per pair;
+                        # against a wall no tension (p_i >= 0, as p_j >= 0 in wall_pass): a fluid
+                        # particle in tension beside a wall is otherwise pulled into it
+                        pf = vol * ((max(pi, 0.0) if kj == WALL else pi) + p[j]) * inv_rhoi
                         # height of i above j along gravity (z_i - z_j for g = (0, -g)); wall
                         # densities come from the Adami extrapolation, so they carry the
                         # hydrostatic part as the fluid's do and take part in the diffusion
