@@ -4,7 +4,7 @@
         [--settle-periods 0] [--inlet-pressure hydrostatic|extrapolated] [--no-outlet-absorb]
         [--h-over-dp 2.0] [--alpha 0.01] [--slip no_slip|free_slip] [--c0-factor 10] [--delta 0.1]
         [--cfl 0.25] [--integrator kdk|symplectic_pc] [--nu 1e-6] [--alpha-wall 1.0]
-        [--shifting none|fickian] [--shift-a 2.0]
+        [--shifting none|fickian|dplus] [--shift-a 2.0]
         [--shift-fs-div 1.8] [--flume-wavelengths 1]
         [--scheme wcsph|riemann] [--reconstruction muscl|none] [--limiter minmod|vanleer]
         [--low-dissipation | --no-low-dissipation]
@@ -64,9 +64,12 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--cfl", type=float, help="Courant number")
     ap.add_argument("--integrator", choices=["kdk", "symplectic_pc"])
     ap.add_argument("--nu", type=float, help="laminar kinematic viscosity [m^2/s]")
-    ap.add_argument("--shifting", choices=["none", "fickian"], help="particle shifting")
+    ap.add_argument("--shifting", choices=["none", "fickian", "dplus"], help="particle shifting")
     ap.add_argument("--shift-a", type=float, help="shifting coefficient A (Lind et al. 2012)")
     ap.add_argument("--shift-fs-div", type=float, help="free-surface position-divergence limit")
+    ap.add_argument("--shift-dplus-scale", type=float, help="dplus: multiplier on CFL Ma (2h)^2")
+    ap.add_argument("--no-shift-carry", action="store_true",
+                    help="do not Taylor-carry rho, v of a shifted particle")
     ap.add_argument("--alpha-wall", type=float, help="artificial viscosity factor against walls")
     ap.add_argument("--no-outlet-absorb", action="store_true",
                     help="outlet without the absorption correction (diagnostic: its reflection)")
@@ -78,6 +81,8 @@ def main(argv: list[str] | None = None) -> int:
                              "delta": a.delta, "cfl": a.cfl, "nu": a.nu,
                              "integrator": a.integrator, "shifting": a.shifting,
                              "shift_a": a.shift_a, "shift_fs_div": a.shift_fs_div,
+                             "shift_dplus_scale": a.shift_dplus_scale,
+                             "shift_carry": False if a.no_shift_carry else None,
                              "alpha_wall_factor": a.alpha_wall}.items() if v is not None}
     scheme = scheme_from_args(a)
     c0 = a.c0_factor * math.sqrt(9.81 * a.d)

@@ -112,6 +112,12 @@ class Params(NamedTuple):
     riemann: bool = False
     limiter: int = 0     # MUSCL slope limiter (riemann.LIMITERS): 0 = no reconstruction
     rs_eta: float = 0.0  # Zhang et al. 2017 dissipation limiter eta (0: full dissipation)
+    # particle shifting law (shifting.py): Fickian (D = shift_a h |v_i| dt) or delta-plus
+    # (D = shift_a h max|v| dt, anti-clustering weight 1 + R (W / W(dp))^4 with shift_inv_wdp
+    # = 1 / W(dp), Marrone's surface detection); shift_carry: Taylor-carry rho, v over the shift
+    shift_dplus: bool = False
+    shift_carry: bool = True
+    shift_inv_wdp: float = 0.0
 
 
 class OpenEnds(NamedTuple):
