@@ -1,6 +1,12 @@
-"""Fickian particle shifting with free-surface detection (Lind et al. 2012; Skillen et al. 2013).
+"""Particle shifting with free-surface detection: two laws (scene ``constants.shifting``).
 
-After each step every fluid particle i moves by
+``shift_particles``: Fickian (Lind et al. 2012; Skillen et al. 2013). ``shift_particles_dplus``:
+delta-plus SPH (Sun, Colagrossi, Marrone, Zhang 2017) with the free-surface detection of Marrone
+et al. 2010 (its own docstring). Both carry rho and v of the shifted particle to first order
+unless ``prm.shift_carry`` is off. The renormalisation matrix B_i below is computed here, in the
+shifting pass (a kernel-gradient-correction pass computes the same matrix; share it when both run).
+
+Fickian: after each step every fluid particle i moves by
     dr_i = -D_i grad C_i,   D_i = A h |v_i| dt   (A = Constants.shift_a),
     grad C_i = sum_j V_j grad_i W_ij = -sum_j V_j F_ij r_ij
 (j: fluid, wall and active buffer neighbours; V_j = m_j / rho_j), towards lower particle
@@ -21,6 +27,10 @@ The displacement and the carried increments are gathered into the scratch rows x
 vzn, rhon (kdk does not use them; symplectic_pc rewrites them at its next predictor) and applied
 in a second loop, so no particle reads a neighbour that has already moved. Measured effect on
 the wave of bench/wave_decay.py: none for the better at h/dp 2 (docs/wave_decay_study.md).
+
+delta-plus uses 11 scratch rows (xn, zn, vxn, vzn, rhon and the MUSCL gradient rows gpx..gwz,
+which riemann_gradients rewrites before every use) for three passes: B, lambda, the normal, the
+shift, the gradients and the surface scan; the vicinity test and the projection; the move.
 """
 
 from __future__ import annotations
