@@ -37,6 +37,7 @@ VARIANTS = {
     "kernel_correction all": {"kernel_correction": "all"},
     "kernel_correction surface": {"kernel_correction": "surface"},
     "kernel_correction weighted": {"kernel_correction": "weighted"},
+    "shifting dplus": {"shifting": "dplus"},
 }
 
 

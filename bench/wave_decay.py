@@ -4,7 +4,7 @@
         [--settle-periods 0] [--inlet-pressure hydrostatic|extrapolated] [--no-outlet-absorb]
         [--h-over-dp 2.0] [--alpha 0.01] [--slip no_slip|free_slip] [--c0-factor 10] [--delta 0.1]
         [--cfl 0.25] [--integrator kdk|symplectic_pc] [--nu 1e-6] [--alpha-wall 1.0]
-        [--shifting none|fickian] [--kernel-correction off|all|surface|weighted] [--shift-a 2.0]
+        [--shifting none|fickian|dplus] [--kernel-correction off|all|surface|weighted] [--shift-a 2.0]
         [--shift-fs-div 1.8] [--flume-wavelengths 1] [--gauge-wavelengths 0.75] [--n-gauges 12]
         [--long] [--absorption filter|linear|shallow] [--transfer piston|flux]
         [--scheme wcsph|riemann|isph] [--reconstruction muscl|none] [--limiter minmod|vanleer]
@@ -82,9 +82,12 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--cfl", type=float, help="Courant number")
     ap.add_argument("--integrator", choices=["kdk", "symplectic_pc"])
     ap.add_argument("--nu", type=float, help="laminar kinematic viscosity [m^2/s]")
-    ap.add_argument("--shifting", choices=["none", "fickian"], help="particle shifting")
+    ap.add_argument("--shifting", choices=["none", "fickian", "dplus"], help="particle shifting")
     ap.add_argument("--shift-a", type=float, help="shifting coefficient A (Lind et al. 2012)")
     ap.add_argument("--shift-fs-div", type=float, help="free-surface position-divergence limit")
+    ap.add_argument("--shift-dplus-scale", type=float, help="dplus: multiplier on CFL Ma (2h)^2")
+    ap.add_argument("--no-shift-carry", action="store_true",
+                    help="do not Taylor-carry rho, v of a shifted particle")
     ap.add_argument("--alpha-wall", type=float, help="artificial viscosity factor against walls")
     ap.add_argument("--no-outlet-absorb", action="store_true",
                     help="outlet without the absorption correction (diagnostic: its reflection)")
@@ -99,6 +102,8 @@ def main(argv: list[str] | None = None) -> int:
                              "integrator": a.integrator, "shifting": a.shifting,
                              "shift_a": a.shift_a, "shift_fs_div": a.shift_fs_div,
                              "alpha_wall_factor": a.alpha_wall,
+                             "shift_dplus_scale": a.shift_dplus_scale,
+                             "shift_carry": False if a.no_shift_carry else None,
                              "kernel_correction": a.kernel_correction}.items() if v is not None}
     scheme = scheme_from_args(a)
     if a.long:

@@ -165,10 +165,17 @@ class Constants(_Model):
         "artificial viscosity against walls = this x alpha (DualSPHysics' ViscoBoundFactor); "
         "0 (default) for waves, 1 for violent flows on a bed (the dam-break case); applies "
         "with no_slip walls only"))
-    shifting: Literal["none", "fickian"] = Field("none", description=(
-        "particle shifting after each step: fickian = Lind et al. 2012, tangential only near "
-        "the free surface (sph_core.shifting)"))
-    shift_a: float = Field(2.0, gt=0, description="shifting coefficient A: D = A h |v| dt")
+    shifting: Literal["none", "fickian", "dplus"] = Field("none", description=(
+        "particle shifting after each step: fickian = Lind et al. 2012, tangential only below "
+        "shift_fs_div; dplus = Sun et al. 2017 (delta-plus SPH), tangential only at the free "
+        "surface found by Marrone et al. 2010 and within 2h of it, none for isolated particles "
+        "(sph_core.shifting)"))
+    shift_a: float = Field(2.0, gt=0, description="fickian: shifting coefficient A: D = A h |v| dt")
+    shift_dplus_scale: float = Field(1.0, gt=0, description=(
+        "dplus: multiplier on Sun et al. 2017's CFL Ma (2h)^2 (D = 4 scale h max|v| dt)"))
+    shift_carry: bool = Field(True, description=(
+        "carry the shifted particle's density and velocity to its new position (first-order "
+        "Taylor); without it the shift diffuses the velocity field"))
     shift_fs_div: float = Field(1.8, gt=0, lt=2, description=(
         "position divergence below which a particle counts as near the free surface (2D: 2 "
         "inside the fluid) and shifts only tangentially"))

@@ -1,6 +1,12 @@
-"""Fickian particle shifting with free-surface detection (Lind et al. 2012; Skillen et al. 2013).
+"""Particle shifting with free-surface detection: two laws (scene ``constants.shifting``).
 
-After each step every fluid particle i moves by
+``shift_particles``: Fickian (Lind et al. 2012; Skillen et al. 2013). ``shift_particles_dplus``:
+delta-plus SPH (Sun, Colagrossi, Marrone, Zhang 2017) with the free-surface detection of Marrone
+et al. 2010 (its own docstring). Both carry rho and v of the shifted particle to first order
+unless ``prm.shift_carry`` is off. The renormalisation matrix B_i below is computed here, in the
+shifting pass (a kernel-gradient-correction pass computes the same matrix; share it when both run).
+
+Fickian: after each step every fluid particle i moves by
     dr_i = -D_i grad C_i,   D_i = A h |v_i| dt   (A = Constants.shift_a),
     grad C_i = sum_j V_j grad_i W_ij = -sum_j V_j F_ij r_ij
 (j: fluid, wall and active buffer neighbours; V_j = m_j / rho_j), towards lower particle
@@ -21,6 +27,10 @@ The displacement and the carried increments are gathered into the scratch rows x
 vzn, rhon (kdk does not use them; symplectic_pc rewrites them at its next predictor) and applied
 in a second loop, so no particle reads a neighbour that has already moved. Measured effect on
 the wave of bench/wave_decay.py: none for the better at h/dp 2 (docs/wave_decay_study.md).
+
+delta-plus uses 11 scratch rows (xn, zn, vxn, vzn, rhon and the MUSCL gradient rows gpx..gwz,
+which riemann_gradients rewrites before every use) for three passes: B, lambda, the normal, the
+shift, the gradients and the surface scan; the vicinity test and the projection; the move.
 """
 
 from __future__ import annotations
@@ -29,7 +39,7 @@ import math
 
 from numba import njit, prange
 
-from .kernels import f_of_q
+from .kernels import f_of_q, w_of_q
 from .neighbours import block_of
 from .particles import FLUID, OUTLET, WALL
 
@@ -130,9 +140,10 @@ def shift_particles(ps, n, cells, prm, dt):
         sxr[i] = sx
         szr[i] = sz
         # first-order carry of rho and v to the new position
-        srho[i] = sx * grx + sz * grz
-        svx[i] = sx * gux + sz * guz
-        svz[i] = sx * gwx + sz * gwz
+        if prm.shift_carry:
+            srho[i] = sx * grx + sz * grz
+            svx[i] = sx * gux + sz * guz
+            svz[i] = sx * gwx + sz * gwz
     for i in prange(n):
         if kind[i] == FLUID:
             x[i] += sxr[i]
@@ -140,3 +151,204 @@ def shift_particles(ps, n, cells, prm, dt):
             rho[i] += srho[i]
             vx[i] += svx[i]
             vz[i] += svz[i]
+
+
+# --- delta-plus shifting (Sun, Colagrossi, Marrone, Zhang 2017; Marrone et al. 2010) -----------
+
+DPLUS_R = 0.2            # anti-clustering term 1 + R (W_ij / W(dp))^n of Sun et al. 2017
+DPLUS_N = 4
+LAMBDA_ISOLATED = 0.2    # lambda_i (smallest eigenvalue of B_i) at or below: a splash / jet, no shift
+LAMBDA_INTERIOR = 0.75   # above: full support, not a surface candidate (Marrone et al. 2010)
+FS_INTERIOR = 0.0        # flags of pass 1 (stored in the scratch row ps.guz)
+FS_SURFACE = 1.0
+FS_ISOLATED = 2.0
+
+
+@njit(parallel=True, cache=True)
+def shift_particles_dplus(ps, n, cells, prm, dt, umax):
+    """delta-plus shifting of every fluid particle of the sorted state ``ps``:
+        dr_i = -A h U dt sum_j [1 + R (W_ij / W(dp))^n] grad_i W_ij V_j,
+    A = ``prm.shift_a`` (4 = Sun et al. 2017's CFL Ma (2h)^2 with Ma = U / c0, CFL = c0 dt / h),
+    U = ``umax`` the largest fluid speed. Free surface (Marrone et al. 2010): lambda_i, the smallest
+    eigenvalue of B_i = sum_j V_j F_ij r_ij r_ij^T, <= LAMBDA_ISOLATED: no shift; a candidate
+    (lambda_i <= LAMBDA_INTERIOR) whose scan region (the cone/umbrella of radius h at h along the
+    renormalised normal n_i = -B_i^-1 grad C_i / |.|) holds no neighbour is a surface particle;
+    surface particles and those within 2h of one keep only dr - (dr . n) n. With
+    ``prm.shift_carry`` the shifted particle's rho and v are carried to the new position by
+    their renormalised gradients (first-order Taylor). See the module docstring for the rows."""
+    x = ps.x
+    z = ps.z
+    vx = ps.vx
+    vz = ps.vz
+    rho = ps.rho
+    m = ps.m
+    kind = ps.kind
+    cell = ps.cell
+    cell_start = cells.start
+    ncx = cells.ncx
+    h = prm.h
+    alpha_f = prm.alpha_f
+    alpha_w = prm.alpha_w
+    inv_wdp = prm.shift_inv_wdp
+    coef = prm.shift_a * h * umax * dt
+    carry = prm.shift_carry
+    max_shift = 0.05 * h
+    s2 = 4.0 * h * h
+    inv_h = 1.0 / h
+    scan2 = 2.0 * h * h       # |r_ji| < sqrt(2) h: the umbrella test, else the circle
+    # scratch rows: dr (xn, zn), n (gpx, gpz), flag (guz), the gradients of rho (vxn, vzn),
+    # of vx (rhon, gux), of vz (gwx, gwz); pass 2 overwrites dr and puts the carries in
+    # vxn (rho), vzn (vx), rhon (vz)
+    sxr = ps.xn
+    szr = ps.zn
+    snx = ps.gpx
+    snz = ps.gpz
+    flag = ps.guz
+    grx = ps.vxn
+    grz = ps.vzn
+    gux = ps.rhon
+    guz = ps.gux
+    gwx = ps.gwx
+    gwz = ps.gwz
+    # pass 1: B, lambda, the normal, the shift, the gradients; the surface scan
+    for i in prange(n):
+        sxr[i] = 0.0
+        szr[i] = 0.0
+        snx[i] = 0.0
+        snz[i] = 0.0
+        flag[i] = FS_INTERIOR
+        grx[i] = grz[i] = gux[i] = guz[i] = gwx[i] = gwz[i] = 0.0
+        if kind[i] == FLUID:
+            xi = x[i]
+            zi = z[i]
+            gcx = gcz = 0.0       # sum V grad W (the normal)
+            wcx = wcz = 0.0       # the same with the anti-clustering weight (the shift)
+            bxx = bxz = bzz = 0.0
+            ax_ = az_ = ux = uz = wx = wz = 0.0
+            cxl, cxh, czl, czh = block_of(cell[i], cells)
+            for zz in range(czl, czh + 1):
+                row = zz * ncx
+                for j in range(cell_start[row + cxl], cell_start[row + cxh + 1]):
+                    kj = kind[j]
+                    if j == i or kj < FLUID or kj > OUTLET:
+                        continue
+                    dx = xi - x[j]
+                    dz = zi - z[j]
+                    r2 = dx * dx + dz * dz
+                    if r2 >= s2:
+                        continue
+                    q = math.sqrt(r2) * inv_h
+                    fv = f_of_q(q, alpha_f) * m[j] / rho[j]
+                    wr = w_of_q(q, alpha_w) * inv_wdp
+                    wr2 = wr * wr
+                    wgt = 1.0 + DPLUS_R * wr2 * wr2
+                    gcx -= fv * dx            # grad_i W_ij = -F r_ij
+                    gcz -= fv * dz
+                    wcx -= wgt * fv * dx
+                    wcz -= wgt * fv * dz
+                    bxx += fv * dx * dx
+                    bxz += fv * dx * dz
+                    bzz += fv * dz * dz
+                    dr = rho[j] - rho[i]
+                    ax_ -= fv * dr * dx
+                    az_ -= fv * dr * dz
+                    if kj != WALL:  # walls carry no flow field of their own
+                        du = vx[j] - vx[i]
+                        dw = vz[j] - vz[i]
+                        ux -= fv * du * dx
+                        uz -= fv * du * dz
+                        wx -= fv * dw * dx
+                        wz -= fv * dw * dz
+            half_tr = 0.5 * (bxx + bzz)
+            hd = 0.5 * (bxx - bzz)
+            lam = half_tr - math.sqrt(hd * hd + bxz * bxz)
+            det = bxx * bzz - bxz * bxz
+            if lam <= LAMBDA_ISOLATED or det <= 1e-6:
+                flag[i] = FS_ISOLATED
+            else:
+                # renormalised gradients (first-order consistent up to the surface)
+                lx = (bzz * gcx - bxz * gcz) / det
+                lz = (bxx * gcz - bxz * gcx) / det
+                grx[i] = (bzz * ax_ - bxz * az_) / det
+                grz[i] = (bxx * az_ - bxz * ax_) / det
+                gux[i] = (bzz * ux - bxz * uz) / det
+                guz[i] = (bxx * uz - bxz * ux) / det
+                gwx[i] = (bzz * wx - bxz * wz) / det
+                gwz[i] = (bxx * wz - bxz * wx) / det
+                sxr[i] = -coef * wcx
+                szr[i] = -coef * wcz
+                gn = math.sqrt(lx * lx + lz * lz)
+                if gn > 0.0:
+                    nx = -lx / gn
+                    nz = -lz / gn
+                    snx[i] = nx
+                    snz[i] = nz
+                    if lam <= LAMBDA_INTERIOR:
+                        # scan: is any neighbour in the region around T = r_i + h n?
+                        tx = xi + h * nx
+                        tz = zi + h * nz
+                        occupied = False
+                        for zz in range(czl, czh + 1):
+                            row = zz * ncx
+                            for j in range(cell_start[row + cxl], cell_start[row + cxh + 1]):
+                                kj = kind[j]
+                                if occupied or j == i or kj < FLUID or kj > OUTLET:
+                                    continue
+                                dx = x[j] - xi
+                                dz = z[j] - zi
+                                r2 = dx * dx + dz * dz
+                                if r2 >= s2:
+                                    continue
+                                ex = x[j] - tx
+                                ez = z[j] - tz
+                                if r2 >= scan2:
+                                    occupied = ex * ex + ez * ez < h * h
+                                else:
+                                    occupied = (abs(ex * nx + ez * nz)
+                                                + abs(ez * nx - ex * nz)) < h
+                        if not occupied:
+                            flag[i] = FS_SURFACE
+    # pass 2: the surface and its vicinity (within 2h of a surface particle) shift tangentially
+    for i in prange(n):
+        if kind[i] == FLUID and flag[i] != FS_ISOLATED:
+            near = flag[i] == FS_SURFACE
+            if not near:
+                xi = x[i]
+                zi = z[i]
+                cxl, cxh, czl, czh = block_of(cell[i], cells)
+                for zz in range(czl, czh + 1):
+                    row = zz * ncx
+                    for j in range(cell_start[row + cxl], cell_start[row + cxh + 1]):
+                        if near or flag[j] != FS_SURFACE or kind[j] != FLUID:
+                            continue
+                        dx = xi - x[j]
+                        dz = zi - z[j]
+                        near = dx * dx + dz * dz < s2
+            sx = sxr[i]
+            sz = szr[i]
+            if near:
+                sn = sx * snx[i] + sz * snz[i]
+                sx -= sn * snx[i]
+                sz -= sn * snz[i]
+            s = math.sqrt(sx * sx + sz * sz)
+            if s > max_shift:
+                sx *= max_shift / s
+                sz *= max_shift / s
+            sxr[i] = sx
+            szr[i] = sz
+            if carry:
+                crho = sx * grx[i] + sz * grz[i]
+                cu = sx * gux[i] + sz * guz[i]
+                cw = sx * gwx[i] + sz * gwz[i]
+            else:
+                crho = cu = cw = 0.0
+            grx[i] = crho
+            grz[i] = cu
+            gux[i] = cw
+    for i in prange(n):
+        if kind[i] == FLUID and flag[i] != FS_ISOLATED:
+            x[i] += sxr[i]
+            z[i] += szr[i]
+            rho[i] += grx[i]
+            vx[i] += grz[i]
+            vz[i] += gux[i]

@@ -34,7 +34,7 @@ from .bodies import BodyLog, BodySet
 from .boundary_data import BoundaryData, BoundaryDataError, BoundarySample
 from .eos import hydrostatic_density, tait_b
 from .geometry import build_layout
-from .kernels import wendland_alpha
+from .kernels import w_of_q, wendland_alpha
 from .neighbours import CellGrid, compute_cells, counting_sort
 from .load_probes import LoadProbes
 from .open_ends import OpenBoundaries
@@ -129,6 +129,14 @@ class Simulation:
         # has gone through the wall; the top z1 is open
         fx0, fx1 = self.open.fluid_box(t.x0 - 0.5 * dp, t.x1 + 0.5 * dp, dp)
         lo, hi = c.density_band
+        # shifting (shifting.py): delta-plus's CFL Ma (2h)^2 is D = 4 h max|v| dt
+        dplus = c.shifting == "dplus" and not self.isph
+        if dplus:
+            shift_a = 4.0 * c.shift_dplus_scale
+        elif c.shifting == "fickian" or (self.isph and scheme.isph_shifting):
+            shift_a = c.shift_a
+        else:
+            shift_a = 0.0
         self.prm = Params(h=h, alpha_w=aw, alpha_f=5.0 * aw / (h * h), rho0=c.rho0, c0=self.c0,
                           b=self.b, gamma=7.0, gx=0.0, gz=-c.g, nu=c.nu,
                           # ISPH has no artificial viscosity (the bodies' load pass reads alpha)
@@ -137,9 +145,10 @@ class Simulation:
                           rho_lo=lo, rho_hi=hi,
                           noslip=c.wall_slip == "no_slip", fx0=fx0, fx1=fx1,
                           fz0=t.z0 - 0.5 * dp, fz1=t.z1, alpha_wall=c.alpha_wall_factor,
-                          shift_a=(c.shift_a if (c.shifting == "fickian"
-                                                 or (self.isph and scheme.isph_shifting)) else 0.0),
-                          shift_fs_div=c.shift_fs_div,
+                          shift_a=shift_a, shift_fs_div=c.shift_fs_div,
+                          # ISPH's figures (docs/schemes.md) were measured without the carry
+                          shift_dplus=dplus, shift_carry=c.shift_carry and not self.isph,
+                          shift_inv_wdp=1.0 / w_of_q(dp / h, aw),
                           kgc=KERNEL_CORRECTIONS[c.kernel_correction],
                           **scheme_params(scene.scheme))
         self.integrator = wcsph.INTEGRATORS[c.integrator]

@@ -118,6 +118,12 @@ class Params(NamedTuple):
     # kernel gradient correction of the pressure gradient (scene constants.kernel_correction;
     # kernel_correction.KERNEL_CORRECTIONS): 0 off, 1 all fluid particles, 2 near the surface
     kgc: int = 0
+    # particle shifting law (shifting.py): Fickian (D = shift_a h |v_i| dt) or delta-plus
+    # (D = shift_a h max|v| dt, anti-clustering weight 1 + R (W / W(dp))^4 with shift_inv_wdp
+    # = 1 / W(dp), Marrone's surface detection); shift_carry: Taylor-carry rho, v over the shift
+    shift_dplus: bool = False
+    shift_carry: bool = True
+    shift_inv_wdp: float = 0.0
 
 
 class OpenEnds(NamedTuple):

@@ -64,7 +64,7 @@ from .neighbours import sort_by_cell
 from .open_boundary import extrapolate_buffers, measure_boundaries, update_buffers
 from .particles import N_SORTED_KDK, N_SORTED_PC
 from .riemann import NO_RECONSTRUCTION, riemann_gradients
-from .shifting import shift_particles
+from .shifting import shift_particles, shift_particles_dplus
 from .wcsph import (KDK, ST_CAPACITY, ST_DENSITY, ST_LEFT_DOMAIN, ST_NONFINITE, ST_REACHED_T,
                     ST_STEP_LIMIT, fluid_pass, kdk_kick, kdk_kick_drift, pc_correct, pc_predict,
                     stable_dt, update_pressure, wall_pass)
@@ -81,6 +81,16 @@ def _forces(ps, n, cells, prm, bd):
         riemann_gradients(ps, n, cells, prm)   # MUSCL: gradients of p and v (riemann.py)
     fluid_pass(ps, n, cells, prm)
     body_loads(ps, n, cells, prm, bd)
+
+
+@njit(cache=True)
+def _shift(ps, n, cells, prm, dt, v2max):
+    """Particle shifting after the update (shifting.py), if on: Fickian or delta-plus."""
+    if prm.shift_a > 0.0:
+        if prm.shift_dplus:
+            shift_particles_dplus(ps, n, cells, prm, dt, math.sqrt(v2max))
+        else:
+            shift_particles(ps, n, cells, prm, dt)
 
 
 @njit(cache=True)
@@ -114,8 +124,7 @@ def _step_kdk(ps, ps2, cells, prm, ends, bd, n, t, dt):
     n_bad, n_band, v2max, a2max, rmax = kdk_kick(ps2, n, dt, prm)
     bodies_kick(bd, t, dt)
     place_bodies(ps2, n, bd)
-    if prm.shift_a > 0.0:
-        shift_particles(ps2, n, cells, prm, dt)
+    _shift(ps2, n, cells, prm, dt, v2max)
     measure_boundaries(ps2, cells, ends, prm)
     return _verdict(n, n_bad, n_band, n_out, v2max, a2max, rmax)
 
@@ -134,8 +143,7 @@ def _step_pc(ps, ps2, cells, prm, ends, bd, n, t, dt):
     n_bad, n_band, n_out, v2max, a2max, rmax = pc_correct(ps2, n, dt, prm)
     bodies_correct(bd, t, dt)
     place_bodies(ps2, n, bd)
-    if prm.shift_a > 0.0:
-        shift_particles(ps2, n, cells, prm, dt)
+    _shift(ps2, n, cells, prm, dt, v2max)
     if n_bad == 0 and n_out == 0:
         n_new = update_buffers(ps2, n, t + dt, dt, ends, prm)
         if n_new < 0:

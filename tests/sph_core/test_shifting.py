@@ -1,32 +1,39 @@
-"""Particle shifting (sph_core.shifting): a disordered particle moves back towards the lattice,
-a surface particle never moves along the surface normal, and still water with shifting on stays
-still for 100 sqrt(d/g) (no surface drift; mass and momentum conserved; slow: ~100 s on a
-loaded core)."""
+"""Particle shifting (sph_core.shifting), Fickian and delta-plus: a disordered particle moves back
+towards the lattice, a surface particle never moves along the surface normal, delta-plus finds the
+free surface (Marrone et al. 2010) and leaves an isolated particle alone, and still water with
+shifting on stays still for 100 sqrt(d/g) (no surface drift; mass and momentum conserved; slow:
+~100 s per law on a loaded core)."""
 
 import math
 
 import numpy as np
 import pytest
 
-from sph_core.kernels import wendland_alpha
+from sph_core.kernels import w_of_q, wendland_alpha
 from sph_core.neighbours import CellGrid
-from sph_core.particles import FLUID, M, N_FIELDS, RHO, VX, VZ, WALL, X, Z
+from sph_core.particles import FLUID, GUZ, M, N_FIELDS, RHO, VX, VZ, WALL, X, Z
 from sph_core.scene import make_scene
-from sph_core.shifting import shift_particles
+from sph_core.shifting import FS_SURFACE, shift_particles, shift_particles_dplus
 from sph_core.simulation import Simulation
 from sph_core.state import Cells, Params, particles_view
 
 
 def _lattice_run(nx: int, nz: int, dp: float, h: float, moved: tuple[int, float, float],
-                 coef: float = 2.0, fs_div: float = 1.8, speed: float = 1.0):
-    """Shift a lattice of nx x nz fluid particles (one moved by (dx, dz)) above 4 wall rows;
-    returns (x, z before, x, z after, kinds, the sort order)."""
+                 coef: float = 2.0, fs_div: float = 1.8, speed: float = 1.0,
+                 dplus: bool = False, extra: tuple[float, float] | None = None):
+    """Shift a lattice of nx x nz fluid particles (one moved by (dx, dz); ``extra``: one more
+    fluid particle there) above 4 wall rows by the Fickian or (``dplus``) the delta-plus law;
+    returns (x, z before, x, z after, kinds, the sort order, the delta-plus surface flags)."""
     xs, zs, kinds = [], [], []
     for j in range(-4, nz):
         for i in range(nx):
             xs.append((i + 0.5) * dp)
             zs.append((j + 0.5) * dp)
             kinds.append(WALL if j < 0 else FLUID)
+    if extra is not None:
+        xs.append(extra[0])
+        zs.append(extra[1])
+        kinds.append(FLUID)
     n = len(xs)
     f = np.zeros((N_FIELDS, n))
     f[X], f[Z] = xs, zs
@@ -51,18 +58,27 @@ def _lattice_run(nx: int, nz: int, dp: float, h: float, moved: tuple[int, float,
     prm = Params(h=h, alpha_w=aw, alpha_f=5.0 * aw / (h * h), rho0=1000.0, c0=10.0, b=1.0,
                  gamma=7.0, gx=0.0, gz=-9.81, alpha=0.01, nu=1e-6, delta=0.1, cfl=0.25,
                  rho_lo=0.7, rho_hi=1.3, noslip=True, fx0=-1.0, fx1=1.0, fz0=-1.0, fz1=1.0,
-                 alpha_wall=1.0, shift_a=coef, shift_fs_div=fs_div)
+                 alpha_wall=1.0, shift_a=coef, shift_fs_div=fs_div, shift_dplus=dplus,
+                 shift_inv_wdp=1.0 / w_of_q(dp / h, aw))
     before = (f[X].copy(), f[Z].copy())
-    shift_particles(particles_view(f, kind, np.arange(n, dtype=np.int64), cell), n, cells, prm,
-                    1e-3)
-    return before, (f[X], f[Z]), kind, order
+    ps = particles_view(f, kind, np.arange(n, dtype=np.int64), cell)
+    if dplus:
+        shift_particles_dplus(ps, n, cells, prm, 1e-3, speed)
+    else:
+        shift_particles(ps, n, cells, prm, 1e-3)
+    return before, (f[X], f[Z]), kind, order, f[GUZ].copy()
 
 
-def test_displaced_interior_particle_moves_back_towards_its_lattice_site():
+LAWS = [pytest.param({}, id="fickian"), pytest.param({"dplus": True, "coef": 4.0}, id="dplus")]
+
+
+@pytest.mark.parametrize("law", LAWS)
+def test_displaced_interior_particle_moves_back_towards_its_lattice_site(law):
     dp, h = 0.02, 0.04
     nx, nz = 12, 10
     k = 4 * nx + 6 + 4 * nx  # row 4 of the fluid (above 4 wall rows), column 6
-    (x0, z0), (x1, z1), kind, order = _lattice_run(nx, nz, dp, h, (k, 0.2 * dp, 0.1 * dp))
+    (x0, z0), (x1, z1), kind, order, _ = _lattice_run(nx, nz, dp, h, (k, 0.2 * dp, 0.1 * dp),
+                                                      **law)
     i = int(np.nonzero(order == k)[0][0])
     site = np.array([6.5 * dp, 4.5 * dp])
     before = np.hypot(x0[i] - site[0], z0[i] - site[1])
@@ -70,11 +86,12 @@ def test_displaced_interior_particle_moves_back_towards_its_lattice_site():
     assert after < before, f"shifted away from its site: {before:.3g} -> {after:.3g} m"
 
 
-def test_surface_particle_does_not_move_along_the_normal():
+@pytest.mark.parametrize("law", LAWS)
+def test_surface_particle_does_not_move_along_the_normal(law):
     dp, h = 0.02, 0.04
     nx, nz = 12, 6
     k = (nz - 1 + 4) * nx + 6  # top fluid row, column 6, moved sideways
-    (x0, z0), (x1, z1), kind, order = _lattice_run(nx, nz, dp, h, (k, 0.2 * dp, 0.0))
+    (x0, z0), (x1, z1), kind, order, _ = _lattice_run(nx, nz, dp, h, (k, 0.2 * dp, 0.0), **law)
     i = int(np.nonzero(order == k)[0][0])
     assert x1[i] != x0[i], "the tangential shift should act"
     # flat surface: the normal is z; the top row keeps its height (away from the block's lateral
@@ -82,6 +99,24 @@ def test_surface_particle_does_not_move_along_the_normal():
     top = (np.isclose(z0, (nz - 0.5) * dp) & (kind == FLUID) & (x0 > 3 * dp)
            & (x0 < (nx - 3) * dp))
     assert np.all(np.abs(z1[top] - z0[top]) < 1e-3 * dp)
+
+
+
+def test_dplus_finds_the_free_surface_and_leaves_an_isolated_particle_alone():
+    dp, h = 0.02, 0.04
+    nx, nz = 16, 10
+    k = 4 * nx + 8 + 4 * nx  # an interior particle, displaced so that the lattice is not at rest
+    drop = (8.5 * dp, (nz + 6) * dp)  # a drop 6 dp above the surface: no neighbour within 2h
+    (x0, z0), (x1, z1), kind, order, flag = _lattice_run(
+        nx, nz, dp, h, (k, 0.2 * dp, 0.1 * dp), dplus=True, coef=4.0, extra=drop)
+    fluid = kind == FLUID
+    inner = fluid & (x0 > 3 * dp) & (x0 < (nx - 3) * dp)
+    top = inner & np.isclose(z0, (nz - 0.5) * dp)
+    deep = inner & (z0 < (nz - 3) * dp)
+    assert np.all(flag[top] == FS_SURFACE), "the top row is the free surface"
+    assert not np.any(flag[deep] == FS_SURFACE), "a particle 3 rows down is not"
+    i = int(np.nonzero(np.isclose(x0, drop[0]) & np.isclose(z0, drop[1]))[0][0])
+    assert x1[i] == x0[i] and z1[i] == z0[i], "the isolated particle was shifted"
 
 
 D = 0.16            # still-water depth [m]
@@ -116,9 +151,9 @@ def still_water_run(shifting: str = "fickian"):
     return sim, st0, np.array(mom)
 
 
-@pytest.fixture(scope="module")
-def still_shifted():
-    return still_water_run()
+@pytest.fixture(scope="module", params=["fickian", "dplus"])
+def still_shifted(request):
+    return still_water_run(request.param)
 
 
 @pytest.mark.slow
