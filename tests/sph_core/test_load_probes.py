@@ -48,11 +48,7 @@ def test_hydrostatic_force_moment_and_pressure_on_a_tank_wall(tmp_path):
     assert {"right_fx", "right_fz", "right_my", "wall_p0", "wall_p4"} <= set(header)
 
 
-def test_overtopping_volume_and_steady_dam_site_flux():
-    """Dam break of a long reservoir (h0 = 0.1 m, 1 m long) on a dry bed: at the dam the flow is
-    steady, q = (8/27) sqrt(g) h0^(3/2) (Ritter 1892), until the reflection from the back wall
-    returns (t > 1 s). Measured at dp = 0.01, free slip: the fit over t = 0.3-0.8 s is 0.991 of
-    Ritter's q. The cumulative volume is the volume of the fluid past the section."""
+def _dry_bed_dam_break() -> Simulation:
     dp, h0, L = 0.01, 0.1, 1.0
     scene = make_scene({
         "dp": dp, "t_end": 0.8,
@@ -63,6 +59,17 @@ def test_overtopping_volume_and_steady_dam_site_flux():
         "probes": [{"kind": "overtopping", "name": "dam", "x": L}]})
     sim = Simulation(scene)
     sim.advance_to(scene.t_end)
+    return sim
+
+
+def test_overtopping_volume_and_steady_dam_site_flux():
+    """Dam break of a long reservoir (h0 = 0.1 m, 1 m long) on a dry bed: at the dam the flow is
+    steady, q = (8/27) sqrt(g) h0^(3/2) (Ritter 1892), until the reflection from the back wall
+    returns (t > 1 s). Measured at dp = 0.01, free slip: the fit over t = 0.3-0.8 s is 0.991 of
+    Ritter's q. The cumulative volume is the volume of the fluid past the section, plus the
+    particles excluded after crossing it (counted when they crossed; see the leak test below)."""
+    h0, L = 0.1, 1.0
+    sim = _dry_bed_dam_break()
     t = np.array([r["t"] for r in sim.history])
     vol = np.array([r["dam_volume"] for r in sim.history])
     steady = t >= 0.3 - 1e-9
@@ -71,8 +78,19 @@ def test_overtopping_volume_and_steady_dam_site_flux():
     assert np.mean([r["dam_q"] for r in sim.history[1:]]) * t[-1] == pytest.approx(vol[-1], rel=1e-9)
     ps = sim.particles
     past = (ps.kind[: ps.n] == FLUID) & (ps.field(X) >= L)
-    assert vol[-1] == pytest.approx(float((ps.field(M)[past] / ps.field(RHO)[past]).sum()), rel=0.01)
-    assert vol[0] == 0.0 and np.all(np.diff(vol) >= -1e-12)
+    m = float(ps.field(M)[past][0])
+    gone = sum(m / e["rho"] for e in sim.excluded if e["x"] >= L)
+    assert vol[-1] == pytest.approx(float((ps.field(M)[past] / ps.field(RHO)[past]).sum()) + gone,
+                                    rel=0.01)
+
+
+@pytest.mark.xfail(strict=True, reason=(
+    "the thin front of a dam break on a dry free-slip bed loses particles through the bed at "
+    "h/dp 2 (2-3 'left the tank' at z = -dp/2, x = 1.4-2.0 m, t = 0.36-0.77 s, on main before "
+    "and after the wall-tension fix); issue 11 item 5, not fixed"))
+def test_no_particle_leaves_through_the_bed_under_a_dry_bed_front():
+    sim = _dry_bed_dam_break()
+    assert sim.excluded == []
 
 
 def test_load_probe_errors_name_the_field():
