@@ -69,6 +69,8 @@ METHODS: dict[str, dict[str, Any]] = {
     # end "unstable" with the reason
     "isph_amg": {"h_over_dp": ISPH_H_OVER_DP, "alpha_wall_factor": 0.0,
                  "scheme": {"kind": "isph", "ppe_solver": "amg"}},
+    "isph_bicgstab": {"h_over_dp": ISPH_H_OVER_DP, "alpha_wall_factor": 0.0,
+                      "scheme": {"kind": "isph", "ppe_solver": "bicgstab"}},  # ISPH's default
 }
 # the coupled case's two ways to compute the same flume
 COUPLED_METHODS = ("coupled", "sph_only")
