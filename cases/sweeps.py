@@ -434,6 +434,9 @@ def plot_accuracy(records: list[dict[str, Any]], path: Path, title: str = "") ->
     ncol = min(3, n)
     nrow = math.ceil(n / ncol)
     fig, axes = plt.subplots(nrow, ncol, figsize=(4.6 * ncol, 3.8 * nrow), squeeze=False)
+    # one colour per method on every panel, so a line reads the same across cases
+    methods = sorted({r["method"] for r in records})
+    colour = {m: f"C{k % 10}" for k, m in enumerate(methods)}
     for ax, case in zip(axes.flat, cases):
         for method in sorted({r["method"] for r in records if r["case"] == case}):
             pts = sorted((r for r in records if r["case"] == case and r["method"] == method
@@ -441,10 +444,12 @@ def plot_accuracy(records: list[dict[str, Any]], path: Path, title: str = "") ->
                          key=lambda r: -r["dp"])
             bad = sum(1 for r in records if r["case"] == case and r["method"] == method
                       and r.get("status") != "ok")
-            if not pts:
+            if not pts:  # named in the legend, so a missing line is not read as not run
+                ax.plot([], [], "x", color=colour[method], label=f"{method} (all {bad} unstable/failed)")
                 continue
             label = method + (f" ({bad} unstable/failed)" if bad else "")
-            ax.plot([r["wall_s"] for r in pts], [r["error"] for r in pts], "o-", label=label)
+            ax.plot([r["wall_s"] for r in pts], [r["error"] for r in pts], "o-", label=label,
+                    color=colour[method])
             for r in pts:
                 ax.annotate(f"{r['dp']:g}", (r["wall_s"], r["error"]), fontsize=7,
                             xytext=(3, 3), textcoords="offset points")

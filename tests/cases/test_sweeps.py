@@ -149,6 +149,20 @@ def test_plan_reaches_the_target_on_the_fitted_line(tmp_path):
     assert finer.dp == pytest.approx(0.005) and finer.expected_wall_s > 3 * plan.expected_wall_s
 
 
+def test_plan_skips_unstable_and_barely_converging_methods(tmp_path):
+    """A method whose flume points ended unstable is not planned; one whose fit barely
+    converges (p 0.04 asked for dp ~1e-5 m, and a lattice of terabytes) is skipped, not built."""
+    good = sweeps.read_csv(_synthetic(tmp_path))
+    flat = [{**r, "method": "riemann_muscl", "error": 0.3 * r["H_over_dp"] ** -0.04} for r in good]
+    shaky = [{**r, "method": "isph_bicgstab", "error": 0.2 * r["H_over_dp"] ** -2.0} for r in good]
+    shaky[-1] = {**shaky[-1], "status": "unstable", "error": None}
+    req = planning.PlanRequest(height=0.06, period=2.0, depth=0.3, duration=10.0, target_error=0.05)
+    plan = planning.make_plan(req, good + flat + shaky)
+    assert plan.method == "wcsph_kdk" and plan.dp == pytest.approx(0.01)
+    with pytest.raises(ValueError):
+        planning.make_plan(req, flat + shaky)
+
+
 def test_plan_cli_json_for_the_demo_scene(tmp_path):
     data = _synthetic(tmp_path)
     cmd = [sys.executable, "-m", "wavesph_cli", "plan", str(ROOT / "examples/scenes/demo_beach_flume.toml"),
@@ -271,7 +285,8 @@ def test_wavesph_run_wave_option_warns_on_stderr(capsys):
     from wavesph_cli.run import _warn_if_expensive
 
     req = planning.PlanRequest(height=0.06, period=2.0, depth=0.3, duration=5.0)
-    planned = planning.zone_scene(req, 0.03)
+    plan = planning.make_plan(req)
+    planned = planning.zone_scene(req, plan.dp, plan.method)
     _warn_if_expensive(planned, 0.06, 2.0)
     assert "warning" not in capsys.readouterr().err
     x1 = 10 * planned.tank.x1
