@@ -79,6 +79,7 @@ from .kernels import f_of_q, w_of_q
 from .neighbours import block_of, sort_by_cell
 from .open_boundary import extrapolate_buffers, measure_boundaries, update_buffers
 from .particles import FLUID, INLET, N_SORTED_KDK, OUTLET, WALL
+from .renormalisation import moments, solve
 from .shifting import shift_particles
 from .wcsph import (FASTMATH, ST_CAPACITY, ST_LEFT_DOMAIN, ST_NONFINITE, ST_REACHED_T,
                     ST_STEP_LIMIT)
@@ -465,7 +466,8 @@ def correct(ps, n, cells, prm, dt, corrected, dry_walls):
     """u^{n+1} = u* - dt (grad p / rho)_i (eq. 16), r^{n+1} = r^n + dt (u^n + u^{n+1}) / 2
     (eq. 17); grad p by seed eq. 5 (symmetric), or ``corrected``: the renormalised difference
     B_i^-1 sum_j V_j (p_j - p_i) grad_i W_ij (Bonet & Lok 1999), exact for a linear field on a
-    truncated support. Returns (#non-finite, #outside the tank box, max |v|^2)."""
+    truncated support (B_i, the sum: renormalisation.moments; seed eq. 5 where det B_i <= 0.01).
+    Returns (#non-finite, #outside the tank box, max |v|^2)."""
     x = ps.x
     z = ps.z
     vx = ps.vx
@@ -489,40 +491,37 @@ def correct(ps, n, cells, prm, dt, corrected, dry_walls):
         if kind[i] == FLUID:
             fx = 0.0
             fz = 0.0
-            gpx = 0.0
-            gpz = 0.0
-            bxx = 0.0
-            bxz = 0.0
-            bzz = 0.0
-            cxl, cxh, czl, czh = block_of(cell[i], cells)
-            for zz in range(czl, czh + 1):
-                row = zz * ncx
-                for j in range(cell_start[row + cxl], cell_start[row + cxh + 1]):
-                    kj = kind[j]
-                    # without dry_walls, a wall particle with p < 0 (the air side of a wetted
-                    # wall, above the free surface) is left out like air: with it, the surface
-                    # corners of still water crept away from the wall (docs/schemes.md)
-                    if j != i and 0 <= kj <= OUTLET and (kj != WALL or dry_walls or p[j] >= 0.0):
-                        dx = x[i] - x[j]
-                        dz = z[i] - z[j]
-                        r2 = dx * dx + dz * dz
-                        if r2 < s2:
-                            fij = f_of_q(math.sqrt(r2) * inv_h, af)
-                            # -(1/rho) grad p = sum_j m_j (p_i/rho_i^2 + p_j/rho_j^2) F r_ij
-                            pf = m[j] * (p[i] / (rho[i] * rho[i]) + p[j] / (rho[j] * rho[j]))
-                            fx += pf * fij * dx
-                            fz += pf * fij * dz
-                            # corrected: grad p = B^-1 sum_j V_j (p_j - p_i) grad_i W_ij
-                            vf = m[j] / rho[j] * fij
-                            gpx -= vf * (p[j] - p[i]) * dx
-                            gpz -= vf * (p[j] - p[i]) * dz
-                            bxx += vf * dx * dx
-                            bxz += vf * dx * dz
-                            bzz += vf * dz * dz
-            det = bxx * bzz - bxz * bxz
-            if corrected and det > 0.01:  # 1 on a full 2D lattice support
-                fx = -(bzz * gpx - bxz * gpz) / (det * rho[i])
-                fz = -(bxx * gpz - bxz * gpx) / (det * rho[i])
+            symmetric = True
+            if corrected:
+                # grad p = M^-1 sum_j V_j (p_j - p_i) grad_i W_ij over the neighbours below
+                s = moments(i, ps, cells, prm, p, vx, vz, dry_walls)
+                det = s.mxx * s.mzz - s.mxz * s.mxz
+                if det > 0.01:  # 1 on a full 2D lattice support
+                    gpx, gpz = solve(s.mxx, s.mxz, s.mzz, det, s.phix, s.phiz)
+                    fx = -gpx / rho[i]
+                    fz = -gpz / rho[i]
+                    symmetric = False
+            if symmetric:
+                # -(1/rho) grad p = sum_j m_j (p_i/rho_i^2 + p_j/rho_j^2) F r_ij
+                cxl, cxh, czl, czh = block_of(cell[i], cells)
+                for zz in range(czl, czh + 1):
+                    row = zz * ncx
+                    for j in range(cell_start[row + cxl], cell_start[row + cxh + 1]):
+                        kj = kind[j]
+                        # without dry_walls, a wall particle with p < 0 (the air side of a
+                        # wetted wall, above the free surface) is left out like air: with it,
+                        # the surface corners of still water crept away from the wall
+                        # (docs/schemes.md)
+                        if j != i and 0 <= kj <= OUTLET and (kj != WALL or dry_walls
+                                                             or p[j] >= 0.0):
+                            dx = x[i] - x[j]
+                            dz = z[i] - z[j]
+                            r2 = dx * dx + dz * dz
+                            if r2 < s2:
+                                fij = f_of_q(math.sqrt(r2) * inv_h, af)
+                                pf = m[j] * (p[i] / (rho[i] * rho[i]) + p[j] / (rho[j] * rho[j]))
+                                fx += pf * fij * dx
+                                fz += pf * fij * dz
             # the pressure acceleration; with the predictor's, (u^{n+1} - u^n) / dt
             ax[i] = fx
             az[i] = fz

@@ -30,19 +30,18 @@ Measured (docs/wave_decay_study.md, "Kernel gradient correction"): experimental,
 three holds still water in this WCSPH (``all`` and ``surface`` lose particles through the bed;
 ``weighted`` grows particle noise, though it lowers the closed tank's decay 1.80 -> 0.68 %/m).
 
+M_i comes from the walk shared with the shifting laws and ISPH (renormalisation.py).
 Where M_i is near singular (a splash particle with a few neighbours in a line) L_i = I: there
 the correction would amplify noise, not fix a truncation.
 """
 
 from __future__ import annotations
 
-import math
-
 from numba import njit, prange
 
-from .kernels import f_of_q, w_of_q
-from .neighbours import block_of
+from .kernels import w_of_q
 from .particles import FLUID, OUTLET, WALL
+from .renormalisation import moments
 
 # scene constants.kernel_correction -> Params.kgc
 KERNEL_CORRECTIONS = {"off": 0, "all": 1, "surface": 2, "weighted": 3}
@@ -63,23 +62,11 @@ _FASTMATH = {"nsz", "arcp", "contract", "afn", "reassoc"}
 @njit(parallel=True, cache=True, fastmath=_FASTMATH)
 def correction_matrices(ps, n, cells, prm):
     """L_i (rows lxx, lxz, lzz) of every fluid and buffer particle; the identity elsewhere."""
-    x = ps.x
-    z = ps.z
-    rho = ps.rho
-    m = ps.m
     lxx = ps.lxx
     lxz = ps.lxz
     lzz = ps.lzz
     kind = ps.kind
-    cell = ps.cell
-    cell_start = cells.start
-    ncx = cells.ncx
-    h = prm.h
-    inv_h = 1.0 / h
-    s2 = 4.0 * h * h
-    af = prm.alpha_f
-    aw = prm.alpha_w
-    w0 = w_of_q(0.0, aw)
+    w0 = w_of_q(0.0, prm.alpha_w)
     surface = prm.kgc == KGC_SURFACE
     weighted = prm.kgc == KGC_WEIGHTED
     ramp = 1.0 / (SURFACE_GAMMA_OFF - SURFACE_GAMMA_FULL)
@@ -89,29 +76,12 @@ def correction_matrices(ps, n, cells, prm):
         cxz = 0.0
         czz = 1.0
         if ki >= FLUID and ki <= OUTLET and ki != WALL:   # WALL (1) lies inside that range
-            xi = x[i]
-            zi = z[i]
-            mxx = 0.0
-            mxz = 0.0
-            mzz = 0.0
-            gam = m[i] / rho[i] * w0
-            cxl, cxh, czl, czh = block_of(cell[i], cells)
-            for zz in range(czl, czh + 1):
-                row = zz * ncx
-                for j in range(cell_start[row + cxl], cell_start[row + cxh + 1]):
-                    kj = kind[j]
-                    if j != i and kj >= FLUID and kj <= OUTLET:   # fluid, wall, buffers
-                        rx = x[j] - xi
-                        rz = z[j] - zi
-                        r2 = rx * rx + rz * rz
-                        if r2 < s2:
-                            q = math.sqrt(r2) * inv_h
-                            vol = m[j] / rho[j]
-                            w = vol * f_of_q(q, af)
-                            mxx += w * rx * rx
-                            mxz += w * rx * rz
-                            mzz += w * rz * rz
-                            gam += vol * w_of_q(q, aw)
+            # M_i and the Shepard sum (the field sums of ``moments`` are not read: compiled away)
+            s = moments(i, ps, cells, prm, ps.p, ps.vx, ps.vz, True)
+            mxx = s.mxx
+            mxz = s.mxz
+            mzz = s.mzz
+            gam = ps.m[i] / ps.rho[i] * w0 + s.shepard
             det = mxx * mzz - mxz * mxz
             tr = mxx + mzz
             if tr > 0.0 and det > MIN_DET_RATIO * tr * tr:

@@ -41,13 +41,10 @@ walls is scaled by ``prm.alpha_wall`` as WCSPH's artificial viscosity against wa
 
 from __future__ import annotations
 
-import math
-
 from numba import njit, prange
 
-from .kernels import f_of_q
-from .neighbours import block_of
-from .particles import FLUID, OUTLET, WALL
+from .particles import FLUID, OUTLET
+from .renormalisation import moments, solve
 
 # scene [scheme] limiter -> Params.limiter (0: no reconstruction)
 LIMITERS = {"minmod": 1, "vanleer": 2}
@@ -85,14 +82,9 @@ def interface_state(ul, ur, pl, pr, zc, inv_c, eta, wall_factor):
 @njit(parallel=True, cache=True, fastmath=_FASTMATH)
 def riemann_gradients(ps, n, cells, prm):
     """Kernel-corrected gradients of p, vx, vz of every fluid and buffer particle (rows gpx..gwz;
-    zero elsewhere, and where the neighbour moment matrix is near singular: first order there)."""
-    x = ps.x
-    z = ps.z
-    vx = ps.vx
-    vz = ps.vz
-    rho = ps.rho
-    p = ps.p
-    m = ps.m
+    zero elsewhere, and where the neighbour moment matrix is near singular: first order there),
+    from the shared walk renormalisation.moments. (Wall particles, inside the kind range, get
+    gradients too; nothing reads them.)"""
     gpx = ps.gpx
     gpz = ps.gpz
     gux = ps.gux
@@ -100,13 +92,6 @@ def riemann_gradients(ps, n, cells, prm):
     gwx = ps.gwx
     gwz = ps.gwz
     kind = ps.kind
-    cell = ps.cell
-    cell_start = cells.start
-    ncx = cells.ncx
-    h = prm.h
-    inv_h = 1.0 / h
-    s2 = 4.0 * h * h
-    af = prm.alpha_f
     for i in prange(n):
         ki = kind[i]
         gpx[i] = 0.0
@@ -116,57 +101,15 @@ def riemann_gradients(ps, n, cells, prm):
         gwx[i] = 0.0
         gwz[i] = 0.0
         if ki >= FLUID and ki <= OUTLET:
-            xi = x[i]
-            zi = z[i]
-            pi = p[i]
-            ui = vx[i]
-            wi = vz[i]
-            # moment matrices: all neighbours (pressure), fluid and buffers (velocity)
-            axx = axz = azz = 0.0
-            bxx = bxz = bzz = 0.0
-            spx = spz = 0.0
-            sux = suz = swx = swz = 0.0
-            cxl, cxh, czl, czh = block_of(cell[i], cells)
-            for zz in range(czl, czh + 1):
-                row = zz * ncx
-                for j in range(cell_start[row + cxl], cell_start[row + cxh + 1]):
-                    kj = kind[j]
-                    if (j != i and kj >= FLUID and kj <= OUTLET) or kj == WALL:
-                        rx = x[j] - xi
-                        rz = z[j] - zi
-                        r2 = rx * rx + rz * rz
-                        if r2 < s2:
-                            w = m[j] / rho[j] * f_of_q(math.sqrt(r2) * inv_h, af)
-                            wx = w * rx
-                            wz = w * rz
-                            axx += wx * rx
-                            axz += wx * rz
-                            azz += wz * rz
-                            dp = p[j] - pi
-                            spx += dp * wx
-                            spz += dp * wz
-                            if kj != WALL:
-                                bxx += wx * rx
-                                bxz += wx * rz
-                                bzz += wz * rz
-                                du = vx[j] - ui
-                                dw = vz[j] - wi
-                                sux += du * wx
-                                suz += du * wz
-                                swx += dw * wx
-                                swz += dw * wz
+            # moment matrices: all neighbours M (pressure), fluid and buffers Mf (velocity)
+            s = moments(i, ps, cells, prm, ps.p, ps.vx, ps.vz, True)
             # invert where well conditioned: det relative to the isotropic (tr/2)^2 above 5 %
-            det = axx * azz - axz * axz
-            tr = axx + azz
+            det = s.mxx * s.mzz - s.mxz * s.mxz
+            tr = s.mxx + s.mzz
             if tr > 0.0 and det > 0.0125 * tr * tr:
-                inv = 1.0 / det
-                gpx[i] = (azz * spx - axz * spz) * inv
-                gpz[i] = (axx * spz - axz * spx) * inv
-            det = bxx * bzz - bxz * bxz
-            tr = bxx + bzz
+                gpx[i], gpz[i] = solve(s.mxx, s.mxz, s.mzz, det, s.phix, s.phiz)
+            det = s.mfxx * s.mfzz - s.mfxz * s.mfxz
+            tr = s.mfxx + s.mfzz
             if tr > 0.0 and det > 0.0125 * tr * tr:
-                inv = 1.0 / det
-                gux[i] = (bzz * sux - bxz * suz) * inv
-                guz[i] = (bxx * suz - bxz * sux) * inv
-                gwx[i] = (bzz * swx - bxz * swz) * inv
-                gwz[i] = (bxx * swz - bxz * swx) * inv
+                gux[i], guz[i] = solve(s.mfxx, s.mfxz, s.mfzz, det, s.ux, s.uz)
+                gwx[i], gwz[i] = solve(s.mfxx, s.mfxz, s.mfzz, det, s.wx, s.wz)

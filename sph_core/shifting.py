@@ -3,8 +3,9 @@
 ``shift_particles``: Fickian (Lind et al. 2012; Skillen et al. 2013). ``shift_particles_dplus``:
 delta-plus SPH (Sun, Colagrossi, Marrone, Zhang 2017) with the free-surface detection of Marrone
 et al. 2010 (its own docstring). Both carry rho and v of the shifted particle to first order
-unless ``prm.shift_carry`` is off. The renormalisation matrix B_i below is computed here, in the
-shifting pass (a kernel-gradient-correction pass computes the same matrix; share it when both run).
+unless ``prm.shift_carry`` is off. Both take B_i, grad C_i and the gradients from the one
+neighbour walk of renormalisation.py (``moments``: B_i there is M_i), shared with the kernel
+gradient correction and ISPH.
 
 Fickian: after each step every fluid particle i moves by
     dr_i = -D_i grad C_i,   D_i = A h |v_i| dt   (A = Constants.shift_a),
@@ -39,9 +40,66 @@ import math
 
 from numba import njit, prange
 
-from .kernels import f_of_q, w_of_q
 from .neighbours import block_of
-from .particles import FLUID, OUTLET, WALL
+from .particles import FLUID, OUTLET
+from .renormalisation import moments, smallest_eigenvalue, solve
+
+
+@njit(cache=True, inline="always")
+def _surface_normal(s, det):
+    """The renormalised outward normal n = -M^-1 g / |M^-1 g| of a particle with the sums ``s``
+    (renormalisation.Moments; Marrone et al. 2010, Sun et al. 2017), g itself where det M <=
+    1e-6; (0, 0) where it vanishes."""
+    if det > 1e-6:
+        lx, lz = solve(s.mxx, s.mxz, s.mzz, det, s.gx, s.gz)
+    else:
+        lx = s.gx
+        lz = s.gz
+    gn = math.sqrt(lx * lx + lz * lz)
+    if gn > 0.0:
+        return -lx / gn, -lz / gn
+    return 0.0, 0.0
+
+
+@njit(cache=True, inline="always")
+def _limited(sx, sz, tangential, nx, nz, max_shift):
+    """The shift (sx, sz), with its component along the normal n removed if ``tangential``,
+    capped at |dr| = max_shift."""
+    if tangential:
+        sn = sx * nx + sz * nz
+        sx -= sn * nx
+        sz -= sn * nz
+    ds = math.sqrt(sx * sx + sz * sz)
+    if ds > max_shift:
+        sx *= max_shift / ds
+        sz *= max_shift / ds
+    return sx, sz
+
+
+@njit(parallel=True, cache=True)
+def _move(ps, n):
+    """Apply the gathered shifts and carries (rows xn, zn and rhon, vxn, vzn) to every fluid
+    particle: a separate loop, so that no particle's sums saw a neighbour already moved."""
+    # rows as locals: ``ps.x[i] = ...`` inside a prange writes nothing (numba 0.68.1)
+    x = ps.x
+    z = ps.z
+    rho = ps.rho
+    vx = ps.vx
+    vz = ps.vz
+    xn = ps.xn
+    zn = ps.zn
+    rhon = ps.rhon
+    vxn = ps.vxn
+    vzn = ps.vzn
+    kind = ps.kind
+    for i in prange(n):
+        if kind[i] == FLUID:
+            x[i] += xn[i]
+            z[i] += zn[i]
+            rho[i] += rhon[i]
+            vx[i] += vxn[i]
+            vz[i] += vzn[i]
+
 
 @njit(parallel=True, cache=True)
 def shift_particles(ps, n, cells, prm, dt):
@@ -52,18 +110,11 @@ def shift_particles(ps, n, cells, prm, dt):
     vx = ps.vx
     vz = ps.vz
     rho = ps.rho
-    m = ps.m
     kind = ps.kind
-    cell = ps.cell
-    cell_start = cells.start
-    ncx = cells.ncx
     h = prm.h
-    alpha_f = prm.alpha_f
     coef = prm.shift_a
     fs_div = prm.shift_fs_div
     max_shift = 0.05 * h
-    s2 = 4.0 * h * h
-    inv_h = 1.0 / h
     sxr = ps.xn    # scratch rows (see the module docstring)
     szr = ps.zn
     srho = ps.rhon
@@ -77,86 +128,30 @@ def shift_particles(ps, n, cells, prm, dt):
         svz[i] = 0.0
         if kind[i] != FLUID:
             continue
-        xi = x[i]
-        zi = z[i]
-        gcx = 0.0
-        gcz = 0.0
-        bxx = bxz = bzz = 0.0
-        # velocity and density gradients (for the first-order carry of v and rho)
-        gux = guz = gwx = gwz = grx = grz = 0.0
-        cxl, cxh, czl, czh = block_of(cell[i], cells)
-        for zz in range(czl, czh + 1):
-            row = zz * ncx
-            for j in range(cell_start[row + cxl], cell_start[row + cxh + 1]):
-                kj = kind[j]
-                if j == i or kj < FLUID or kj > OUTLET:
-                    continue
-                dx = xi - x[j]
-                dz = zi - z[j]
-                r2 = dx * dx + dz * dz
-                if r2 >= s2:
-                    continue
-                fv = f_of_q(math.sqrt(r2) * inv_h, alpha_f) * m[j] / rho[j]
-                # grad_i W_ij = -F r_ij
-                gcx -= fv * dx
-                gcz -= fv * dz
-                bxx += fv * dx * dx
-                bxz += fv * dx * dz
-                bzz += fv * dz * dz
-                if kj != WALL:  # walls carry no flow field of their own
-                    du = vx[j] - vx[i]
-                    dw = vz[j] - vz[i]
-                    gux -= fv * du * dx
-                    guz -= fv * du * dz
-                    gwx -= fv * dw * dx
-                    gwz -= fv * dw * dz
-                dr = rho[j] - rho[i]
-                grx -= fv * dr * dx
-                grz -= fv * dr * dz
+        # B, grad C and the (unrenormalised) gradients of rho and v for the first-order carry
+        s = moments(i, ps, cells, prm, rho, vx, vz, True)
         dcoef = coef * h * math.sqrt(vx[i] * vx[i] + vz[i] * vz[i]) * dt
-        sx = -dcoef * gcx
-        sz = -dcoef * gcz
-        if bxx + bzz < fs_div:  # div r = trace B
-            # renormalised normal n = -B^-1 grad C / |.| (Marrone et al. 2010; Sun et al. 2017):
-            # grad C itself is parallel to the shift and cannot split it
-            det = bxx * bzz - bxz * bxz
-            if det > 1e-6:
-                lx = (bzz * gcx - bxz * gcz) / det
-                lz = (bxx * gcz - bxz * gcx) / det
-            else:
-                lx = gcx
-                lz = gcz
-            gn = math.sqrt(lx * lx + lz * lz)
-            if gn > 0.0:
-                nx = -lx / gn
-                nz = -lz / gn
-                sn = sx * nx + sz * nz
-                sx -= sn * nx
-                sz -= sn * nz
-        s = math.sqrt(sx * sx + sz * sz)
-        if s > max_shift:
-            sx *= max_shift / s
-            sz *= max_shift / s
+        sx = -dcoef * s.gx
+        sz = -dcoef * s.gz
+        nx = nz = 0.0
+        tangential = s.mxx + s.mzz < fs_div  # div r = trace B
+        if tangential:
+            # renormalised normal: grad C itself is parallel to the shift and cannot split it
+            nx, nz = _surface_normal(s, s.mxx * s.mzz - s.mxz * s.mxz)
+        sx, sz = _limited(sx, sz, tangential, nx, nz, max_shift)
         sxr[i] = sx
         szr[i] = sz
         # first-order carry of rho and v to the new position
         if prm.shift_carry:
-            srho[i] = sx * grx + sz * grz
-            svx[i] = sx * gux + sz * guz
-            svz[i] = sx * gwx + sz * gwz
-    for i in prange(n):
-        if kind[i] == FLUID:
-            x[i] += sxr[i]
-            z[i] += szr[i]
-            rho[i] += srho[i]
-            vx[i] += svx[i]
-            vz[i] += svz[i]
+            srho[i] = sx * s.phix + sz * s.phiz
+            svx[i] = sx * s.ux + sz * s.uz
+            svz[i] = sx * s.wx + sz * s.wz
+    _move(ps, n)
 
 
 # --- delta-plus shifting (Sun, Colagrossi, Marrone, Zhang 2017; Marrone et al. 2010) -----------
+# (its anti-clustering constants R, n: renormalisation.DPLUS_R, DPLUS_N, with the walk)
 
-DPLUS_R = 0.2            # anti-clustering term 1 + R (W_ij / W(dp))^n of Sun et al. 2017
-DPLUS_N = 4
 LAMBDA_ISOLATED = 0.2    # lambda_i (smallest eigenvalue of B_i) at or below: a splash / jet, no shift
 LAMBDA_INTERIOR = 0.75   # above: full support, not a surface candidate (Marrone et al. 2010)
 FS_INTERIOR = 0.0        # flags of pass 1 (stored in the scratch row ps.guz)
@@ -181,24 +176,19 @@ def shift_particles_dplus(ps, n, cells, prm, dt, umax):
     vx = ps.vx
     vz = ps.vz
     rho = ps.rho
-    m = ps.m
     kind = ps.kind
     cell = ps.cell
     cell_start = cells.start
     ncx = cells.ncx
     h = prm.h
-    alpha_f = prm.alpha_f
-    alpha_w = prm.alpha_w
-    inv_wdp = prm.shift_inv_wdp
     coef = prm.shift_a * h * umax * dt
     carry = prm.shift_carry
     max_shift = 0.05 * h
     s2 = 4.0 * h * h
-    inv_h = 1.0 / h
     scan2 = 2.0 * h * h       # |r_ji| < sqrt(2) h: the umbrella test, else the circle
     # scratch rows: dr (xn, zn), n (gpx, gpz), flag (guz), the gradients of rho (vxn, vzn),
     # of vx (rhon, gux), of vz (gwx, gwz); pass 2 overwrites dr and puts the carries in
-    # vxn (rho), vzn (vx), rhon (vz)
+    # _move's rows rhon (rho), vxn (vx), vzn (vz)
     sxr = ps.xn
     szr = ps.zn
     snx = ps.gpx
@@ -219,95 +209,52 @@ def shift_particles_dplus(ps, n, cells, prm, dt, umax):
         flag[i] = FS_INTERIOR
         grx[i] = grz[i] = gux[i] = guz[i] = gwx[i] = gwz[i] = 0.0
         if kind[i] == FLUID:
-            xi = x[i]
-            zi = z[i]
-            gcx = gcz = 0.0       # sum V grad W (the normal)
-            wcx = wcz = 0.0       # the same with the anti-clustering weight (the shift)
-            bxx = bxz = bzz = 0.0
-            ax_ = az_ = ux = uz = wx = wz = 0.0
-            cxl, cxh, czl, czh = block_of(cell[i], cells)
-            for zz in range(czl, czh + 1):
-                row = zz * ncx
-                for j in range(cell_start[row + cxl], cell_start[row + cxh + 1]):
-                    kj = kind[j]
-                    if j == i or kj < FLUID or kj > OUTLET:
-                        continue
-                    dx = xi - x[j]
-                    dz = zi - z[j]
-                    r2 = dx * dx + dz * dz
-                    if r2 >= s2:
-                        continue
-                    q = math.sqrt(r2) * inv_h
-                    fv = f_of_q(q, alpha_f) * m[j] / rho[j]
-                    wr = w_of_q(q, alpha_w) * inv_wdp
-                    wr2 = wr * wr
-                    wgt = 1.0 + DPLUS_R * wr2 * wr2
-                    gcx -= fv * dx            # grad_i W_ij = -F r_ij
-                    gcz -= fv * dz
-                    wcx -= wgt * fv * dx
-                    wcz -= wgt * fv * dz
-                    bxx += fv * dx * dx
-                    bxz += fv * dx * dz
-                    bzz += fv * dz * dz
-                    dr = rho[j] - rho[i]
-                    ax_ -= fv * dr * dx
-                    az_ -= fv * dr * dz
-                    if kj != WALL:  # walls carry no flow field of their own
-                        du = vx[j] - vx[i]
-                        dw = vz[j] - vz[i]
-                        ux -= fv * du * dx
-                        uz -= fv * du * dz
-                        wx -= fv * dw * dx
-                        wz -= fv * dw * dz
-            half_tr = 0.5 * (bxx + bzz)
-            hd = 0.5 * (bxx - bzz)
-            lam = half_tr - math.sqrt(hd * hd + bxz * bxz)
+            s = moments(i, ps, cells, prm, rho, vx, vz, True)
+            bxx = s.mxx
+            bxz = s.mxz
+            bzz = s.mzz
+            lam = smallest_eigenvalue(bxx, bxz, bzz)
             det = bxx * bzz - bxz * bxz
             if lam <= LAMBDA_ISOLATED or det <= 1e-6:
                 flag[i] = FS_ISOLATED
             else:
                 # renormalised gradients (first-order consistent up to the surface)
-                lx = (bzz * gcx - bxz * gcz) / det
-                lz = (bxx * gcz - bxz * gcx) / det
-                grx[i] = (bzz * ax_ - bxz * az_) / det
-                grz[i] = (bxx * az_ - bxz * ax_) / det
-                gux[i] = (bzz * ux - bxz * uz) / det
-                guz[i] = (bxx * uz - bxz * ux) / det
-                gwx[i] = (bzz * wx - bxz * wz) / det
-                gwz[i] = (bxx * wz - bxz * wx) / det
-                sxr[i] = -coef * wcx
-                szr[i] = -coef * wcz
-                gn = math.sqrt(lx * lx + lz * lz)
-                if gn > 0.0:
-                    nx = -lx / gn
-                    nz = -lz / gn
-                    snx[i] = nx
-                    snz[i] = nz
-                    if lam <= LAMBDA_INTERIOR:
-                        # scan: is any neighbour in the region around T = r_i + h n?
-                        tx = xi + h * nx
-                        tz = zi + h * nz
-                        occupied = False
-                        for zz in range(czl, czh + 1):
-                            row = zz * ncx
-                            for j in range(cell_start[row + cxl], cell_start[row + cxh + 1]):
-                                kj = kind[j]
-                                if occupied or j == i or kj < FLUID or kj > OUTLET:
-                                    continue
-                                dx = x[j] - xi
-                                dz = z[j] - zi
-                                r2 = dx * dx + dz * dz
-                                if r2 >= s2:
-                                    continue
-                                ex = x[j] - tx
-                                ez = z[j] - tz
-                                if r2 >= scan2:
-                                    occupied = ex * ex + ez * ez < h * h
-                                else:
-                                    occupied = (abs(ex * nx + ez * nz)
-                                                + abs(ez * nx - ex * nz)) < h
-                        if not occupied:
-                            flag[i] = FS_SURFACE
+                grx[i], grz[i] = solve(bxx, bxz, bzz, det, s.phix, s.phiz)
+                gux[i], guz[i] = solve(bxx, bxz, bzz, det, s.ux, s.uz)
+                gwx[i], gwz[i] = solve(bxx, bxz, bzz, det, s.wx, s.wz)
+                sxr[i] = -coef * s.acx
+                szr[i] = -coef * s.acz
+                nx, nz = _surface_normal(s, det)
+                snx[i] = nx
+                snz[i] = nz
+                if (nx != 0.0 or nz != 0.0) and lam <= LAMBDA_INTERIOR:
+                    # scan: is any neighbour in the region around T = r_i + h n?
+                    xi = x[i]
+                    zi = z[i]
+                    tx = xi + h * nx
+                    tz = zi + h * nz
+                    occupied = False
+                    cxl, cxh, czl, czh = block_of(cell[i], cells)
+                    for zz in range(czl, czh + 1):
+                        row = zz * ncx
+                        for j in range(cell_start[row + cxl], cell_start[row + cxh + 1]):
+                            kj = kind[j]
+                            if occupied or j == i or kj < FLUID or kj > OUTLET:
+                                continue
+                            dx = x[j] - xi
+                            dz = z[j] - zi
+                            r2 = dx * dx + dz * dz
+                            if r2 >= s2:
+                                continue
+                            ex = x[j] - tx
+                            ez = z[j] - tz
+                            if r2 >= scan2:
+                                occupied = ex * ex + ez * ez < h * h
+                            else:
+                                occupied = (abs(ex * nx + ez * nz)
+                                            + abs(ez * nx - ex * nz)) < h
+                    if not occupied:
+                        flag[i] = FS_SURFACE
     # pass 2: the surface and its vicinity (within 2h of a surface particle) shift tangentially
     for i in prange(n):
         if kind[i] == FLUID and flag[i] != FS_ISOLATED:
@@ -324,31 +271,16 @@ def shift_particles_dplus(ps, n, cells, prm, dt, umax):
                         dx = xi - x[j]
                         dz = zi - z[j]
                         near = dx * dx + dz * dz < s2
-            sx = sxr[i]
-            sz = szr[i]
-            if near:
-                sn = sx * snx[i] + sz * snz[i]
-                sx -= sn * snx[i]
-                sz -= sn * snz[i]
-            s = math.sqrt(sx * sx + sz * sz)
-            if s > max_shift:
-                sx *= max_shift / s
-                sz *= max_shift / s
+            sx, sz = _limited(sxr[i], szr[i], near, snx[i], snz[i], max_shift)
             sxr[i] = sx
             szr[i] = sz
+            crho = cu = cw = 0.0
             if carry:
                 crho = sx * grx[i] + sz * grz[i]
                 cu = sx * gux[i] + sz * guz[i]
                 cw = sx * gwx[i] + sz * gwz[i]
-            else:
-                crho = cu = cw = 0.0
-            grx[i] = crho
-            grz[i] = cu
-            gux[i] = cw
-    for i in prange(n):
-        if kind[i] == FLUID and flag[i] != FS_ISOLATED:
-            x[i] += sxr[i]
-            z[i] += szr[i]
-            rho[i] += grx[i]
-            vx[i] += grz[i]
-            vz[i] += gux[i]
+            # the carries in _move's rows rhon, vxn, vzn (this particle's gradients are read)
+            gux[i] = crho
+            grx[i] = cu
+            grz[i] = cw
+    _move(ps, n)

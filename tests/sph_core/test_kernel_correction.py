@@ -8,13 +8,13 @@ import math
 
 import numpy as np
 import pytest
+from cell_sorted import sort_into_cells
 
 from sph_core.kernel_correction import (KGC_ALL, KGC_OFF, KGC_SURFACE, KGC_WEIGHTED,
                                         correction_matrices)
 from sph_core.kernels import f_of_q, wendland_alpha
-from sph_core.neighbours import CellGrid
 from sph_core.particles import FLUID, M, N_FIELDS, P, RHO, WALL, X, Z
-from sph_core.state import Cells, Params, particles_view
+from sph_core.state import Params, particles_view
 from sph_core.wcsph import fluid_pass
 
 RHO0, C0 = 1000.0, 20.0
@@ -39,15 +39,8 @@ def _block(kgc: int, walls: bool = True, jitter: float = 0.15, seed: int = 3, nx
     f[Z] = np.array(zs) + np.where(kind == FLUID, rng.uniform(-jitter, jitter, n) * DP, 0.0)
     f[RHO] = RHO0 * (1.0 + rng.uniform(-0.01, 0.01, n))
     f[M] = RHO0 * DP * DP
-    grid = CellGrid.covering(-3 * H, nx * DP + 3 * H, -6 * DP - 3 * H, nz * DP + 3 * H, 2.0 * H,
-                             reach=2)
-    cell = ((np.floor((f[Z] - grid.zmin) / grid.cs).astype(np.int64)) * grid.ncx
-            + np.floor((f[X] - grid.xmin) / grid.cs).astype(np.int64))
-    order = np.argsort(cell, kind="stable")
-    f, kind, cell = f[:, order].copy(), kind[order].copy(), cell[order].copy()
-    start = np.searchsorted(cell, np.arange(grid.ncell + 2)).astype(np.int64)
-    cells = Cells(start, np.zeros(grid.ncell + 1, dtype=np.int64), np.zeros(n, dtype=np.int64),
-                  grid.ncx, grid.ncz, grid.xmin, grid.zmin, 1.0 / grid.cs, grid.reach)
+    f, kind, cell, cells, _ = sort_into_cells(f, kind, H, (-3 * H, nx * DP + 3 * H,
+                                                           -6 * DP - 3 * H, nz * DP + 3 * H))
     aw = wendland_alpha(H)
     prm = Params(h=H, alpha_w=aw, alpha_f=5.0 * aw / (H * H), rho0=RHO0, c0=C0,
                  b=C0 * C0 * RHO0 / 7.0, gamma=7.0, gx=0.0, gz=-9.81, alpha=0.0, nu=0.0,

@@ -5,12 +5,12 @@ field exactly on a disordered particle set, and so MUSCL removes the pressure ju
 
 import numpy as np
 import pytest
+from cell_sorted import sort_into_cells
 
 from sph_core.kernels import wendland_alpha
-from sph_core.neighbours import CellGrid
 from sph_core.particles import FLUID, M, N_FIELDS, P, RHO, VX, VZ, WALL, X, Z
 from sph_core.riemann import MINMOD, NO_RECONSTRUCTION, VANLEER, interface_state, limited, riemann_gradients
-from sph_core.state import Cells, Params, particles_view
+from sph_core.state import Params, particles_view
 from sph_core.wcsph import fluid_pass
 
 RHO0, C0 = 1000.0, 20.0
@@ -72,15 +72,8 @@ def _disordered_block(linear_v: bool, limiter: int, seed: int = 3):
     grad_u = np.array([[0.3, -0.2], [0.1, -0.3]]) if linear_v else np.zeros((2, 2))
     f[VX] = np.where(kind == FLUID, grad_u[0, 0] * f[X] + grad_u[0, 1] * f[Z], 0.0)
     f[VZ] = np.where(kind == FLUID, grad_u[1, 0] * f[X] + grad_u[1, 1] * f[Z], 0.0)
-    grid = CellGrid.covering(-3 * h, 14 * dp + 3 * h, -6 * dp - 3 * h, 10 * dp + 3 * h, 2.0 * h,
-                             reach=2)
-    cell = ((np.floor((f[Z] - grid.zmin) / grid.cs).astype(np.int64)) * grid.ncx
-            + np.floor((f[X] - grid.xmin) / grid.cs).astype(np.int64))
-    order = np.argsort(cell, kind="stable")
-    f, kind, cell = f[:, order].copy(), kind[order].copy(), cell[order].copy()
-    start = np.searchsorted(cell, np.arange(grid.ncell + 2)).astype(np.int64)
-    cells = Cells(start, np.zeros(grid.ncell + 1, dtype=np.int64), np.zeros(n, dtype=np.int64),
-                  grid.ncx, grid.ncz, grid.xmin, grid.zmin, 1.0 / grid.cs, grid.reach)
+    f, kind, cell, cells, _ = sort_into_cells(f, kind, h, (-3 * h, 14 * dp + 3 * h,
+                                                           -6 * dp - 3 * h, 10 * dp + 3 * h))
     aw = wendland_alpha(h)
     prm = Params(h=h, alpha_w=aw, alpha_f=5.0 * aw / (h * h), rho0=RHO0, c0=C0,
                  b=C0 * C0 * RHO0 / 7.0, gamma=7.0, gx=0.0, gz=-9.81, alpha=0.01, nu=0.0,

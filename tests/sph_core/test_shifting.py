@@ -8,14 +8,14 @@ import math
 
 import numpy as np
 import pytest
+from cell_sorted import sort_into_cells
 
 from sph_core.kernels import w_of_q, wendland_alpha
-from sph_core.neighbours import CellGrid
 from sph_core.particles import FLUID, GUZ, M, N_FIELDS, RHO, VX, VZ, WALL, X, Z
 from sph_core.scene import make_scene
 from sph_core.shifting import FS_SURFACE, shift_particles, shift_particles_dplus
 from sph_core.simulation import Simulation
-from sph_core.state import Cells, Params, particles_view
+from sph_core.state import Params, particles_view
 
 
 def _lattice_run(nx: int, nz: int, dp: float, h: float, moved: tuple[int, float, float],
@@ -44,16 +44,8 @@ def _lattice_run(nx: int, nz: int, dp: float, h: float, moved: tuple[int, float,
     f[X, k] += ddx
     f[Z, k] += ddz
     kind = np.array(kinds, dtype=np.int8)
-    # cells of side h (reach 2), as the simulation's
-    grid = CellGrid.covering(-3 * h, nx * dp + 3 * h, -6 * dp - 3 * h, nz * dp + 3 * h, 2.0 * h,
-                             reach=2)
-    cell = ((np.floor((f[Z] - grid.zmin) / grid.cs).astype(np.int64)) * grid.ncx
-            + np.floor((f[X] - grid.xmin) / grid.cs).astype(np.int64))
-    order = np.argsort(cell, kind="stable")
-    f, kind, cell = f[:, order].copy(), kind[order].copy(), cell[order].copy()
-    start = np.searchsorted(cell, np.arange(grid.ncell + 2)).astype(np.int64)
-    cells = Cells(start, np.zeros(grid.ncell + 1, dtype=np.int64), np.zeros(n, dtype=np.int64),
-                  grid.ncx, grid.ncz, grid.xmin, grid.zmin, 1.0 / grid.cs, grid.reach)
+    f, kind, cell, cells, order = sort_into_cells(f, kind, h, (-3 * h, nx * dp + 3 * h,
+                                                               -6 * dp - 3 * h, nz * dp + 3 * h))
     aw = wendland_alpha(h)
     prm = Params(h=h, alpha_w=aw, alpha_f=5.0 * aw / (h * h), rho0=1000.0, c0=10.0, b=1.0,
                  gamma=7.0, gx=0.0, gz=-9.81, alpha=0.01, nu=1e-6, delta=0.1, cfl=0.25,

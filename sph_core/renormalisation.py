@@ -1,0 +1,159 @@
+"""The renormalisation matrix and the first-order neighbour sums built with it: ONE neighbour
+walk (``moments``) that the kernel gradient correction (kernel_correction.py), both shifting
+laws (shifting.py), ISPH's corrected pressure gradient (isph.py) and Riemann SPH's MUSCL
+gradients (riemann.py) share.
+
+For particle i and its neighbours j (fluid, wall, active buffer; j != i), r_ji = r_j - r_i,
+V_j = m_j / rho_j, grad_i W_ij = F_ij r_ji (kernels.py):
+
+    M_i     = sum_j V_j F_ij r_ji (x) r_ji         the renormalisation matrix (symmetric 2x2;
+                                                 the B_i of Marrone et al. 2010, Sun et al. 2017)
+    g_i     = sum_j V_j grad_i W_ij              (grad C of the shifting laws)
+    a_i     = sum_j (1 + R (W_ij / W(dp))^4) V_j grad_i W_ij   (delta-plus anti-clustering, R 0.2)
+    s_i     = sum_j V_j W_ij                     (Shepard sum without the self term)
+    d_i[phi] = sum_j V_j (phi_j - phi_i) grad_i W_ij   for phi: the row ``phi`` over every
+               neighbour, the rows ``u``, ``w`` over fluid and buffer neighbours only (walls carry
+               no flow field of their own)
+    Mf_i    = M_i over fluid and buffer neighbours only (renormalises d_i[u], d_i[w] in Riemann
+              SPH's MUSCL gradients; the shifting laws take M_i for them)
+
+L_i = M_i^-1 makes L_i d_i[phi] exact for a linear phi wherever M_i is invertible (Bonet & Lok
+1999). lambda_i, the smallest eigenvalue of M_i, is Marrone et al.'s free-surface indicator
+(2 in 2D with a full support; ~1 at the surface; ~0 for a splash).
+
+Why one walk function and not one stored pass: no two callers evaluate M at the same state. The
+kernel correction (and Riemann SPH's MUSCL gradients) take it in the force pass (before the kick changes rho), the shifting after
+the kick (kdk) or after the corrector (symplectic_pc: other positions), ISPH at r^n with the
+solved pressure (its wall filter below) and its shifting at r^{n+1}. A pass storing M for
+another caller would add a neighbour walk per use (shifting's one walk costs ~0.5x a step), so
+every caller inlines ``moments`` into its own pass and what it does not read is compiled away
+(inline="always", then LLVM's dead-code elimination).
+
+Each caller keeps its own test of a near-singular M_i (they were tuned separately; unifying
+them would change results): the kernel correction and Riemann SPH det M > 0.0125 (tr M)^2, the shifting laws
+det M > 1e-6 (delta-plus also lambda > 0.2), ISPH det M > 0.01.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import NamedTuple
+
+from numba import njit
+
+from .kernels import f_of_q, w_of_q
+from .neighbours import block_of
+from .particles import FLUID, OUTLET, WALL
+
+DPLUS_R = 0.2     # anti-clustering term 1 + R (W_ij / W(dp))^n of Sun et al. 2017
+DPLUS_N = 4       # (the exponent is written out as wr2 * wr2 in ``moments``)
+
+
+class Moments(NamedTuple):
+    """The sums of ``moments`` for one particle (module docstring)."""
+
+    mxx: float    # M
+    mxz: float
+    mzz: float
+    gx: float     # g = sum V grad W
+    gz: float
+    acx: float    # a = the same with the delta-plus anti-clustering weight
+    acz: float
+    shepard: float  # sum V W over the neighbours (no self term)
+    phix: float   # d[phi] (every neighbour)
+    phiz: float
+    ux: float     # d[u] (fluid and buffer neighbours)
+    uz: float
+    wx: float     # d[w]
+    wz: float
+    mfxx: float   # Mf (fluid and buffer neighbours)
+    mfxz: float
+    mfzz: float
+
+
+@njit(cache=True, inline="always")
+def moments(i, ps, cells, prm, phi, u, w, suction_walls):
+    """The neighbour sums of particle i (module docstring), over fluid, wall and active buffer
+    neighbours within 2h; ``suction_walls`` False leaves out a wall neighbour with p < 0 (ISPH:
+    the air side of a wetted wall). ``phi``, ``u``, ``w`` are particle rows (any, when unused)."""
+    x = ps.x
+    z = ps.z
+    m = ps.m
+    rho = ps.rho
+    p = ps.p
+    kind = ps.kind
+    cell_start = cells.start
+    ncx = cells.ncx
+    inv_h = 1.0 / prm.h
+    s2 = 4.0 * prm.h * prm.h
+    af = prm.alpha_f
+    aw = prm.alpha_w
+    inv_wdp = prm.shift_inv_wdp
+    xi = x[i]
+    zi = z[i]
+    phii = phi[i]
+    ui = u[i]
+    wi = w[i]
+    mxx = mxz = mzz = 0.0
+    gx = gz = acx = acz = shep = 0.0
+    px = pz = ux = uz = wx = wz = 0.0
+    mfxx = mfxz = mfzz = 0.0
+    cxl, cxh, czl, czh = block_of(ps.cell[i], cells)
+    for zz in range(czl, czh + 1):
+        row = zz * ncx
+        for j in range(cell_start[row + cxl], cell_start[row + cxh + 1]):
+            kj = kind[j]
+            if j == i or kj < FLUID or kj > OUTLET:
+                continue
+            if kj == WALL and not suction_walls and p[j] < 0.0:
+                continue
+            rx = x[j] - xi
+            rz = z[j] - zi
+            r2 = rx * rx + rz * rz
+            if r2 >= s2:
+                continue
+            q = math.sqrt(r2) * inv_h
+            vol = m[j] / rho[j]
+            fv = vol * f_of_q(q, af)
+            fx = fv * rx                 # V_j grad_i W_ij
+            fz = fv * rz
+            mxx += fx * rx
+            mxz += fx * rz
+            mzz += fz * rz
+            gx += fx
+            gz += fz
+            wk = w_of_q(q, aw)
+            shep += vol * wk
+            wr = wk * inv_wdp
+            wr2 = wr * wr
+            wgt = 1.0 + DPLUS_R * wr2 * wr2
+            acx += wgt * fx
+            acz += wgt * fz
+            d = phi[j] - phii
+            px += d * fx
+            pz += d * fz
+            if kj != WALL:
+                mfxx += fx * rx
+                mfxz += fx * rz
+                mfzz += fz * rz
+                du = u[j] - ui
+                dw = w[j] - wi
+                ux += du * fx
+                uz += du * fz
+                wx += dw * fx
+                wz += dw * fz
+    return Moments(mxx, mxz, mzz, gx, gz, acx, acz, shep, px, pz, ux, uz, wx, wz, mfxx, mfxz,
+                   mfzz)
+
+
+@njit(cache=True, inline="always")
+def smallest_eigenvalue(mxx, mxz, mzz):
+    """lambda_min of the symmetric 2x2 matrix [[mxx, mxz], [mxz, mzz]]."""
+    hd = 0.5 * (mxx - mzz)
+    return 0.5 * (mxx + mzz) - math.sqrt(hd * hd + mxz * mxz)
+
+
+@njit(cache=True, inline="always")
+def solve(mxx, mxz, mzz, det, bx, bz):
+    """M^-1 b for the symmetric M with determinant ``det`` (the caller has checked it)."""
+    return (mzz * bx - mxz * bz) / det, (mxx * bz - mxz * bx) / det
