@@ -19,19 +19,21 @@ V_j = m_j / rho_j, grad_i W_ij = F_ij r_ji (kernels.py):
 
 L_i = M_i^-1 makes L_i d_i[phi] exact for a linear phi wherever M_i is invertible (Bonet & Lok
 1999). lambda_i, the smallest eigenvalue of M_i, is Marrone et al.'s free-surface indicator
-(2 in 2D with a full support; ~1 at the surface; ~0 for a splash).
+(~1 with a full support, where M ~ I; ~0.5 in the top row of a flat surface at h/dp 2; ~0 for
+a splash).
 
 Why one walk function and not one stored pass: no two callers evaluate M at the same state. The
-kernel correction (and Riemann SPH's MUSCL gradients) take it in the force pass (before the kick changes rho), the shifting after
-the kick (kdk) or after the corrector (symplectic_pc: other positions), ISPH at r^n with the
-solved pressure (its wall filter below) and its shifting at r^{n+1}. A pass storing M for
-another caller would add a neighbour walk per use (shifting's one walk costs ~0.5x a step), so
-every caller inlines ``moments`` into its own pass and what it does not read is compiled away
-(inline="always", then LLVM's dead-code elimination).
+kernel correction (and Riemann SPH's MUSCL gradients) take it in the force pass, before the kick
+changes rho; the shifting after the kick (kdk) or after the corrector (symplectic_pc: other
+positions); ISPH at r^n with the solved pressure (its wall filter below), its shifting at r^{n+1}.
+A pass storing M for another caller would add a neighbour walk per use (shifting's one walk
+costs ~0.5x a step), so every caller inlines ``moments`` into its own pass, and what it does not
+read is compiled away (inline="always", then LLVM's dead-code elimination: the kernel
+correction, which reads M and the Shepard sum only, costs no more than before).
 
 Each caller keeps its own test of a near-singular M_i (they were tuned separately; unifying
-them would change results): the kernel correction and Riemann SPH det M > 0.0125 (tr M)^2, the shifting laws
-det M > 1e-6 (delta-plus also lambda > 0.2), ISPH det M > 0.01.
+them would change results): the kernel correction and Riemann SPH det M > 0.0125 (tr M)^2, the
+shifting laws det M > 1e-6 (delta-plus also lambda > 0.2), ISPH det M > 0.01.
 """
 
 from __future__ import annotations

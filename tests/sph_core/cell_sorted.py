@@ -10,7 +10,8 @@ from sph_core.particles import X, Z
 from sph_core.state import Cells
 
 
-def sort_into_cells(f: np.ndarray, kind: np.ndarray, h: float, box: tuple[float, float, float, float]):
+def sort_into_cells(f: np.ndarray, kind: np.ndarray, h: float,
+                    box: tuple[float, float, float, float]):
     """Sort the rows f[:, k] and kinds k by cell of a grid of side h (reach 2, as the simulation's)
     covering box = (x0, x1, z0, z1); returns (f, kind, cell, cells, order): the sorted copies, the
     cell of each slot, the Cells, and order (slot s holds the input's particle order[s])."""
