@@ -145,6 +145,8 @@ def wall_state(ps, n, cells, prm, dt, stop, wsum, dwall):
     ax = ps.ax
     az = ps.az
     rho = ps.rho
+    # a local binding: numba 0.68 drops prange stores made through ps.p[i]
+    p = ps.p
     vwx = ps.vwx
     vwz = ps.vwz
     kind = ps.kind
@@ -181,7 +183,7 @@ def wall_state(ps, n, cells, prm, dt, stop, wsum, dwall):
                             sw += w
                             sd += rho[j] * (bx * dx + bz * dz) * w
                             if kj != FLUID:  # an open end's buffer: its pressure is known
-                                sd += ps.p[j] * w
+                                sd += p[j] * w
                             svx += vx[j] * w
                             svz += vz[j] * w
                             nx -= dx * w
@@ -213,7 +215,7 @@ def wall_state(ps, n, cells, prm, dt, stop, wsum, dwall):
                 vwx[i] = 2.0 * vx[i] - svx / sw
                 vwz[i] = 2.0 * vz[i] - svz / sw
             else:
-                ps.p[i] = 0.0
+                p[i] = 0.0
                 vwx[i] = vx[i]
                 vwz[i] = vz[i]
 

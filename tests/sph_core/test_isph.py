@@ -16,6 +16,7 @@ import scipy.sparse as sp
 
 from cases.dambreak import dambreak_scene, front_errors, martin_moyce_table
 from sph_core import isph
+from sph_core.particles import P, WALL, Z
 from sph_core.scene import SceneError, make_scene
 from sph_core.simulation import Simulation
 
@@ -49,6 +50,21 @@ def assembled_ppe(res: int = 10):
                       st.indices, st.data, st.b, st.x0, st.slot, st.rho_k, st.rho_ref, 0.0)
     isph.compact_rows(m, st.indptr, st.indices, st.data, st.ptr)
     return st, sim, m, sim.particles.f[1, st.slot[:m]].copy()
+
+
+def test_wall_particles_without_fluid_neighbours_get_zero_pressure():
+    """The tank's walls above the water have no fluid neighbour: wall_state must reset their
+    pressure (it kept a stale value: numba dropped the prange store made through ps.p[i]), so
+    probes and loads on dry walls read 0."""
+    sim = Simulation(still_scene(10, 1.0))
+    st, ps, prm, dt = sim.stepper, sim.particles.view, sim.prm, sim.dt
+    parts, n = sim.particles, sim.particles.n
+    dry = (parts.kind[:n] == WALL) & (parts.field(Z)[:n] > D + 3 * prm.h)
+    assert dry.sum() > 10
+    parts.field(P)[:n][dry] = 1234.0
+    isph.wall_state(ps, n, sim.cells, prm, dt, st.wall_stop, st.wsum, st.dwall)
+    assert np.all(st.wsum[:n][dry] == 0.0)
+    assert np.all(parts.field(P)[:n][dry] == 0.0)
 
 
 @pytest.mark.parametrize("solver", isph.PPE_SOLVERS)
