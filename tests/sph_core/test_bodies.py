@@ -322,6 +322,7 @@ def _isph(scene_dict: dict):
     return make_scene(d)
 
 
+@pytest.mark.slow   # 38 s for a known, measured failure: kept out of the default run's budget
 @pytest.mark.xfail(strict=True, reason=(
     "ISPH: the fixed box's heave load after the first step is 0.907 x rho0 g B d (0.89-0.90 "
     "over 0.5 s): p = 0 sits on the surface particles' centres, dp/2 below the surface, a "
