@@ -17,6 +17,8 @@ momentum:
 walls (Adami, Hu & Adams 2012, eq. 22 of seed 004), from fluid neighbours f of wall particle s:
     p_s = max(0, [sum_f p_f W_sf + (g - a_s) . sum_f rho_f r_sf W_sf] / sum_f W_sf),  rho_s = EOS^-1(p_s),
     no-slip: v_s(viscous) = 2 v_s - sum_f v_f W_sf / sum_f W_sf;  no fluid neighbour: p_s = 0.
+    A fluid particle within dp/4 of a wall face loses its velocity towards the wall (the
+    no-penetration correction of wall_contact.py: dvnx, dvnz from fluid_pass, added by the kick).
 time step (Monaghan 1989; DualSPHysics):
     dt = min(CFL h / (c_max + |v|_max), CFL sqrt(h / |a|_max), 0.125 h^2 / nu).
 
@@ -140,7 +142,8 @@ def fluid_pass(ps, n, cells, prm):
 
     With ``prm.riemann`` the pair's continuity, delta-SPH, pressure and artificial viscosity are
     the Riemann SPH flux instead (riemann.py; MUSCL gradients from riemann_gradients).
-    Writes ax, az, drho of each fluid particle; returns nothing (reductions are in the kicks)."""
+    Writes ax, az, drho and the no-penetration velocity change dvnx, dvnz (wall_contact.py) of
+    each fluid particle; returns nothing (reductions are in the kicks)."""
     x = ps.x
     z = ps.z
     vx = ps.vx
