@@ -36,13 +36,16 @@ GPX, GPZ, GUX, GUZ, GWX, GWZ = range(17, 23)
 # kernel gradient correction (kernel_correction.py): the symmetric 2x2 matrix L of every fluid
 # and buffer particle (identity elsewhere), recomputed before every force pass
 LXX, LXZ, LZZ = range(23, 26)
-N_FIELDS = 26
+# no-penetration velocity correction of fluid particles at a wall face (wall_contact.py),
+# recomputed in every force pass and added by the kick / corrector
+DVNX, DVNZ = range(26, 28)
+N_FIELDS = 28
 N_SORTED_KDK = 9
 N_SORTED_PC = 14
 
 FIELD_NAMES = ("x", "z", "vx", "vz", "ax", "az", "rho", "p", "m",
                "xn", "zn", "vxn", "vzn", "rhon", "drho", "vwx", "vwz",
-               "gpx", "gpz", "gux", "guz", "gwx", "gwz", "lxx", "lxz", "lzz")
+               "gpx", "gpz", "gux", "guz", "gwx", "gwz", "lxx", "lxz", "lzz", "dvnx", "dvnz")
 
 
 @dataclass

@@ -44,6 +44,7 @@ from .probes import (fluid_neighbour_counts, interpolate_points, line_mass_densi
                      surface_from_line)
 from .scene import ElevationProbe, FrontProbe, PointProbe, Scene, Scheme
 from .state import Params
+from .wall_contact import face_shares
 
 STEPS_PER_CALL = 200  # steps per jitted call between progress callbacks
 # cells per kernel support radius 2h (neighbours.py): 2 = cells of side h, a 5 x 5 search block
@@ -150,6 +151,11 @@ class Simulation:
                           shift_dplus=dplus, shift_carry=c.shift_carry and not self.isph,
                           shift_inv_wdp=1.0 / w_of_q(dp / h, aw),
                           kgc=KERNEL_CORRECTIONS[c.kernel_correction],
+                          # no penetration at wall faces (WCSPH and Riemann; ISPH has its own
+                          # no-penetration pressure, isph_wall_stop)
+                          **dict(zip(("wall_ga", "wall_g0", "wall_gb"),
+                                     (0.0, 0.0, 0.0) if self.isph
+                                     else face_shares(h, dp, layout.n_layers, aw))),
                           **scheme_params(scene.scheme))
         self.integrator = wcsph.INTEGRATORS[c.integrator]
         self.passes_per_step = wcsph.PASSES_PER_STEP[c.integrator]

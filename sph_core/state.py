@@ -19,8 +19,8 @@ from typing import NamedTuple
 import numpy as np
 
 from .absorption import N_FILTER
-from .particles import (AX, AZ, DRHO, GPX, GPZ, GUX, GUZ, GWX, GWZ, LXX, LXZ, LZZ, M, P, RHO,
-                        RHON, VWX, VWZ, VX, VXN, VZ, VZN, XN, ZN, X, Z)
+from .particles import (AX, AZ, DRHO, DVNX, DVNZ, GPX, GPZ, GUX, GUZ, GWX, GWZ, LXX, LXZ, LZZ,
+                        M, P, RHO, RHON, VWX, VWZ, VX, VXN, VZ, VZN, XN, ZN, X, Z)
 
 
 class Particles(NamedTuple):
@@ -57,6 +57,8 @@ class Particles(NamedTuple):
     lxx: np.ndarray      # kernel gradient correction L (kernel_correction.py): symmetric 2x2
     lxz: np.ndarray
     lzz: np.ndarray
+    dvnx: np.ndarray     # fluid: no-penetration velocity correction at a wall face (wall_contact.py)
+    dvnz: np.ndarray
     kind: np.ndarray     # int8: particles.FLUID, WALL, INLET, ...
     ids: np.ndarray      # int64 identity, kept through sorts
     cell: np.ndarray     # int64 cell index of the slot (set by the sort)
@@ -66,7 +68,7 @@ def particles_view(f: np.ndarray, kind: np.ndarray, ids: np.ndarray, cell: np.nd
     """Named views of the storage ``f`` (no copy)."""
     return Particles(f, f[X], f[Z], f[VX], f[VZ], f[AX], f[AZ], f[RHO], f[P], f[M], f[XN], f[ZN],
                      f[VXN], f[VZN], f[RHON], f[DRHO], f[VWX], f[VWZ], f[GPX], f[GPZ], f[GUX], f[GUZ],
-                     f[GWX], f[GWZ], f[LXX], f[LXZ], f[LZZ], kind, ids, cell)
+                     f[GWX], f[GWZ], f[LXX], f[LXZ], f[LZZ], f[DVNX], f[DVNZ], kind, ids, cell)
 
 
 class Cells(NamedTuple):
@@ -124,6 +126,12 @@ class Params(NamedTuple):
     shift_dplus: bool = False
     shift_carry: bool = True
     shift_inv_wdp: float = 0.0
+    # no-penetration correction at wall faces (wall_contact.py): the wall's kernel share
+    # sum_s V_s W_is of a fluid particle dp/4 in front of a flat wall face, at it, dp/4 behind
+    # it (wall_g0 = 0: off)
+    wall_ga: float = 0.0
+    wall_g0: float = 0.0
+    wall_gb: float = 0.0
 
 
 class OpenEnds(NamedTuple):

@@ -17,6 +17,8 @@ momentum:
 walls (Adami, Hu & Adams 2012, eq. 22 of seed 004), from fluid neighbours f of wall particle s:
     p_s = max(0, [sum_f p_f W_sf + (g - a_s) . sum_f rho_f r_sf W_sf] / sum_f W_sf),  rho_s = EOS^-1(p_s),
     no-slip: v_s(viscous) = 2 v_s - sum_f v_f W_sf / sum_f W_sf;  no fluid neighbour: p_s = 0.
+    A fluid particle within dp/4 of a wall face loses its velocity towards the wall (the
+    no-penetration correction of wall_contact.py: dvnx, dvnz from fluid_pass, added by the kick).
 time step (Monaghan 1989; DualSPHysics):
     dt = min(CFL h / (c_max + |v|_max), CFL sqrt(h / |a|_max), 0.125 h^2 / nu).
 
@@ -41,6 +43,7 @@ from .kernels import f_of_q, w_of_q
 from .neighbours import block_of
 from .particles import FLUID, INLET, OUTLET, WALL
 from .riemann import NO_RECONSTRUCTION, interface_state, limited
+from .wall_contact import no_penetration
 
 # status codes returned by the time loop (step.run)
 ST_REACHED_T = 0
@@ -139,7 +142,8 @@ def fluid_pass(ps, n, cells, prm):
 
     With ``prm.riemann`` the pair's continuity, delta-SPH, pressure and artificial viscosity are
     the Riemann SPH flux instead (riemann.py; MUSCL gradients from riemann_gradients).
-    Writes ax, az, drho of each fluid particle; returns nothing (reductions are in the kicks)."""
+    Writes ax, az, drho and the no-penetration velocity change dvnx, dvnz (wall_contact.py) of
+    each fluid particle; returns nothing (reductions are in the kicks)."""
     x = ps.x
     z = ps.z
     vx = ps.vx
@@ -195,6 +199,15 @@ def fluid_pass(ps, n, cells, prm):
     lxx = ps.lxx
     lxz = ps.lxz
     lzz = ps.lzz
+    # no penetration at wall faces (wall_contact.py): g0 = 0 turns it off
+    ga = prm.wall_ga
+    g0 = prm.wall_g0
+    gb = prm.wall_gb
+    nopen = g0 > 0.0
+    aw = prm.alpha_w
+    inv_rho0 = 1.0 / rho0
+    dvnx = ps.dvnx
+    dvnz = ps.dvnz
     for i in prange(n):
         if kind[i] == FLUID:
             xi = x[i]
@@ -213,6 +226,11 @@ def fluid_pass(ps, n, cells, prm):
             fz = 0.0
             cont = 0.0
             diff = 0.0
+            gw = 0.0     # wall share, normal and velocity sums (wall_contact.py)
+            gnx = 0.0
+            gnz = 0.0
+            gvx = 0.0
+            gvz = 0.0
             cxl, cxh, czl, czh = block_of(cell[i], cells)
             for zz in range(czl, czh + 1):
                 row = zz * ncx
@@ -278,6 +296,14 @@ def fluid_pass(ps, n, cells, prm):
                     if kj == WALL:
                         dvx = vxi - vwx[j]
                         dvz = vzi - vwz[j]
+                        if nopen:
+                            vg = mj * inv_rho0
+                            wg = vg * w_of_q(math.sqrt(r2) * inv_h, aw)
+                            gw += wg
+                            gnx += vg * fij * dx
+                            gnz += vg * fij * dz
+                            gvx += wg * vx[j]
+                            gvz += wg * vz[j]
                     if kgc:
                         # the pressure part alone goes through L; viscosity keeps grad W
                         if kj == WALL:
@@ -304,6 +330,8 @@ def fluid_pass(ps, n, cells, prm):
             ax[i] = fx + gx
             az[i] = fz + gz
             drho[i] = rhoi * cont + ddiff * diff
+            if nopen:
+                dvnx[i], dvnz[i] = no_penetration(gw, gnx, gnz, gvx, gvz, vxi, vzi, ga, g0, gb)
 
 
 @njit(parallel=True, cache=True)
@@ -363,10 +391,13 @@ def kdk_kick(ps, n, dt, prm):
     v2max = 0.0
     a2max = 0.0
     rmax = 0.0
+    dvnx = ps.dvnx
+    dvnz = ps.dvnz
     for i in prange(n):
         if kind[i] == FLUID:
-            u = vx[i] + hdt * ax[i]
-            w = vz[i] + hdt * az[i]
+            # dvn: the no-penetration correction of the force pass (wall_contact.py)
+            u = vx[i] + hdt * ax[i] + dvnx[i]
+            w = vz[i] + hdt * az[i] + dvnz[i]
             r = rho[i] + hdt * drho[i]
             vx[i] = u
             vz[i] = w
@@ -461,8 +492,9 @@ def pc_correct(ps, n, dt, prm):
             r = rhon[i] * (2.0 - eps) / (2.0 + eps)
             u0 = vxn[i]
             w0 = vzn[i]
-            u = u0 + dt * ax[i]
-            w = w0 + dt * az[i]
+            # dvn: the no-penetration correction of the half-step force pass (wall_contact.py)
+            u = u0 + dt * ax[i] + ps.dvnx[i]
+            w = w0 + dt * az[i] + ps.dvnz[i]
             xi = xn[i] + 0.5 * dt * (u + u0)
             zi = zn[i] + 0.5 * dt * (w + w0)
             vx[i] = u

@@ -189,6 +189,33 @@ def test_particle_thrown_beside_a_side_wall_stays_in_the_tank(integrator, h_over
     assert gap_min > 0.0                   # no fluid centre behind a wall face
 
 
+@pytest.mark.parametrize("integrator", ["kdk", "symplectic_pc"])
+def test_thin_front_on_a_dry_bed_does_not_sink_through_it(integrator):
+    """A dam break (h0 0.1 m, 0.5 m long) running over a dry free-slip bed, dp 0.02, h/dp 2: the
+    bottom particles of the thin, stretching front approach the bed at ~h du/dx to keep their
+    density and sank between the wall particles (main befe411, kdk: one centre reached the first
+    dummy row, z = -dp/2, at 0.443 s and the run, exclude_limit 0, stopped). With the
+    no-penetration correction (sph_core.wall_contact) no centre passes the bed's face
+    (docs/wall_pressure.md, 2026-11-23 "the dry-bed front")."""
+    dp = 0.02
+    scene = make_scene({
+        "dp": dp, "t_end": 0.6,
+        "tank": {"x0": 0, "x1": 3.0, "z0": 0, "z1": 0.3},
+        "water_blocks": [{"x0": 0, "x1": 0.5, "z0": 0, "z1": 0.1}],
+        "constants": {"wall_slip": "free_slip", "exclude_limit": 0.0, "integrator": integrator}})
+    sim = Simulation(scene)
+    ps = sim.particles
+    z_min, x_front = np.inf, 0.0
+    while sim.t < scene.t_end:   # exclude_limit 0: a particle through the bed stops the run
+        sim.advance_to(min(sim.t + 0.01, scene.t_end))
+        f = ps.mask(FLUID)
+        z_min = min(z_min, float(ps.field(Z)[f].min()))
+        x_front = max(x_front, float(ps.field(X)[f].max()))
+    assert not sim.excluded
+    assert z_min > 0.0                     # no fluid centre behind the bed's face
+    assert x_front > 1.2                   # the front did run out over the dry bed
+
+
 def test_dry_gauge_reports_dry(tmp_path):
     scene = make_scene({
         "dp": 0.01, "t_end": 0.01, "still_water_level": 0.1,
