@@ -41,7 +41,25 @@ from numba import njit, prange
 
 from .kernels import f_of_q, w_of_q
 from .neighbours import block_of
-from .particles import FLUID, OUTLET, WALL
+from .particles import FLUID, INLET, OUTLET, WALL
+
+# next to an open end's buffer (an active buffer particle within 2h; scene
+# constants.shift_open_end): 0 "full" shift, 1 "tangential" (no component along the face
+# normal, x), 2 "none". The buffer is a lattice moved by the imposed flow; a shift along x of the
+# fluid beside it moves fluid across the face (or away from it) that the imposed flux did not
+# carry, and the crossing rules then count it in or out (docs/wave_decay_study.md, 2026-11-23
+# "flume-vs-tank gap").
+SHIFT_OPEN_END = {"full": 0, "tangential": 1, "none": 2}
+
+
+@njit(cache=True, inline="always")
+def _open_end_rule(sx, sz, rule):
+    if rule == 1:
+        return 0.0, sz
+    if rule == 2:
+        return 0.0, 0.0
+    return sx, sz
+
 
 @njit(parallel=True, cache=True)
 def shift_particles(ps, n, cells, prm, dt):
@@ -61,6 +79,7 @@ def shift_particles(ps, n, cells, prm, dt):
     alpha_f = prm.alpha_f
     coef = prm.shift_a
     fs_div = prm.shift_fs_div
+    shift_open = prm.shift_open
     max_shift = 0.05 * h
     s2 = 4.0 * h * h
     inv_h = 1.0 / h
@@ -84,6 +103,7 @@ def shift_particles(ps, n, cells, prm, dt):
         bxx = bxz = bzz = 0.0
         # velocity and density gradients (for the first-order carry of v and rho)
         gux = guz = gwx = gwz = grx = grz = 0.0
+        near_buf = False   # an active open-end buffer particle within 2h
         cxl, cxh, czl, czh = block_of(cell[i], cells)
         for zz in range(czl, czh + 1):
             row = zz * ncx
@@ -96,6 +116,8 @@ def shift_particles(ps, n, cells, prm, dt):
                 r2 = dx * dx + dz * dz
                 if r2 >= s2:
                     continue
+                if kj == INLET or kj == OUTLET:
+                    near_buf = True
                 fv = f_of_q(math.sqrt(r2) * inv_h, alpha_f) * m[j] / rho[j]
                 # grad_i W_ij = -F r_ij
                 gcx -= fv * dx
@@ -133,6 +155,8 @@ def shift_particles(ps, n, cells, prm, dt):
                 sn = sx * nx + sz * nz
                 sx -= sn * nx
                 sz -= sn * nz
+        if near_buf:
+            sx, sz = _open_end_rule(sx, sz, shift_open)
         s = math.sqrt(sx * sx + sz * sz)
         if s > max_shift:
             sx *= max_shift / s
@@ -162,6 +186,7 @@ LAMBDA_INTERIOR = 0.75   # above: full support, not a surface candidate (Marrone
 FS_INTERIOR = 0.0        # flags of pass 1 (stored in the scratch row ps.guz)
 FS_SURFACE = 1.0
 FS_ISOLATED = 2.0
+FS_NEAR_BUFFER = 4.0     # added to the flag: an active open-end buffer particle within 2h
 
 
 @njit(parallel=True, cache=True)
@@ -192,6 +217,7 @@ def shift_particles_dplus(ps, n, cells, prm, dt, umax):
     inv_wdp = prm.shift_inv_wdp
     coef = prm.shift_a * h * umax * dt
     carry = prm.shift_carry
+    shift_open = prm.shift_open
     max_shift = 0.05 * h
     s2 = 4.0 * h * h
     inv_h = 1.0 / h
@@ -225,6 +251,7 @@ def shift_particles_dplus(ps, n, cells, prm, dt, umax):
             wcx = wcz = 0.0       # the same with the anti-clustering weight (the shift)
             bxx = bxz = bzz = 0.0
             ax_ = az_ = ux = uz = wx = wz = 0.0
+            near_buf = False   # an active open-end buffer particle within 2h
             cxl, cxh, czl, czh = block_of(cell[i], cells)
             for zz in range(czl, czh + 1):
                 row = zz * ncx
@@ -237,6 +264,8 @@ def shift_particles_dplus(ps, n, cells, prm, dt, umax):
                     r2 = dx * dx + dz * dz
                     if r2 >= s2:
                         continue
+                    if kj == INLET or kj == OUTLET:
+                        near_buf = True
                     q = math.sqrt(r2) * inv_h
                     fv = f_of_q(q, alpha_f) * m[j] / rho[j]
                     wr = w_of_q(q, alpha_w) * inv_wdp
@@ -308,10 +337,16 @@ def shift_particles_dplus(ps, n, cells, prm, dt, umax):
                                                 + abs(ez * nx - ex * nz)) < h
                         if not occupied:
                             flag[i] = FS_SURFACE
+            if near_buf:
+                flag[i] += FS_NEAR_BUFFER
     # pass 2: the surface and its vicinity (within 2h of a surface particle) shift tangentially
     for i in prange(n):
-        if kind[i] == FLUID and flag[i] != FS_ISOLATED:
-            near = flag[i] == FS_SURFACE
+        fl = flag[i]
+        near_buf = fl >= FS_NEAR_BUFFER
+        if near_buf:
+            fl -= FS_NEAR_BUFFER
+        if kind[i] == FLUID and fl != FS_ISOLATED:
+            near = fl == FS_SURFACE
             if not near:
                 xi = x[i]
                 zi = z[i]
@@ -319,7 +354,8 @@ def shift_particles_dplus(ps, n, cells, prm, dt, umax):
                 for zz in range(czl, czh + 1):
                     row = zz * ncx
                     for j in range(cell_start[row + cxl], cell_start[row + cxh + 1]):
-                        if near or flag[j] != FS_SURFACE or kind[j] != FLUID:
+                        if near or kind[j] != FLUID or (flag[j] != FS_SURFACE and flag[j]
+                                                        != FS_SURFACE + FS_NEAR_BUFFER):
                             continue
                         dx = xi - x[j]
                         dz = zi - z[j]
@@ -330,6 +366,8 @@ def shift_particles_dplus(ps, n, cells, prm, dt, umax):
                 sn = sx * snx[i] + sz * snz[i]
                 sx -= sn * snx[i]
                 sz -= sn * snz[i]
+            if near_buf:
+                sx, sz = _open_end_rule(sx, sz, shift_open)
             s = math.sqrt(sx * sx + sz * sz)
             if s > max_shift:
                 sx *= max_shift / s
@@ -346,7 +384,8 @@ def shift_particles_dplus(ps, n, cells, prm, dt, umax):
             grz[i] = cu
             gux[i] = cw
     for i in prange(n):
-        if kind[i] == FLUID and flag[i] != FS_ISOLATED:
+        fl = flag[i]
+        if kind[i] == FLUID and fl != FS_ISOLATED and fl != FS_ISOLATED + FS_NEAR_BUFFER:
             x[i] += sxr[i]
             z[i] += szr[i]
             rho[i] += grx[i]

@@ -42,6 +42,7 @@ from .output import RunWriter
 from .particles import FLUID, INACTIVE, M, P, RHO, VX, VZ, WALL, X, Z, Checkpoint, ParticleSet
 from .probes import (fluid_neighbour_counts, interpolate_points, line_mass_density,
                      surface_from_line)
+from .shifting import SHIFT_OPEN_END
 from .scene import ElevationProbe, FrontProbe, PointProbe, Scene, Scheme
 from .state import Params
 
@@ -149,6 +150,7 @@ class Simulation:
                           # ISPH's figures (docs/schemes.md) were measured without the carry
                           shift_dplus=dplus, shift_carry=c.shift_carry and not self.isph,
                           shift_inv_wdp=1.0 / w_of_q(dp / h, aw),
+                          shift_open=SHIFT_OPEN_END[c.shift_open_end],
                           kgc=KERNEL_CORRECTIONS[c.kernel_correction],
                           **scheme_params(scene.scheme))
         self.integrator = wcsph.INTEGRATORS[c.integrator]

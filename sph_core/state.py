@@ -124,6 +124,8 @@ class Params(NamedTuple):
     shift_dplus: bool = False
     shift_carry: bool = True
     shift_inv_wdp: float = 0.0
+    # shifting next to an open end's buffer (shifting.SHIFT_OPEN_END): 0 full, 1 tangential, 2 none
+    shift_open: int = 0
 
 
 class OpenEnds(NamedTuple):
