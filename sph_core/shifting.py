@@ -45,10 +45,11 @@ from .particles import FLUID, INLET, OUTLET, WALL
 
 # next to an open end's buffer (an active buffer particle within 2h; scene
 # constants.shift_open_end): 0 "full" shift, 1 "tangential" (no component along the face
-# normal, x), 2 "none". The buffer is a lattice moved by the imposed flow; a shift along x of the
-# fluid beside it moves fluid across the face (or away from it) that the imposed flux did not
-# carry, and the crossing rules then count it in or out (docs/wave_decay_study.md, 2026-11-23
-# "flume-vs-tank gap").
+# normal, x), 2 "none". The buffer is a lattice moved by the imposed flow, and the crossing rules
+# count fluid in and out by where particles are: a shift beside it moves fluid that the imposed
+# flux did not carry. Measured (docs/wave_decay_study.md, 2026-11-23 "flume-vs-tank gap",
+# oscillating flow through both ends, delta-plus): "tangential" gains water fast (the vertical
+# shift alone beside the buffer's fixed rows), "none" keeps the count as without shifting.
 SHIFT_OPEN_END = {"full": 0, "tangential": 1, "none": 2}
 
 

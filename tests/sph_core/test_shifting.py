@@ -210,3 +210,12 @@ def test_still_water_with_shifting_keeps_zero_momentum(still_shifted):
     assert np.abs(mom).max() / scale < 3e-3
     late = mom[len(mom) // 2:]
     assert np.abs(late.mean(axis=0)).max() / scale < 1e-4
+
+
+def test_open_end_rule_reaches_params():
+    base = {"dp": 0.05, "t_end": 0.1, "tank": {"x0": 0, "x1": 0.5, "z0": 0, "z1": 0.4},
+            "water_blocks": [{"x0": 0, "x1": 0.5, "z0": 0, "z1": 0.2}]}
+    sim = Simulation(make_scene({**base, "constants": {"shifting": "dplus",
+                                                       "shift_open_end": "none"}}))
+    assert sim.prm.shift_open == SHIFT_OPEN_END["none"] == 2
+    assert Simulation(make_scene(base)).prm.shift_open == SHIFT_OPEN_END["full"] == 0
