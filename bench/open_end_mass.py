@@ -39,7 +39,7 @@ DEFAULT_VARIANTS = [{}, {"shifting": "dplus"},
                     {"shifting": "dplus", "shift_open_end": "none"}]
 
 
-class Oscillating:
+class _Oscillating:
     """Uniform horizontal flow u = U sin(2 pi t / T) at the nodes of one end, still surface."""
 
     def __init__(self, nodes) -> None:
@@ -50,7 +50,7 @@ class Oscillating:
         return BoundarySample(t, np.full(self.n, u), np.zeros(self.n), 0.0)
 
 
-def run(dp: float, periods: int, constants: dict) -> dict:
+def _run_variant(dp: float, periods: int, constants: dict) -> dict:
     scene = make_scene({
         "dp": dp, "t_end": float(periods) * PERIOD, "still_water_level": DEPTH,
         "tank": {"x0": 0.0, "x1": LENGTH, "z0": 0.0, "z1": DEPTH + 0.12},
@@ -58,7 +58,7 @@ def run(dp: float, periods: int, constants: dict) -> dict:
         "constants": {"c0": 10.0 * math.sqrt(G * DEPTH), **constants},
         "open_boundaries": [{"side": "left", "elevation": "imposed"},
                             {"side": "right", "elevation": "extrapolated"}]})
-    sim = Simulation(scene, sources={s: Oscillating(nd) for s, nd in flume_nodes(scene).items()},
+    sim = Simulation(scene, sources={s: _Oscillating(nd) for s, nd in flume_nodes(scene).items()},
                      window=0.02)
     tic = time.perf_counter()
     change = []
@@ -82,7 +82,7 @@ def main(argv: list[str] | None = None) -> int:
                     help="JSON list of scene-constant overrides")
     a = ap.parse_args(argv)
     for cst in a.variants:
-        print(json.dumps(run(a.dp, a.periods, {"h_over_dp": 2.0, **cst})), flush=True)
+        print(json.dumps(_run_variant(a.dp, a.periods, {"h_over_dp": 2.0, **cst})), flush=True)
     return 0
 
 
