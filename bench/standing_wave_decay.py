@@ -14,8 +14,10 @@ bench/wave_decay.py's decay_per_m, without inlet, outlet or gauge.
 Prints one JSON line per dp: omega_error, beta_per_s, equiv_decay_per_m,
 equiv_loss_per_wavelength, beta_gauge_per_s, gauge_over_velocity_amplitude (the gauge's bias),
 ke_noise_over_ke0 (kinetic energy outside the first three modes over the initial, mean over the
-second half, and max), particles, steps, wall_s (jitted loop), particle_steps_per_s; then, given
-several dp, the convergence order of equiv_decay_per_m.
+second half, and max), local_noise_over_ke0 (cases.particle_noise: velocity minus a local
+quadratic fit, the measure bench/wave_decay.py --noise uses along the open flume; KE_0 is the
+standing wave's energy, rho0 g a^2 / 4 per metre), particles, steps, wall_s (jitted loop),
+particle_steps_per_s; then, given several dp, the convergence order of equiv_decay_per_m.
 """
 
 from __future__ import annotations
@@ -85,6 +87,7 @@ def main(argv: list[str] | None = None) -> int:
             "gauge_over_velocity_amplitude": round(r.gauge_over_velocity, 4),
             "ke_noise_over_ke0_mean_2nd_half": round(r.noise_ke_fraction, 5),
             "ke_noise_over_ke0_max": round(r.noise_ke_fraction_max, 5),
+            "local_noise_over_ke0_mean_2nd_half": round(r.local_noise_fraction, 6),
             "particles": r.particles, "steps": r.steps, "wall_s": round(r.wall_s, 1),
             "particle_steps_per_s": round(r.particles * r.steps / max(r.wall_s, 1e-9))}),
             flush=True)

@@ -5,8 +5,9 @@
         [--h-over-dp 2.0] [--alpha 0.01] [--slip no_slip|free_slip] [--c0-factor 10] [--delta 0.1]
         [--cfl 0.25] [--integrator kdk|symplectic_pc] [--nu 1e-6] [--alpha-wall 1.0]
         [--shifting none|fickian|dplus] [--kernel-correction off|all|surface|weighted] [--shift-a 2.0]
-        [--shift-fs-div 1.8] [--flume-wavelengths 1] [--gauge-wavelengths 0.75] [--n-gauges 12]
-        [--long] [--absorption filter|linear|shallow] [--transfer piston|flux]
+        [--shift-fs-div 1.8] [--shift-open-end full|tangential|none] [--flume-wavelengths 1]
+        [--gauge-wavelengths 0.75] [--n-gauges 12]
+        [--long] [--noise] [--absorption filter|linear|shallow] [--transfer piston|flux]
         [--scheme wcsph|riemann|isph] [--reconstruction muscl|none] [--limiter minmod|vanleer]
         [--low-dissipation | --no-low-dissipation]
 
@@ -32,6 +33,12 @@ fitted to the complex amplitudes (cases.wave_decay.separated_decay).
 ratio_first_half / ratio_second_half: the ratio over each half of the window (a loss that
 grows in time rather than along x shows here); mean_eta_error_mm: time-mean SPH minus theory
 elevation per gauge; level_drift_mm: change of the flume's mean level from its fluid count.
+boundary_counts: per end, fluid particles in / out and buffer particles created / removed.
+second_harmonic_ratio: |2 omega amplitude| of SPH over the theory's per gauge (a free second
+harmonic from the inlet beats along x). --noise (cases.particle_noise): noise_x_m, bin centres
+(0.25 m); noise_fraction, the particle-noise kinetic energy (velocity minus a local quadratic
+fit) per bin over the wave's energy 0.5 rho0 g a^2 per bin, mean over the window; noise_t_s,
+noise_fraction_t: the same over the gauged span at each sample (every T/5 from the start).
 """
 
 from __future__ import annotations
@@ -69,6 +76,8 @@ def main(argv: list[str] | None = None) -> int:
                     help="the long flume: 3 wavelengths, 36 gauges over 2.25, window after the "
                          "outlet's reflection has come back to the inlet (its pattern, period "
                          "L/2, averages out of the fitted decay)")
+    ap.add_argument("--noise", action="store_true",
+                    help="sample the particle-noise energy along x and in time (diagnostic)")
     ap.add_argument("--n-gauges", type=int, default=12, help="number of elevation gauges")
     ap.add_argument("--absorption", choices=ABSORPTION_KINDS, help="both ends' correction "
                     "(scene default if unset)")
@@ -86,6 +95,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--shift-a", type=float, help="shifting coefficient A (Lind et al. 2012)")
     ap.add_argument("--shift-fs-div", type=float, help="free-surface position-divergence limit")
     ap.add_argument("--shift-dplus-scale", type=float, help="dplus: multiplier on CFL Ma (2h)^2")
+    ap.add_argument("--shift-open-end", choices=["full", "tangential", "none"],
+                    help="shifting next to an open end's buffer")
     ap.add_argument("--no-shift-carry", action="store_true",
                     help="do not Taylor-carry rho, v of a shifted particle")
     ap.add_argument("--alpha-wall", type=float, help="artificial viscosity factor against walls")
@@ -104,6 +115,7 @@ def main(argv: list[str] | None = None) -> int:
                              "alpha_wall_factor": a.alpha_wall,
                              "shift_dplus_scale": a.shift_dplus_scale,
                              "shift_carry": False if a.no_shift_carry else None,
+                             "shift_open_end": a.shift_open_end,
                              "kernel_correction": a.kernel_correction}.items() if v is not None}
     scheme = scheme_from_args(a)
     if a.long:
@@ -119,7 +131,7 @@ def main(argv: list[str] | None = None) -> int:
                                  inlet_pressure=a.inlet_pressure, settle_periods=a.settle_periods,
                                  outlet_absorb=not a.no_outlet_absorb,
                                  gauge_wavelengths=a.gauge_wavelengths, n_gauges=a.n_gauges,
-                                 wait_reflection=a.long,
+                                 wait_reflection=a.long, noise=a.noise,
                                  c0=c0, scheme=scheme, **ends, **cst)
         length = float(model.length)
         decays.append(prof.decay_per_m)
@@ -142,6 +154,14 @@ def main(argv: list[str] | None = None) -> int:
                           "ratio_second_half": [round(float(r), 4) for r in prof.ratio_second_half],
                           "mean_eta_error_mm": [round(1e3 * float(e), 2) for e in prof.mean_eta_error],
                           "level_drift_mm": round(1e3 * prof.level_drift_m, 2),
+                          "boundary_counts": prof.counts,
+                          "second_harmonic_ratio": [round(float(r), 4) for r in prof.ratio_2nd],
+                          **({} if prof.noise_x is None else {
+                              "noise_x_m": [round(float(v), 3) for v in prof.noise_x],
+                              "noise_fraction": [float(f"{v:.4g}") for v in prof.noise_fraction],
+                              "noise_t_s": [round(float(v), 3) for v in prof.noise_t],
+                              "noise_fraction_t": [float(f"{v:.4g}")
+                                                   for v in prof.noise_fraction_t]}),
                           "amplitude_at_0_8m": round(prof.ratio_at(0.8), 4),
                           "wall_s": round(prof.wall_s, 1), "particles": prof.particles,
                           "steps": prof.steps,

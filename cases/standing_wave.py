@@ -29,6 +29,7 @@ from scipy.optimize import curve_fit
 from sph_core.particles import FLUID, M, VX, VZ, X, Z
 from sph_core.scene import make_scene
 from sph_core.simulation import Simulation
+from .particle_noise import noise_energy
 from .wave_analysis import group_velocity
 
 
@@ -46,6 +47,9 @@ class StandingWaveDecay:
     particles: int
     steps: int
     wall_s: float                 # the jitted loop's wall time [s]
+    # cases.particle_noise's local measure (velocity minus a local quadratic fit) over KE_0, mean
+    # over the second half, sampled every T/10: comparable with an open flume's noise_fraction
+    local_noise_fraction: float = 0.0
 
     def loss_per_wavelength(self, wavelength: float) -> float:
         return 1.0 - math.exp(-self.equiv_decay_per_m * wavelength)
@@ -79,7 +83,7 @@ def standing_wave_decay(*, dp: float, depth: float = 0.24, length: float = 1.0,
     u0, w0 = _mode(ps.f[X, : ps.n][fl], ps.f[Z, : ps.n][fl], k)
     ps.f[VX, : ps.n][fl] = amp_a * u0
     ps.f[VZ, : ps.n][fl] = amp_a * w0
-    ts, cs, ke, noise, eta = [], [], [], [], []
+    ts, cs, ke, noise, eta, local = [], [], [], [], [], []
     n_out = int(round(periods * 40))
     for i in range(n_out + 1):
         if i:
@@ -96,6 +100,8 @@ def standing_wave_decay(*, dp: float, depth: float = 0.24, length: float = 1.0,
             ke_modes += 0.5 * cn * cn * norm
             if n == 1:
                 cs.append(cn / amp_a)
+        if i % 4 == 0:
+            local.append((sim.t, float(np.sum(noise_energy(x, z, u, w, m, dp)))))
         ts.append(sim.t)
         ke.append(ke_tot)
         noise.append(max(ke_tot - ke_modes, 0.0))
@@ -116,4 +122,5 @@ def standing_wave_decay(*, dp: float, depth: float = 0.24, length: float = 1.0,
         float(om / omega - 1.0), float(beta), float(beta) / cg, float(be),
         abs(float(ae)) / (amplitude * abs(float(amp))),
         float(np.mean(np.array(noise)[late]) / ke[0]), float(np.max(noise) / ke[0]),
-        sim.n_particles, sim.steps, sim.wall_time)
+        sim.n_particles, sim.steps, sim.wall_time,
+        float(np.mean([e for tt, e in local if tt >= 0.5 * t[-1]]) / ke[0]))

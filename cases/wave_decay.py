@@ -22,8 +22,12 @@ from scipy.optimize import minimize
 
 from sph_core.scene import ElevationProbe
 
+from .particle_noise import binned_noise, noise_energy
 from .wave_analysis import group_velocity, harmonic_amplitude
 from .wave_flume import run_wave_flume, wave_flume_scene
+
+
+NOISE_BIN_M = 0.25   # x bins of the particle-noise profile [m]
 
 
 @dataclass(frozen=True)
@@ -45,6 +49,18 @@ class AmplitudeProfile:
     ratio_second_half: np.ndarray | None = None
     mean_eta_error: np.ndarray | None = None
     level_drift_m: float = 0.0
+    # second harmonic (2 omega) of SPH over the theory's per gauge: a free second harmonic
+    # emitted by the inlet beats along x against the bound one
+    ratio_2nd: np.ndarray | None = None
+    # with noise=True (cases.particle_noise): bin centres [m], the particle-noise kinetic energy
+    # per bin over the wave's energy 0.5 rho0 g a^2 per bin, mean over the window; sample times
+    # [s] and the noise over the gauged span's wave energy at each
+    noise_x: np.ndarray | None = None
+    noise_fraction: np.ndarray | None = None
+    noise_t: np.ndarray | None = None
+    noise_fraction_t: np.ndarray | None = None
+    # per end (left, right): particles in / out / created / removed over the run
+    counts: dict | None = None
 
     def ratio_at(self, x: float) -> float:
         """The fitted ratio at ``x`` [m] (the outlet's small reflection ripples the profile)."""
@@ -57,7 +73,7 @@ def amplitude_profile(model: Any, *, ramp: float, height: float, period: float, 
                       settle_periods: float = 0.0, outlet_absorb: bool = True,
                       gauge_wavelengths: float = 0.75, absorption: str = "filter",
                       absorption_transfer: str = "piston", wait_reflection: bool = False,
-                      **constants: Any) -> AmplitudeProfile:
+                      noise: bool = False, **constants: Any) -> AmplitudeProfile:
     """Run the flume driven by ``model`` (its start-up ramp lasting ``ramp`` s) and measure
     the amplitude ratio along it (``constants`` override the scene's, e.g. alpha). The flume is
     ``flume_wavelengths`` long; the gauges stay within ``gauge_wavelengths`` of the inlet
@@ -65,7 +81,8 @@ def amplitude_profile(model: Any, *, ramp: float, height: float, period: float, 
     after the front has passed the last gauge, or with ``wait_reflection`` after the front's
     reflection from the outlet has come back to the inlet (the separated fit assumes a steady
     reflected wave). ``absorption``, ``absorption_transfer``: both ends' correction
-    (scene.OpenBoundary)."""
+    (scene.OpenBoundary). ``noise``: sample the particle-noise energy along x every period / 5
+    (cases.particle_noise; about 1 s of numpy per sample at dp 0.02, outside ``wall_s``)."""
     length = float(model.length)
     if not 0.0 < gauge_wavelengths < flume_wavelengths:
         raise ValueError(f"gauge_wavelengths ({gauge_wavelengths}) must lie inside the flume "
@@ -85,7 +102,15 @@ def amplitude_profile(model: Any, *, ramp: float, height: float, period: float, 
                              **constants)
     probes = [ElevationProbe(kind="elevation", name=f"g{i}", x=float(x)) for i, x in enumerate(xs)]
     scene = scene.model_copy(update={"probes": probes})
-    res = run_wave_flume(scene, model, window=period / 50)
+    edges = np.arange(0.0, scene.tank.x1 + 1e-9, NOISE_BIN_M)
+    noise_rec: list[tuple[float, np.ndarray]] = []
+
+    def sample(sim: Any) -> None:
+        st = sim.fluid_state()
+        dke = noise_energy(st["x"], st["z"], st["vx"], st["vz"], st["m"], dp)
+        noise_rec.append((sim.t, binned_noise(st["x"], dke, edges)))
+
+    res = run_wave_flume(scene, model, window=period / 50, sample=sample if noise else None)
     sel = np.nonzero(res.t >= t0 - 1e-9)[0]
     sel = sel[: int(round(periods * period / (res.t[1] - res.t[0])))]
     omega = 2.0 * math.pi / period
@@ -104,9 +129,23 @@ def amplitude_profile(model: Any, *, ramp: float, height: float, period: float, 
                          for p in probes])
     nf = res.n_fluid
     drift = float((nf[-1, 1] - nf[0, 1]) * dp * dp / scene.tank.x1)
+    ratio2 = np.array([abs(harmonic_amplitude(res.t[sel], res.eta[p.name][sel], 2.0 * omega))
+                       / abs(harmonic_amplitude(res.t[sel], res.theory[p.name][sel], 2.0 * omega))
+                       for p in probes])
+    nx = nfr = nt = nft = None
+    if noise_rec:
+        e_bin = 0.5 * scene.constants.rho0 * scene.constants.g * (0.5 * height) ** 2 * NOISE_BIN_M
+        nt = np.array([t for t, _ in noise_rec])
+        nb = np.array([b for _, b in noise_rec])
+        win = (nt >= t0 - 1e-9) & (nt <= t0 + periods * period + 1e-9)
+        nx = 0.5 * (edges[1:] + edges[:-1])
+        nfr = nb[win].mean(axis=0) / e_bin
+        span = edges[1:] <= xs[-1] + 1e-9
+        nft = nb[:, span].sum(axis=1) / (e_bin * np.count_nonzero(span))
     return AmplitudeProfile(xs, ratio, float(-slope), float(icpt), res.wall_s, res.particles,
                             res.steps, amp, 2.0 * math.pi / length, half_ratio(sel[:nh]),
-                            half_ratio(sel[nh:]), mean_err, drift)
+                            half_ratio(sel[nh:]), mean_err, drift, ratio2, nx, nfr, nt, nft,
+                            res.counts)
 
 
 def separated_decay(x: np.ndarray, amp: np.ndarray, k: float) -> tuple[float, float, float]:

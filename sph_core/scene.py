@@ -176,6 +176,9 @@ class Constants(_Model):
     shift_carry: bool = Field(True, description=(
         "carry the shifted particle's density and velocity to its new position (first-order "
         "Taylor); without it the shift diffuses the velocity field"))
+    shift_open_end: Literal["full", "tangential", "none"] = Field("full", description=(
+        "shifting of a fluid particle with an open end's active buffer particle within 2h: "
+        "full, tangential (no component along the face normal, x), none (sph_core.shifting)"))
     shift_fs_div: float = Field(1.8, gt=0, lt=2, description=(
         "position divergence below which a particle counts as near the free surface (2D: 2 "
         "inside the fluid) and shifts only tangentially"))

@@ -41,7 +41,7 @@ import math
 from numba import njit, prange
 
 from .neighbours import block_of
-from .particles import FLUID, OUTLET
+from .particles import FLUID, INLET, OUTLET
 from .renormalisation import moments, smallest_eigenvalue, solve
 
 
@@ -74,6 +74,51 @@ def _limited(sx, sz, tangential, nx, nz, max_shift):
         sx *= max_shift / ds
         sz *= max_shift / ds
     return sx, sz
+
+
+# next to an open end's buffer (an active buffer particle within 2h; scene
+# constants.shift_open_end): 0 "full" shift, 1 "tangential" (no component along the face
+# normal, x), 2 "none". The buffer is a lattice moved by the imposed flow, and the crossing rules
+# count fluid in and out by where particles are: a shift beside it moves fluid that the imposed
+# flux did not carry. Measured (docs/wave_decay_study.md, 2026-11-23 "flume-vs-tank gap",
+# oscillating flow through both ends, delta-plus): "tangential" gains water fast (the vertical
+# shift alone beside the buffer's fixed rows), "none" keeps the count as without shifting.
+SHIFT_OPEN_END = {"full": 0, "tangential": 1, "none": 2}
+
+
+@njit(cache=True, inline="always")
+def _near_buffer(i, ps, cells, h):
+    """Is an active open-end buffer particle within 2h of particle i?"""
+    x = ps.x
+    z = ps.z
+    kind = ps.kind
+    s2 = 4.0 * h * h
+    cxl, cxh, czl, czh = block_of(ps.cell[i], cells)
+    for zz in range(czl, czh + 1):
+        row = zz * cells.ncx
+        for j in range(cells.start[row + cxl], cells.start[row + cxh + 1]):
+            kj = kind[j]
+            if kj == INLET or kj == OUTLET:
+                dx = x[i] - x[j]
+                dz = z[i] - z[j]
+                if dx * dx + dz * dz < s2:
+                    return True
+    return False
+
+
+@njit(cache=True, inline="always")
+def _open_end_limited(i, ps, cells, prm, sx, sz, tangential, nx, nz, max_shift):
+    """_limited, with the open-end rule (prm.shift_open) applied after the surface projection and
+    before the cap for a particle beside a buffer."""
+    rule = prm.shift_open
+    if rule != 0 and _near_buffer(i, ps, cells, prm.h):
+        sx, sz = _limited(sx, sz, tangential, nx, nz, math.inf)
+        if rule == 1:
+            sx = 0.0
+        else:
+            sx = sz = 0.0
+        return _limited(sx, sz, False, nx, nz, max_shift)
+    return _limited(sx, sz, tangential, nx, nz, max_shift)
 
 
 @njit(parallel=True, cache=True)
@@ -138,7 +183,7 @@ def shift_particles(ps, n, cells, prm, dt):
         if tangential:
             # renormalised normal: grad C itself is parallel to the shift and cannot split it
             nx, nz = _surface_normal(s, s.mxx * s.mzz - s.mxz * s.mxz)
-        sx, sz = _limited(sx, sz, tangential, nx, nz, max_shift)
+        sx, sz = _open_end_limited(i, ps, cells, prm, sx, sz, tangential, nx, nz, max_shift)
         sxr[i] = sx
         szr[i] = sz
         # first-order carry of rho and v to the new position
@@ -271,7 +316,8 @@ def shift_particles_dplus(ps, n, cells, prm, dt, umax):
                         dx = xi - x[j]
                         dz = zi - z[j]
                         near = dx * dx + dz * dz < s2
-            sx, sz = _limited(sxr[i], szr[i], near, snx[i], snz[i], max_shift)
+            sx, sz = _open_end_limited(i, ps, cells, prm, sxr[i], szr[i], near, snx[i], snz[i],
+                                       max_shift)
             sxr[i] = sx
             szr[i] = sz
             crho = cu = cw = 0.0

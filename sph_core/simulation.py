@@ -42,6 +42,7 @@ from .output import RunWriter
 from .particles import FLUID, INACTIVE, M, P, RHO, VX, VZ, WALL, X, Z, Checkpoint, ParticleSet
 from .probes import (fluid_neighbour_counts, interpolate_points, line_mass_density,
                      surface_from_line)
+from .shifting import SHIFT_OPEN_END
 from .scene import ElevationProbe, FrontProbe, PointProbe, Scene, Scheme
 from .state import Params
 from .wall_contact import face_shares
@@ -150,6 +151,7 @@ class Simulation:
                           # ISPH's figures (docs/schemes.md) were measured without the carry
                           shift_dplus=dplus, shift_carry=c.shift_carry and not self.isph,
                           shift_inv_wdp=1.0 / w_of_q(dp / h, aw),
+                          shift_open=SHIFT_OPEN_END[c.shift_open_end],
                           kgc=KERNEL_CORRECTIONS[c.kernel_correction],
                           # no penetration at wall faces (WCSPH and Riemann; ISPH has its own
                           # no-penetration pressure, isph_wall_stop)

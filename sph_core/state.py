@@ -132,6 +132,8 @@ class Params(NamedTuple):
     wall_ga: float = 0.0
     wall_g0: float = 0.0
     wall_gb: float = 0.0
+    # shifting next to an open end's buffer (shifting.SHIFT_OPEN_END): 0 full, 1 tangential, 2 none
+    shift_open: int = 0
 
 
 class OpenEnds(NamedTuple):

@@ -11,25 +11,29 @@ import pytest
 from cell_sorted import sort_into_cells
 
 from sph_core.kernels import w_of_q, wendland_alpha
-from sph_core.particles import FLUID, GUZ, M, N_FIELDS, RHO, VX, VZ, WALL, X, Z
+from sph_core.particles import FLUID, GUZ, INLET, M, N_FIELDS, RHO, VX, VZ, WALL, X, Z
 from sph_core.scene import make_scene
-from sph_core.shifting import FS_SURFACE, shift_particles, shift_particles_dplus
+from sph_core.shifting import (FS_SURFACE, SHIFT_OPEN_END, shift_particles,
+                               shift_particles_dplus)
 from sph_core.simulation import Simulation
 from sph_core.state import Params, particles_view
 
 
 def _lattice_run(nx: int, nz: int, dp: float, h: float, moved: tuple[int, float, float],
                  coef: float = 2.0, fs_div: float = 1.8, speed: float = 1.0,
-                 dplus: bool = False, extra: tuple[float, float] | None = None):
+                 dplus: bool = False, extra: tuple[float, float] | None = None,
+                 buffer_cols: int = 0, shift_open: int = 0):
     """Shift a lattice of nx x nz fluid particles (one moved by (dx, dz); ``extra``: one more
     fluid particle there) above 4 wall rows by the Fickian or (``dplus``) the delta-plus law;
-    returns (x, z before, x, z after, kinds, the sort order, the delta-plus surface flags)."""
+    returns (x, z before, x, z after, kinds, the sort order, the delta-plus surface flags).
+    ``buffer_cols``: the left-most columns are an open end's active buffer (INLET), moving with
+    the fluid; ``shift_open``: Params.shift_open."""
     xs, zs, kinds = [], [], []
     for j in range(-4, nz):
         for i in range(nx):
             xs.append((i + 0.5) * dp)
             zs.append((j + 0.5) * dp)
-            kinds.append(WALL if j < 0 else FLUID)
+            kinds.append(WALL if j < 0 else INLET if i < buffer_cols else FLUID)
     if extra is not None:
         xs.append(extra[0])
         zs.append(extra[1])
@@ -39,7 +43,7 @@ def _lattice_run(nx: int, nz: int, dp: float, h: float, moved: tuple[int, float,
     f[X], f[Z] = xs, zs
     f[RHO] = 1000.0
     f[M] = 1000.0 * dp * dp
-    f[VX] = np.where(np.array(kinds) == FLUID, speed, 0.0)
+    f[VX] = np.where(np.array(kinds) != WALL, speed, 0.0)
     k, ddx, ddz = moved
     f[X, k] += ddx
     f[Z, k] += ddz
@@ -51,7 +55,7 @@ def _lattice_run(nx: int, nz: int, dp: float, h: float, moved: tuple[int, float,
                  gamma=7.0, gx=0.0, gz=-9.81, alpha=0.01, nu=1e-6, delta=0.1, cfl=0.25,
                  rho_lo=0.7, rho_hi=1.3, noslip=True, fx0=-1.0, fx1=1.0, fz0=-1.0, fz1=1.0,
                  alpha_wall=1.0, shift_a=coef, shift_fs_div=fs_div, shift_dplus=dplus,
-                 shift_inv_wdp=1.0 / w_of_q(dp / h, aw))
+                 shift_inv_wdp=1.0 / w_of_q(dp / h, aw), shift_open=shift_open)
     before = (f[X].copy(), f[Z].copy())
     ps = particles_view(f, kind, np.arange(n, dtype=np.int64), cell)
     if dplus:
@@ -92,6 +96,33 @@ def test_surface_particle_does_not_move_along_the_normal(law):
            & (x0 < (nx - 3) * dp))
     assert np.all(np.abs(z1[top] - z0[top]) < 1e-3 * dp)
 
+
+@pytest.mark.parametrize("law", LAWS)
+@pytest.mark.parametrize("rule", ["full", "tangential", "none"])
+def test_shift_beside_an_open_end_follows_the_rule(law, rule):
+    # a fluid particle two columns from an inlet buffer (3 columns), displaced: "full" shifts it
+    # as anywhere, "tangential" never along the face normal x (a shift across the face would
+    # move fluid in or out that the imposed flow did not carry), "none" not at all; a particle
+    # more than 2h from the buffer shifts in every case
+    dp, h = 0.02, 0.04
+    nx, nz = 14, 10
+    near = (4 + 4) * nx + 4          # fluid row 4, column 4: 1.5 dp from the buffer's last column
+    far = (4 + 4) * nx + 10
+    out = {}
+    for k in (near, far):
+        (x0, z0), (x1, z1), kind, order, _ = _lattice_run(
+            nx, nz, dp, h, (k, 0.2 * dp, 0.1 * dp), buffer_cols=3,
+            shift_open=SHIFT_OPEN_END[rule], **law)
+        i = int(np.nonzero(order == k)[0][0])
+        out[k] = (x1[i] - x0[i], z1[i] - z0[i])
+    (nxs, nzs), (fxs, fzs) = out[near], out[far]
+    assert abs(fxs) > 1e-4 * dp and abs(fzs) > 1e-4 * dp, "far from the end: shifted"
+    if rule == "full":
+        assert abs(nxs) > 1e-4 * dp and abs(nzs) > 1e-4 * dp
+    elif rule == "tangential":
+        assert nxs == 0.0 and abs(nzs) > 1e-4 * dp
+    else:
+        assert nxs == 0.0 and nzs == 0.0
 
 
 def test_dplus_finds_the_free_surface_and_leaves_an_isolated_particle_alone():
@@ -171,3 +202,12 @@ def test_still_water_with_shifting_keeps_zero_momentum(still_shifted):
     assert np.abs(mom).max() / scale < 3e-3
     late = mom[len(mom) // 2:]
     assert np.abs(late.mean(axis=0)).max() / scale < 1e-4
+
+
+def test_open_end_rule_reaches_params():
+    base = {"dp": 0.05, "t_end": 0.1, "tank": {"x0": 0, "x1": 0.5, "z0": 0, "z1": 0.4},
+            "water_blocks": [{"x0": 0, "x1": 0.5, "z0": 0, "z1": 0.2}]}
+    sim = Simulation(make_scene({**base, "constants": {"shifting": "dplus",
+                                                       "shift_open_end": "none"}}))
+    assert sim.prm.shift_open == SHIFT_OPEN_END["none"] == 2
+    assert Simulation(make_scene(base)).prm.shift_open == SHIFT_OPEN_END["full"] == 0
