@@ -406,6 +406,11 @@ class OpenBoundary(_Model):
         "piston", description="ideal gain of the depth-uniform correction: Biesel's piston "
                               "transfer function, or the depth-mean velocity omega/(k d) "
                               "(sph_core.absorption.transfer_gain)")
+    absorption_profile: Literal["uniform", "mode"] = Field(
+        "uniform", description="vertical profile of the correction: uniform over the depth (a "
+                               "piston), or linear theory's orbital velocity cosh k(z + d) at "
+                               "the wave period (no evanescent near field; uniform when no "
+                               "period is known; sph_core.absorption.correction_profile)")
     absorption_period: float | None = Field(None, gt=0, description="wave period [s] of the "
                                             "linear absorption gain (None: the source's)")
     gauge_offset: float | None = Field(None, gt=0, description="boundary gauge distance inside the face [m]")
