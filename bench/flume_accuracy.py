@@ -5,6 +5,8 @@
     python bench/flume_accuracy.py --theory stokes2 --H 0.02 --d 0.2 --kd 1.2 --absorption shallow
     python bench/flume_accuracy.py --theory stream_function --H 0.02 --d 0.2 --dp 0.005 \
         --kd 1.2 2.0 --absorption linear filter --h-over-dp 2 --alpha-wall 0   # one line each
+    python bench/flume_accuracy.py --theory stream_function --H 0.02 --d 0.2 --dp 0.005 \
+        --kd 2.0 --periods 2 --profile uniform mode    # the correction's vertical profile
 
 Runs one case of the seed 002 validation table (tests/data/wave_cases_seed002.csv, cases I-VI)
 or any regular wave through a flume one wavelength long (standing wave: half a wavelength, faces
@@ -13,7 +15,9 @@ case, theory, H, T, d, dp, H_over_dp, periods, rmse_over_H (mid-flume gauge vs t
 periods after the ramp), reflection (first harmonic, least squares over nine gauges within L/4
 of mid-flume with a fitted spatial decay of both waves: the coarse flume damps its waves, and a
 fit without decay reads that as reflection), reflection_3g (the plain fit over mid-flume and L/8
-either side), reflection_harmonics (Mansard & Funke per harmonic, first and bound second, nine
+either side), reflection_steady (with --steady: nine gauges, decay, over the periods after the
+outlet's start-up emission has passed them; the standard window above holds it at large kd),
+reflection_harmonics (Mansard & Funke per harmonic, first and bound second, nine
 gauges with decay), none for the standing wave; absorption (the open ends' gain: linear
 omega/(k d) at the wave period, the seed 002 shallow sqrt(g/d), or the filter following
 omega/(k d) per frequency; sph_core.absorption), kd; wall_s, particles, steps, particle_steps_per_s,
@@ -32,7 +36,7 @@ import sys
 from pathlib import Path
 
 from cases.wave_flume import flume_case
-from sph_core.absorption import ABSORPTION_KINDS, ABSORPTION_TRANSFERS
+from sph_core.absorption import ABSORPTION_KINDS, ABSORPTION_PROFILES, ABSORPTION_TRANSFERS
 from wave_client.theories import build_theory, wavenumber
 
 CASES_CSV = Path(__file__).resolve().parents[1] / "tests" / "data" / "wave_cases_seed002.csv"
@@ -55,7 +59,8 @@ def case_theory(theory: str, height: float, period: float, depth: float, ramp: f
 def run_flume_case(theory: str, height: float, period: float, depth: float, dp: float, periods: float,
                    ramp_periods: float = 1.0, absorb: bool = True, case: str | None = None,
                    absorption: str = "linear", transfer: str = "piston",
-                   surface: str = "face", **constants) -> dict:
+                   surface: str = "face", profile: str | None = None, steady: bool = False,
+                   **constants) -> dict:
     ramp = ramp_periods * period
     model = case_theory(theory, height, period, depth, ramp)
     if theory == "irregular":  # flume length and gauges from the peak wave
@@ -66,7 +71,8 @@ def run_flume_case(theory: str, height: float, period: float, depth: float, dp: 
                      dp=dp, periods=periods, ramp=ramp, standing=theory == "standing",
                      absorb=(absorb, absorb), regular=theory != "irregular",
                      name=f"flume_{case or theory}", absorption=absorption,
-                     absorption_transfer=transfer, right_surface=surface, **constants)
+                     absorption_transfer=transfer, right_surface=surface,
+                     absorption_profile=profile, steady=steady, **constants)
     return {"case": case, "theory": theory, **constants, **out}
 
 
@@ -92,6 +98,13 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--surface", choices=["gauge", "face"], default="face",
                     help="the outlet buffer's surface: the gauge's reading, or the theory's "
                          "elevation at the face plus the gauge's mismatch")
+    ap.add_argument("--profile", choices=ABSORPTION_PROFILES, nargs="+", default=[None],
+                    help="vertical profile of the correction: uniform (a piston) or linear "
+                         "theory's cosh k(z + d) at the wave period (several: one run each; "
+                         "default: the scene's)")
+    ap.add_argument("--steady", action="store_true",
+                    help="also run until the outlet's start-up emission has passed the gauges "
+                         "and print reflection_steady over --periods periods after it")
     ap.add_argument("--h-over-dp", type=float, help="smoothing length / dp (default: the scene's)")
     ap.add_argument("--alpha-wall", type=float, help="wall viscosity factor (scene default)")
     a = ap.parse_args(argv)
@@ -114,10 +127,12 @@ def main(argv: list[str] | None = None) -> int:
     for period in periods_s:
         for absorption in a.absorption:
             for transfer in a.transfer:
-                out = run_flume_case(theory, height, period, depth, dp, a.periods,
-                                     a.ramp_periods, not a.no_absorb, a.case, absorption,
-                                     transfer, a.surface, **constants)
-                print(json.dumps(out), flush=True)
+                for profile in a.profile:
+                    out = run_flume_case(theory, height, period, depth, dp, a.periods,
+                                         a.ramp_periods, not a.no_absorb, a.case, absorption,
+                                         transfer, a.surface, profile, a.steady,
+                                         **constants)
+                    print(json.dumps(out), flush=True)
     return 0
 
 

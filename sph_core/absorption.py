@@ -47,6 +47,10 @@ ABSORPTION_KINDS = ("shallow", "linear", "filter")
 # wave maker (the default: it is what the buffer's correction is), "flux" the depth-mean
 # velocity omega/(k d) of the wave (the gain before 2026-11-23; 8.7 % reflection at kd 2)
 ABSORPTION_TRANSFERS = ("piston", "flux")
+# the correction's vertical profile: "uniform" (a piston), "mode" linear theory's orbital
+# velocity cosh k(z + d) at the wave period (no evanescent near field at that frequency;
+# docs/absorption.md, 2026-11-23 kd 2 study)
+ABSORPTION_PROFILES = ("uniform", "mode")
 # the filter's time constants tau_j in units of sqrt(d/g), and the kd band it is fitted over
 FILTER_TAUS = (0.3, 1.0, 3.0)  # 4 fit closer, but D ~ 1.8 sqrt(g/d) amplifies gauge noise
 FILTER_KD_BAND = (0.2, 2.5)
@@ -71,27 +75,71 @@ def linear_wavenumber(omega: float, depth: float, g: float = 9.81) -> float:
     return k
 
 
-def transfer_gain(omega: np.ndarray | float, kd: np.ndarray | float,
-                  transfer: str = "piston") -> np.ndarray | float:
-    """Ideal gain G(omega) [1/s] of a depth-uniform correction, for wavenumber kd = k(omega) d.
+def _sinhc(x: np.ndarray | float) -> np.ndarray | float:
+    """sinh(x)/x, 1 at x = 0."""
+    x = np.asarray(x, dtype=float)
+    small = np.abs(x) < 1e-6
+    return np.where(small, 1.0 + x * x / 6.0, np.sinh(np.where(small, 1.0, x)) / np.where(small, 1.0, x))
 
-    ``piston`` (Biesel 1951; Schaeffer & Klopman 2000 use it for a piston absorber): a uniform
-    velocity U radiates a progressive wave of amplitude a = U (H/S)/omega plus evanescent modes,
-    H/S = 4 sinh^2 kd / (sinh 2kd + 2kd); projecting U and the outgoing wave's Airy velocity
-    onto the progressive mode cosh k(z + d), the end swallows the wave without reflection iff
-        G = U/a = omega (sinh 2kd + 2kd) / (4 sinh^2 kd).
-    ``flux``: omega/(k d), the depth-mean velocity per unit elevation (its shallow limit is the
-    same sqrt(g/d)); it ignores that the evanescent modes of the piston carry flux too, and is
-    low by 0.3 % at kd 0.76, 3.6 % at 1.2, 19 % at kd 2 (8.7 % reflection, as measured)."""
+
+def correction_profile(s: np.ndarray | float, profile_kd: float = 0.0) -> np.ndarray:
+    """The correction's vertical profile P at relative height s = (z - z_bed)/d (1 at the
+    still-water level): cosh(q s) q / sinh q for q = ``profile_kd`` > 0 (linear theory's
+    orbital velocity cosh k(z + d) at the wave whose kd is q), 1 for q = 0 (a piston). Its
+    depth mean over 0 <= s <= 1 is 1, so every profile carries the same volume flux per unit
+    correction and the gains below share the long-wave limit sqrt(g/d)."""
+    s = np.asarray(s, dtype=float)
+    if not (math.isfinite(profile_kd) and profile_kd >= 0):
+        raise ValueError(f"profile_kd: must be a finite number >= 0, got {profile_kd}")
+    if profile_kd == 0.0:
+        return np.ones_like(s)
+    q = profile_kd
+    return np.cosh(q * s) * q / math.sinh(q)
+
+
+def transfer_gain(omega: np.ndarray | float, kd: np.ndarray | float,
+                  transfer: str = "piston", profile_kd: float = 0.0) -> np.ndarray | float:
+    """Ideal gain G(omega) [1/s] of the correction U P(z) (``correction_profile``; uniform for
+    ``profile_kd`` 0), for wavenumber kd = k(omega) d.
+
+    ``piston`` (for the uniform profile Biesel's 1951 transfer function; Schaeffer & Klopman
+    2000 use it for a piston absorber): the end's velocity U P(z) radiates a progressive wave
+    (mode phi = cosh k(z + d)) plus evanescent modes, which carry nothing away. Projecting U P
+    and the outgoing wave's Airy velocity a omega phi / sinh kd onto phi, the end swallows the
+    wave without reflection iff
+        G = U/a = omega int phi^2 dz / (sinh kd int P phi dz),
+    for P = 1: omega (sinh 2kd + 2kd) / (4 sinh^2 kd). With the wave's own profile (q = kd)
+    G = omega/(kd): no evanescent mode, and the flux gain is exact. ``flux``: omega/(k d), the
+    depth-mean velocity per unit elevation (the same for every profile of depth mean 1); for
+    the piston it ignores that the evanescent modes carry flux too, and is low by 0.3 % at kd
+    0.76, 3.6 % at 1.2, 19 % at kd 2 (8.7 % reflection, as measured)."""
     if transfer not in ABSORPTION_TRANSFERS:
         raise ValueError(f"absorption_transfer: one of {ABSORPTION_TRANSFERS}, got {transfer!r}")
+    if not (math.isfinite(profile_kd) and profile_kd >= 0):
+        raise ValueError(f"profile_kd: must be a finite number >= 0, got {profile_kd}")
     if transfer == "flux":
         return omega / kd
-    return omega * (np.sinh(2.0 * kd) + 2.0 * kd) / (4.0 * np.sinh(kd) ** 2)
+    q = profile_kd
+    # int_0^1 P(s) cosh(kd s) ds with P = cosh(q s) q / sinh q (q = 0: sinh kd / kd)
+    p_phi = 0.5 * (q / math.sinh(q) if q > 0 else 1.0) * (
+        np.sinh(kd + q) / (kd + q) + _sinhc(kd - q))
+    return omega * (np.sinh(2.0 * kd) + 2.0 * kd) / (4.0 * kd * np.sinh(kd) * p_phi)
+
+
+def profile_wavenumber(profile: str, g: float, depth: float, period: float | None) -> float:
+    """q = k d of the correction's profile: the linear wave of ``period`` for ``mode``; 0 (a
+    uniform piston) for ``uniform`` or when no period is known (the mode's long-wave limit)."""
+    if profile not in ABSORPTION_PROFILES:
+        raise ValueError(f"absorption_profile: one of {ABSORPTION_PROFILES}, got {profile!r}")
+    if profile == "uniform" or period is None:
+        return 0.0
+    if not (math.isfinite(period) and period > 0):
+        raise ValueError(f"absorption period: must be a positive number of seconds, got {period}")
+    return linear_wavenumber(2.0 * math.pi / period, depth, g) * depth
 
 
 def absorption_gain(kind: str, g: float, depth: float, period: float | None = None,
-                    transfer: str = "piston") -> float:
+                    transfer: str = "piston", profile_kd: float = 0.0) -> float:
     """Gain G [1/s] of the depth-uniform correction du = n_x G (eta_meas - eta_gauge).
 
     ``shallow``: sqrt(g/d) (seed 002). ``linear``: the ``transfer`` gain (``transfer_gain``) at
@@ -108,7 +156,8 @@ def absorption_gain(kind: str, g: float, depth: float, period: float | None = No
     if not (math.isfinite(period) and period > 0):
         raise ValueError(f"absorption period: must be a positive number of seconds, got {period}")
     omega = 2.0 * math.pi / period
-    return float(transfer_gain(omega, linear_wavenumber(omega, depth, g) * depth, transfer))
+    return float(transfer_gain(omega, linear_wavenumber(omega, depth, g) * depth, transfer,
+                               profile_kd))
 
 
 def source_period(source: Any) -> float | None:
@@ -123,16 +172,17 @@ def source_period(source: Any) -> float | None:
 
 
 def absorption_filter(kind: str, g: float, depth: float, delay: float = 0.0,
-                      period: float | None = None, transfer: str = "piston"
-                      ) -> tuple[float, np.ndarray, np.ndarray]:
+                      period: float | None = None, transfer: str = "piston",
+                      profile_kd: float = 0.0) -> tuple[float, np.ndarray, np.ndarray]:
     """(D [1/s], tau [s], c [1/s]) of the correction du = n_x [D e + sum_j c_j x_j] with
     dx_j/dt = (e - x_j)/tau_j (module docstring). ``shallow``/``linear``: D = absorption_gain,
     c = 0 (a plain gain). ``filter``: fitted to G(omega) exp(-i k delay) over FILTER_KD_BAND
-    (G the ``transfer`` gain),
-    exact at ``period`` when given; ``delay`` [m] is the gauge's distance inside the face."""
+    (G the ``transfer`` gain of the correction profile ``profile_kd``), exact at ``period``
+    when given; ``delay`` [m] is the gauge's distance inside the face."""
     tau = np.asarray(FILTER_TAUS) * math.sqrt(depth / g)
     if kind != "filter":
-        return absorption_gain(kind, g, depth, period, transfer), tau, np.zeros(N_FILTER)
+        return (absorption_gain(kind, g, depth, period, transfer, profile_kd), tau,
+                np.zeros(N_FILTER))
     if not (depth > 0 and g > 0 and delay >= 0):
         raise ValueError(f"depth ({depth}), g ({g}) must be > 0, delay ({delay}) >= 0")
     kd = np.geomspace(*FILTER_KD_BAND, 200)
@@ -142,7 +192,8 @@ def absorption_filter(kind: str, g: float, depth: float, delay: float = 0.0,
         kd = np.append(kd, linear_wavenumber(omega0, depth, g) * depth)
         weight = np.append(weight, 1e3)  # exact at the wave's own frequency
     omega = np.sqrt(g * kd * np.tanh(kd) / depth)
-    target = transfer_gain(omega, kd, transfer) * np.exp(-1j * kd * delay / depth)  # delayed
+    target = (transfer_gain(omega, kd, transfer, profile_kd)
+              * np.exp(-1j * kd * delay / depth))  # delayed
     cols = np.column_stack([np.ones(kd.size)] + [1.0 / (1.0 + 1j * omega * t) for t in tau])
     a = cols / target[:, None]  # relative error: the reflection is set by H_fit/H - 1
     band = np.ones(kd.size)
@@ -158,11 +209,13 @@ def absorption_filter(kind: str, g: float, depth: float, delay: float = 0.0,
 
 
 def filter_reflection(d_gain: float, tau: np.ndarray, c: np.ndarray, g: float, depth: float,
-                      delay: float, kd: np.ndarray, transfer: str = "piston") -> np.ndarray:
+                      delay: float, kd: np.ndarray, transfer: str = "piston",
+                      profile_kd: float = 0.0) -> np.ndarray:
     """Reflection |(1 - rho)/(1 + rho)| of a correction (D, tau, c) at wavenumbers kd against the
     ideal H(omega) = G(omega) exp(-i k delay), rho = H_filter / H (the gain error alone)."""
     kd = np.asarray(kd, dtype=float)
     omega = np.sqrt(g * kd * np.tanh(kd) / depth)
     h_fit = d_gain + sum(cj / (1.0 + 1j * omega * tj) for cj, tj in zip(c, tau))
-    rho = h_fit / (transfer_gain(omega, kd, transfer) * np.exp(-1j * kd * delay / depth))
+    rho = h_fit / (transfer_gain(omega, kd, transfer, profile_kd)
+                   * np.exp(-1j * kd * delay / depth))
     return np.abs((1.0 - rho) / (1.0 + rho))

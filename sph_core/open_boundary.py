@@ -12,10 +12,12 @@ x_f, outward normal n_x (-1 left, +1 right); d = (x - x_f) n_x is the depth into
 
 Every step, for buffer particle i of end b (the window [t0, t1] holds the source's samples,
 interpolated linearly in time and linearly in z between the nodes):
-    u_i = u(z_i, t) + du_b,  w_i = w(z_i, t),  x_i += dt u_i       (z_i fixed: layers stay level)
+    u_i = u(z_i, t) + du_b P_b(z_i),  w_i = w(z_i, t),  x_i += dt u_i  (z_i fixed: layers level)
     du_b = n_x (eta_meas,b - eta_gauge,b(t)) G  if absorbing   (seed 002 correction; the gain G
            in the ends' sqgd: sqrt(g/d) there, Biesel's piston gain at the period "linear", see
-           sph_core.absorption; by default a causal filter of e following it per frequency)
+           sph_core.absorption; by default a causal filter of e following it per frequency);
+           P_b the correction's vertical profile (ends.corr_prof on the nodes: 1 for a piston,
+           linear theory's cosh k(z + d) at the wave period for the "mode" profile)
     surface z_s,b = swl + eta_b(t)  (elevation imposed)  or, extrapolated, swl + eta_meas,b (surface
     "gauge") or swl + eta_b(t) + (eta_meas,b - eta_gauge,b(t)) (surface "face": the source's
     elevation at the face plus the gauge's mismatch)
@@ -101,6 +103,19 @@ def profile_value(zn, a, r, z):
 
 
 @njit(cache=True)
+def node_value(zn, a, z):
+    """Profile a[node] at height z: linear in z between nodes zn (clamped at the ends)."""
+    nn = zn.size
+    k = np.searchsorted(zn, z)
+    if k <= 0:
+        return a[0]
+    if k >= nn:
+        return a[nn - 1]
+    s = (z - zn[k - 1]) / (zn[k] - zn[k - 1])
+    return (1.0 - s) * a[k - 1] + s * a[k]
+
+
+@njit(cache=True)
 def window_weight(t, win_t):
     """Weight r of the window end in the linear time interpolation, clamped to [0, 1]."""
     span = win_t[1] - win_t[0]
@@ -177,7 +192,7 @@ def buffer_update(ps, n, dt, r, zs0, du0, zs1, du1, ends, prm):
         zi = z[i]
         zs = zs0 if b == 0 else zs1
         du = du0 if b == 0 else du1
-        u = profile_value(zn[b], win_u[b], r, zi) + du
+        u = profile_value(zn[b], win_u[b], r, zi) + du * node_value(zn[b], ends.corr_prof[b], zi)
         w = profile_value(zn[b], win_w[b], r, zi)
         vx[i] = u
         vz[i] = w
@@ -216,7 +231,8 @@ def buffer_transitions(ps, n, ends, r, zs0, du0, zs1, du1):
                 nx = ends.nx[b]
                 d = (x[i] - ends.x_face[b]) * nx
                 if ends.on[b] and d >= 0.0:
-                    u = profile_value(ends.zn[b], ends.win_u[b], r, z[i]) + (du0 if b == 0 else du1)
+                    u = (profile_value(ends.zn[b], ends.win_u[b], r, z[i])
+                         + (du0 if b == 0 else du1) * node_value(ends.zn[b], ends.corr_prof[b], z[i]))
                     if u * nx > 0.0 or d >= ends.dp:
                         zs = zs0 if b == 0 else zs1
                         kind[i] = INLET + b if z[i] < zs else INLET_IDLE + b

@@ -23,7 +23,8 @@ from typing import Mapping
 
 import numpy as np
 
-from .absorption import absorption_filter, source_period
+from .absorption import (absorption_filter, correction_profile, profile_wavenumber,
+                         source_period)
 from .boundary_data import (BoundaryData, BoundaryDataError, BoundaryNodes, BoundarySample,
                             still_sample, validate_sample)
 from .eos import GAMMA, hydrostatic_density
@@ -120,9 +121,12 @@ class OpenBoundaries:
             e.swl[b] = swl
             e.zs[b] = swl   # at rest until the first update
             period = o.absorption_period or source_period(sources.get(o.side))
+            q = profile_wavenumber(o.absorption_profile, c.g, depth, period)
             e.sqgd[b], e.filt_tau[b], e.filt_c[b] = absorption_filter(
                 o.absorption, c.g, depth, abs(nd.x_gauge - nd.x_face), period,
-                o.absorption_transfer)
+                o.absorption_transfer, q)
+            # the profile above the still-water level continues linear theory's cosh (crests)
+            e.corr_prof[b] = correction_profile((nd.z - nd.z_bed) / depth, q)
             e.absorb[b] = o.absorb
             e.imposed[b] = o.elevation == "imposed"
             e.surface_at_face[b] = o.surface == "face"

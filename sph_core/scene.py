@@ -395,7 +395,11 @@ class OpenBoundary(_Model):
     measured best: docs/absorption.md) a causal filter following the ideal gain frequency by
     frequency, delayed by the gauge's offset (exact at the wave period when one is known).
     ``absorption_transfer`` is that ideal gain: ``piston`` (default) Biesel's transfer function
-    of a depth-uniform wave maker, ``flux`` omega/(k d) (low by 19 % at kd 2)."""
+    of a depth-uniform wave maker, ``flux`` omega/(k d) (low by 19 % at kd 2).
+    ``absorption_profile``: the correction's vertical profile, ``mode`` (default) linear
+    theory's cosh k(z + d) at the wave period (its gain by the same projection as Biesel's),
+    ``uniform`` a piston, whose evanescent near field the gauge reads back (at kd 2: 19 % of
+    its wave at 2h, H/dp 4)."""
 
     side: Literal["left", "right"]
     elevation: Literal["imposed", "extrapolated"] = "imposed"
@@ -409,6 +413,12 @@ class OpenBoundary(_Model):
         "piston", description="ideal gain of the depth-uniform correction: Biesel's piston "
                               "transfer function, or the depth-mean velocity omega/(k d) "
                               "(sph_core.absorption.transfer_gain)")
+    absorption_profile: Literal["uniform", "mode"] = Field(
+        "mode", description="vertical profile of the correction: linear theory's orbital "
+                            "velocity cosh k(z + d) at the wave period (default: no evanescent "
+                            "near field for the gauge to read back; uniform when no period is "
+                            "known), or uniform over the depth (a piston; "
+                            "sph_core.absorption.correction_profile, docs/absorption.md)")
     absorption_period: float | None = Field(None, gt=0, description="wave period [s] of the "
                                             "linear absorption gain (None: the source's)")
     gauge_offset: float | None = Field(None, gt=0, description="boundary gauge distance inside the face [m]")

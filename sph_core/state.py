@@ -175,6 +175,9 @@ class OpenEnds(NamedTuple):
     # bool[2]: a measured (extrapolated) surface is the source's elevation at the face plus the
     # gauge's mismatch (else the gauge's reading itself; scene.OpenBoundary.surface)
     surface_at_face: np.ndarray
+    # [2, nodes]: the absorption correction's vertical profile on zn (depth mean 1 below the
+    # still-water level; all ones: a depth-uniform piston; sph_core.absorption.correction_profile)
+    corr_prof: np.ndarray
 
 
 def closed_ends(capacity: int, n_nodes: int = 2) -> OpenEnds:
@@ -187,4 +190,5 @@ def closed_ends(capacity: int, n_nodes: int = 2) -> OpenEnds:
                     np.zeros((2, 2, n_nodes)), np.zeros((2, 2, n_nodes)), np.zeros((2, 2)),
                     np.zeros((2, 2)), np.full(2, np.nan), z2(), np.zeros((2, 4), dtype=np.int64),
                     np.zeros(1, dtype=np.int64), np.ones((2, N_FILTER)),
-                    np.zeros((2, N_FILTER)), np.zeros((2, N_FILTER)), b2())
+                    np.zeros((2, N_FILTER)), np.zeros((2, N_FILTER)), b2(),
+                    np.ones((2, n_nodes)))

@@ -8,8 +8,9 @@ import numpy as np
 import pytest
 
 from sph_core import open_boundary as ob
-from sph_core.absorption import (absorption_filter, absorption_gain, filter_reflection,
-                                 linear_wavenumber, source_period)
+from sph_core.absorption import (absorption_filter, absorption_gain, correction_profile,
+                                 filter_reflection, linear_wavenumber, profile_wavenumber,
+                                 source_period, transfer_gain)
 from sph_core.boundary_data import WaveModelBoundary
 from sph_core.open_ends import OpenBoundaries, flume_nodes
 from sph_core.scene import make_scene
@@ -54,6 +55,54 @@ def test_piston_gain_swallows_the_progressive_mode(kd):
         assert gain / flux == pytest.approx(1.19, abs=0.005)
     with pytest.raises(ValueError, match="absorption_transfer"):
         absorption_gain("linear", G, D, 1.0, transfer="deep")
+
+
+@pytest.mark.parametrize("q", [0.0, 0.8, 2.0])
+@pytest.mark.parametrize("kd", [0.3, 1.2, 2.0])
+def test_profiled_gain_swallows_the_progressive_mode(q, kd):
+    """A correction U P(z) with the mode profile of a wave of kd q (depth mean 1) cancels an
+    outgoing Airy wave of amplitude a iff U P and the wave's u(z) have the same projection on
+    cosh k(z + d): G = omega int phi^2 / (sinh kd int P phi), integrated numerically here. At
+    its own wave (q = kd) the profile is the wave's, and G is the flux gain omega/(k d)."""
+    k = kd / D
+    omega = math.sqrt(G * k * math.tanh(kd))
+    n = 4000
+    s = (np.arange(n) + 0.5) / n  # height above the bed / d
+    prof = correction_profile(s, q)
+    assert prof.mean() == pytest.approx(1.0, rel=1e-6)  # same flux as the piston
+    phi = np.cosh(kd * s)
+    want = omega * np.sum(phi ** 2) / (math.sinh(kd) * np.sum(prof * phi))
+    assert transfer_gain(omega, kd, "piston", q) == pytest.approx(want, rel=1e-6)
+    if q == kd:
+        assert transfer_gain(omega, kd, "piston", q) == pytest.approx(omega / kd, rel=1e-9)
+        # the surface velocity per unit elevation is Airy's omega / tanh kd
+        assert want * prof[-1] == pytest.approx(omega / math.tanh(kd), rel=2e-3)
+    if q == 0.0:
+        assert transfer_gain(omega, kd, "piston", q) == pytest.approx(
+            absorption_gain("linear", G, D, 2 * math.pi / omega), rel=1e-9)
+    with pytest.raises(ValueError, match="profile_kd"):
+        transfer_gain(omega, kd, "piston", -1.0)
+
+
+def test_mode_profile_of_the_flume_is_its_wave_period():
+    """absorption_profile "mode": the ends' correction profile is cosh k(z + d) at the source's
+    period (k from linear dispersion), depth mean 1 below still water; "uniform" all ones;
+    the filter is then fitted to the profiled gain, exact at the wave period."""
+    ends = _ends("filter", profile="mode")
+    kd0 = linear_wavenumber(2 * math.pi, D, G) * D
+    assert profile_wavenumber("mode", G, D, 1.0) == pytest.approx(kd0)
+    assert profile_wavenumber("mode", G, D, None) == 0.0
+    zn = ends.ends.zn[1]
+    want = np.cosh(kd0 * zn / D) * kd0 / math.sinh(kd0)
+    assert np.allclose(ends.ends.corr_prof[1], want, rtol=1e-12)
+    assert (_ends("filter").ends.corr_prof == 1.0).all()
+    e = ends.ends
+    refl = filter_reflection(e.sqgd[1], e.filt_tau[1], e.filt_c[1], G, D,
+                             abs(ends.nodes["right"].x_gauge - ends.nodes["right"].x_face),
+                             np.array([kd0]), "piston", kd0)
+    assert refl[0] < 1e-3
+    with pytest.raises(ValueError, match="absorption_profile"):
+        profile_wavenumber("flap", G, D, 1.0)
 
 
 def test_linear_gain_tends_to_the_shallow_water_gain_for_long_waves():
@@ -144,9 +193,10 @@ def test_checkpoint_keeps_the_filter_state():
     assert (ends.ends.filt_x == 0.25).all()
 
 
-def _ends(absorption: str, period_field: float | None = None) -> OpenBoundaries:
+def _ends(absorption: str, period_field: float | None = None,
+          profile: str = "uniform") -> OpenBoundaries:
     sides = [{"side": s, "elevation": e, "absorption": absorption,
-              "absorption_period": period_field}
+              "absorption_period": period_field, "absorption_profile": profile}
              for s, e in (("left", "imposed"), ("right", "extrapolated"))]
     scene = make_scene({
         "dp": 0.02, "t_end": 1.0, "still_water_level": D,
