@@ -274,6 +274,7 @@ def _particle_loads(ps, n, cells, prm, bd):
     vz = ps.vz
     rho = ps.rho
     p = ps.p
+    pw = ps.pw     # fluid: the p_i the walls felt in fluid_pass (p or max(p, 0))
     m = ps.m
     vwx = ps.vwx
     vwz = ps.vwz
@@ -322,8 +323,9 @@ def _particle_loads(ps, n, cells, prm, bd):
                         if r2 < s2:
                             fij = f_of_q(math.sqrt(r2) * inv_h, af)
                             rhoi = rho[i]
-                            # fluid_pass's fluid-wall pair: no tension across a wall
-                            pf = mj * (max(p[i], 0.0) + pj) / (rhoi * rhoj)
+                            # fluid_pass's fluid-wall pair, with the p_i the wall felt there
+                            # (no tension while i approaches the wall)
+                            pf = mj * (pw[i] + pj) / (rhoi * rhoj)
                             pax = 0.0
                             paz = 0.0
                             if noslip:

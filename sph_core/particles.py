@@ -39,13 +39,16 @@ LXX, LXZ, LZZ = range(23, 26)
 # no-penetration velocity correction of fluid particles at a wall face (wall_contact.py),
 # recomputed in every force pass and added by the kick / corrector
 DVNX, DVNZ = range(26, 28)
-N_FIELDS = 28
+# fluid: the pressure its wall neighbours feel from it, p or max(p, 0) (wcsph.fluid_pass), read
+# by the body loads and force probes so they are the reaction of what the fluid felt
+PW = 28
+N_FIELDS = 29
 N_SORTED_KDK = 9
 N_SORTED_PC = 14
 
 FIELD_NAMES = ("x", "z", "vx", "vz", "ax", "az", "rho", "p", "m",
                "xn", "zn", "vxn", "vzn", "rhon", "drho", "vwx", "vwz",
-               "gpx", "gpz", "gux", "guz", "gwx", "gwz", "lxx", "lxz", "lzz", "dvnx", "dvnz")
+               "gpx", "gpz", "gux", "guz", "gwx", "gwz", "lxx", "lxz", "lzz", "dvnx", "dvnz", "pw")
 
 
 @dataclass

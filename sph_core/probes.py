@@ -129,8 +129,9 @@ def fluid_neighbour_counts(ps, n, cells, h, counts):
 @njit(cache=True)
 def wall_force(ps, cells, slots, xm, zm, h, alpha_f):
     """(F_x, F_z, M_y) the fluid exerts on the wall particles ``slots``: minus the pressure pair
-    forces m_f m_s (max(p_f, 0) + p_s)/(rho_f rho_s) F_fs r_fs of wcsph.fluid_pass (no tension
-    across a wall); M_y about (xm, zm)."""
+    forces m_f m_s (max(p_f, 0) + p_s)/(rho_f rho_s) F_fs r_fs of wcsph.fluid_pass; M_y about (xm, zm).
+    No tension across a wall: fluid_pass drops it only while p_f approaches the wall (its pw row),
+    but a probe reads the state after the step's sort, where that row is not carried."""
     x = ps.x
     z = ps.z
     kind = ps.kind

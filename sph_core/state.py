@@ -20,7 +20,7 @@ import numpy as np
 
 from .absorption import N_FILTER
 from .particles import (AX, AZ, DRHO, DVNX, DVNZ, GPX, GPZ, GUX, GUZ, GWX, GWZ, LXX, LXZ, LZZ,
-                        M, P, RHO, RHON, VWX, VWZ, VX, VXN, VZ, VZN, XN, ZN, X, Z)
+                        M, P, PW, RHO, RHON, VWX, VWZ, VX, VXN, VZ, VZN, XN, ZN, X, Z)
 
 
 class Particles(NamedTuple):
@@ -59,6 +59,7 @@ class Particles(NamedTuple):
     lzz: np.ndarray
     dvnx: np.ndarray     # fluid: no-penetration velocity correction at a wall face (wall_contact.py)
     dvnz: np.ndarray
+    pw: np.ndarray       # fluid: the pressure its walls feel from it, p or max(p, 0) (wcsph.fluid_pass)
     kind: np.ndarray     # int8: particles.FLUID, WALL, INLET, ...
     ids: np.ndarray      # int64 identity, kept through sorts
     cell: np.ndarray     # int64 cell index of the slot (set by the sort)
@@ -68,7 +69,8 @@ def particles_view(f: np.ndarray, kind: np.ndarray, ids: np.ndarray, cell: np.nd
     """Named views of the storage ``f`` (no copy)."""
     return Particles(f, f[X], f[Z], f[VX], f[VZ], f[AX], f[AZ], f[RHO], f[P], f[M], f[XN], f[ZN],
                      f[VXN], f[VZN], f[RHON], f[DRHO], f[VWX], f[VWZ], f[GPX], f[GPZ], f[GUX], f[GUZ],
-                     f[GWX], f[GWZ], f[LXX], f[LXZ], f[LZZ], f[DVNX], f[DVNZ], kind, ids, cell)
+                     f[GWX], f[GWZ], f[LXX], f[LXZ], f[LZZ], f[DVNX], f[DVNZ], f[PW],
+                     kind, ids, cell)
 
 
 class Cells(NamedTuple):

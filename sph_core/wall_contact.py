@@ -47,21 +47,27 @@ def face_shares(h: float, dp: float, n_layers: int, alpha_w: float) -> tuple[flo
 
 
 @njit(cache=True, inline="always")
+def approach_speed(g, nx, nz, gvx, gvz, vx, vz):
+    """u_n of a fluid particle with velocity (vx, vz) against its walls (< 0: towards them);
+    0 without wall neighbours. g, (nx, nz), (gvx, gvz) as in ``no_penetration``."""
+    nn = math.sqrt(nx * nx + nz * nz)
+    if g <= 0.0 or nn <= 0.0:
+        return 0.0
+    return ((vx - gvx / g) * nx + (vz - gvz / g) * nz) / nn
+
+
+@njit(cache=True, inline="always")
 def no_penetration(g, nx, nz, gvx, gvz, vx, vz, ga, g0, gb):
     """Velocity change (dvx, dvz) of a fluid particle with velocity (vx, vz), wall share g,
     unnormalised normal (nx, nz) and sum_s V_s W_is v_s = (gvx, gvz); (0, 0) if g <= ga."""
     if g <= ga:
         return 0.0, 0.0
-    nn = math.sqrt(nx * nx + nz * nz)
-    if nn <= 0.0:
-        return 0.0, 0.0
-    nx /= nn
-    nz /= nn
-    un = (vx - gvx / g) * nx + (vz - gvz / g) * nz
+    un = approach_speed(g, nx, nz, gvx, gvz, vx, vz)
     if un >= 0.0:
         return 0.0, 0.0
+    nn = math.sqrt(nx * nx + nz * nz)
     if g <= g0:
         f = (g - ga) / (g0 - ga)
     else:
         f = min(1.0 + (g - g0) / (gb - g0), 2.0)
-    return -f * un * nx, -f * un * nz
+    return -f * un * nx / nn, -f * un * nz / nn

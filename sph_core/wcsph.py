@@ -43,7 +43,7 @@ from .kernels import f_of_q, w_of_q
 from .neighbours import block_of
 from .particles import FLUID, INLET, OUTLET, WALL
 from .riemann import NO_RECONSTRUCTION, interface_state, limited
-from .wall_contact import no_penetration
+from .wall_contact import approach_speed, no_penetration
 
 # status codes returned by the time loop (step.run)
 ST_REACHED_T = 0
@@ -208,6 +208,7 @@ def fluid_pass(ps, n, cells, prm):
     inv_rho0 = 1.0 / rho0
     dvnx = ps.dvnx
     dvnz = ps.dvnz
+    pw = ps.pw
     for i in prange(n):
         if kind[i] == FLUID:
             xi = x[i]
@@ -231,6 +232,8 @@ def fluid_pass(ps, n, cells, prm):
             gnz = 0.0
             gvx = 0.0
             gvz = 0.0
+            tx = 0.0     # the walls' push that a particle in tension (p_i < 0) would not feel
+            tz = 0.0
             cxl, cxh, czl, czh = block_of(cell[i], cells)
             for zz in range(czl, czh + 1):
                 row = zz * ncx
@@ -284,10 +287,8 @@ def fluid_pass(ps, n, cells, prm):
                         pf = 2.0 * vol * pstar * inv_rhoi
                     else:
                         cont -= vol * fij * (dvx * dx + dvz * dz)
-                        # m_j (p_i + p_j) / (rho_i rho_j), with the divisions shared per pair;
-                        # against a wall no tension (p_i >= 0, as p_j >= 0 in wall_pass): a fluid
-                        # particle in tension beside a wall is otherwise pulled into it
-                        pf = vol * ((max(pi, 0.0) if kj == WALL else pi) + p[j]) * inv_rhoi
+                        # m_j (p_i + p_j) / (rho_i rho_j), with the divisions shared per pair
+                        pf = vol * (pi + p[j]) * inv_rhoi
                         # height of i above j along gravity (z_i - z_j for g = (0, -g)); wall
                         # densities come from the Adami extrapolation, so they carry the
                         # hydrostatic part as the fluid's do and take part in the diffusion
@@ -296,14 +297,21 @@ def fluid_pass(ps, n, cells, prm):
                     if kj == WALL:
                         dvx = vxi - vwx[j]
                         dvz = vzi - vwz[j]
-                        if nopen:
-                            vg = mj * inv_rho0
-                            wg = vg * w_of_q(math.sqrt(r2) * inv_h, aw)
-                            gw += wg
-                            gnx += vg * fij * dx
-                            gnz += vg * fij * dz
-                            gvx += wg * vx[j]
-                            gvz += wg * vz[j]
+                        vg = mj * inv_rho0
+                        wg = vg * w_of_q(math.sqrt(r2) * inv_h, aw)
+                        gw += wg
+                        gnx += vg * fij * dx
+                        gnz += vg * fij * dz
+                        gvx += wg * vx[j]
+                        gvz += wg * vz[j]
+                        if pi < 0.0 and not rs:
+                            pt = -vol * pi * inv_rhoi
+                            if kgc:
+                                tx += pt * fij * (lxxi * dx + lxzi * dz)
+                                tz += pt * fij * (lxzi * dx + lzzi * dz)
+                            else:
+                                tx += pt * fij * dx
+                                tz += pt * fij * dz
                     if kgc:
                         # the pressure part alone goes through L; viscosity keeps grad W
                         if kj == WALL:
@@ -327,6 +335,16 @@ def fluid_pass(ps, n, cells, prm):
                         fz -= lam * fij * dvz
                     fx += pf * fij * dx
                     fz += pf * fij * dz
+            # no tension across a wall while the particle approaches it (p_i -> max(p_i, 0)): a
+            # particle in tension is otherwise pulled into the wall (a dry-bed front sinks
+            # through the bed); one that moves away keeps the pull, so a thin swash film stays
+            # on its beach (docs/wall_pressure.md, session 7)
+            pwi = pi
+            if pi < 0.0 and approach_speed(gw, gnx, gnz, gvx, gvz, vxi, vzi) < 0.0:
+                fx += tx
+                fz += tz
+                pwi = 0.0
+            pw[i] = pwi
             ax[i] = fx + gx
             az[i] = fz + gz
             drho[i] = rhoi * cont + ddiff * diff
