@@ -824,7 +824,7 @@ class IsphStepper:
             # loads come from this step's pressure at r^n (bodies._particle_loads: pressure and
             # laminar pair terms; ISPH's Params carry alpha 0, so no artificial viscosity), and
             # they advance over the step with that acceleration (the kdk stages back to back)
-            ps.pw[:n] = np.maximum(ps.p[:n], 0.0)   # no tension across a body's face
+            np.maximum(ps.p[:n], 0.0, out=ps.pw[:n])   # no tension across a body's face
             body_loads(ps, n, cells, prm, bd)
             bodies_kick_drift(bd, t, dt)
             bodies_kick(bd, t, dt)

@@ -40,7 +40,7 @@ LXX, LXZ, LZZ = range(23, 26)
 # recomputed in every force pass and added by the kick / corrector
 DVNX, DVNZ = range(26, 28)
 # fluid: the pressure its wall neighbours feel from it, p or max(p, 0) (wcsph.fluid_pass), read
-# by the body loads and force probes so they are the reaction of what the fluid felt
+# by the body loads so they are the reaction of what the fluid felt (not carried by a sort)
 PW = 28
 N_FIELDS = 29
 N_SORTED_KDK = 9

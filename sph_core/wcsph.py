@@ -339,8 +339,9 @@ def fluid_pass(ps, n, cells, prm):
             # particle in tension is otherwise pulled into the wall (a dry-bed front sinks
             # through the bed); one that moves away keeps the pull, so a thin swash film stays
             # on its beach (docs/wall_pressure.md, session 7)
+            # (the Riemann flux has no such pair term: tx = 0, and its bodies keep max(p_i, 0))
             pwi = pi
-            if pi < 0.0 and approach_speed(gw, gnx, gnz, gvx, gvz, vxi, vzi) < 0.0:
+            if pi < 0.0 and (rs or approach_speed(gw, gnx, gnz, gvx, gvz, vxi, vzi) < 0.0):
                 fx += tx
                 fz += tz
                 pwi = 0.0
