@@ -59,9 +59,6 @@ STATUS_TEXT = {
     ST_CAPACITY: "particle capacity exhausted by open-boundary inflow",
 }
 
-INTEGRATORS = {"kdk": 0, "symplectic_pc": 1}
-KDK = 0
-SYMPLECTIC_PC = 1
 
 # fast-math for the interaction passes, without the no-NaN/no-inf assumptions: the stability
 # guard must still see a NaN produced there
@@ -101,10 +98,11 @@ def wall_pass(ps, n, cells, prm):
 
 
 @njit(parallel=True, cache=True, fastmath=FASTMATH)
-def fluid_pass(ps, n, cells, prm):
+def fluid_pass(ps, n, cells, prm, riemann):
     """The gather over fluid particles: continuity, delta-SPH, pressure, viscosity, gravity
-    (terms.wcsph_pair), or with ``prm.riemann`` the Riemann SPH flux (terms.riemann_pair; MUSCL
-    gradients from riemann_gradients). Writes ax, az, drho, pw and the no-penetration velocity
+    (terms.wcsph_pair), or with ``riemann`` True (not None) the Riemann SPH flux
+    (terms.riemann_pair; MUSCL gradients from riemann_gradients). A None ``riemann`` compiles
+    the WCSPH pair alone (step.py). Writes ax, az, drho, pw and the no-penetration velocity
     change dvnx, dvnz (wall_contact.py) of each fluid particle; returns nothing (reductions are
     in the kicks)."""
     # only the rows written need locals (numba drops prange stores made through ps.row[i])
@@ -115,7 +113,6 @@ def fluid_pass(ps, n, cells, prm):
     dvnz = ps.dvnz
     pw = ps.pw
     kind = ps.kind
-    rs = prm.riemann
     # no penetration at wall faces (wall_contact.py): g0 = 0 turns it off
     nopen = prm.wall_g0 > 0.0
     for i in prange(n):
@@ -124,11 +121,11 @@ def fluid_pass(ps, n, cells, prm):
             # lowering, and it costs a few flops against ~30 pairs)
             k = fluid_consts(prm)
             fi = fluid_i(i, ps, k)
-            if rs:
-                a = gather(i, fi.x, fi.z, ps.cell[i], ps, cells, k.s2, interacting, riemann_pair,
+            if riemann is None:
+                a = gather(i, fi.x, fi.z, ps.cell[i], ps, cells, k.s2, interacting, wcsph_pair,
                            (k, fi), FLUID_SUMS_ZERO)
             else:
-                a = gather(i, fi.x, fi.z, ps.cell[i], ps, cells, k.s2, interacting, wcsph_pair,
+                a = gather(i, fi.x, fi.z, ps.cell[i], ps, cells, k.s2, interacting, riemann_pair,
                            (k, fi), FLUID_SUMS_ZERO)
             fx = a.fx
             fz = a.fz
@@ -138,8 +135,9 @@ def fluid_pass(ps, n, cells, prm):
             # on its beach (docs/wall_pressure.md). The Riemann flux has no such pair term
             # (tx = 0): its walls always feel max(p_i, 0)
             pwi = fi.p
-            if fi.p < 0.0 and (rs or approach_speed(a.gw, a.gnx, a.gnz, a.gvx, a.gvz, fi.vx,
-                                                    fi.vz) < 0.0):
+            if fi.p < 0.0 and (riemann is not None
+                               or approach_speed(a.gw, a.gnx, a.gnz, a.gvx, a.gvz, fi.vx,
+                                                 fi.vz) < 0.0):
                 fx += a.tx
                 fz += a.tz
                 pwi = 0.0
