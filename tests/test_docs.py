@@ -52,21 +52,21 @@ def _doc_files() -> list[Path]:
 
 
 def relative_targets(path: Path) -> list[str]:
-    """The relative link targets of a markdown file (no URLs, no pure #anchors), code spans
-    and fenced blocks left out."""
+    """The relative link targets of a markdown file (no URLs; '#x' for an anchor in the file
+    itself), code spans and fenced blocks left out."""
     text = re.sub(r"```.*?```", "", path.read_text(encoding="utf-8"), flags=re.S)
     text = re.sub(r"`[^`\n]*`", "", text)
     out = []
     for target in _LINK.findall(text):
-        if re.match(r"^[a-z][a-z0-9+.-]*:", target) or target.startswith("#"):
+        if re.match(r"^[a-z][a-z0-9+.-]*:", target):
             continue
         out.append(target)
     return out
 
 
 def relative_links(path: Path) -> list[str]:
-    """The relative link targets of a markdown file, without their #anchors."""
-    return [target.split("#", 1)[0] for target in relative_targets(path)]
+    """The relative files a markdown file links to, without their #anchors."""
+    return [t.split("#", 1)[0] for t in relative_targets(path) if not t.startswith("#")]
 
 
 def anchors(path: Path) -> set[str]:
@@ -83,7 +83,7 @@ def test_relative_links_resolve() -> None:
     for path in _doc_files():
         for target in relative_targets(path):
             file, _, anchor = target.partition("#")
-            dest = path.parent / file
+            dest = path.parent / file if file else path
             if not dest.exists():
                 broken.append(f"{path.relative_to(ROOT)} -> {target}")
             elif anchor and dest.suffix == ".md" and anchor not in anchors(dest):

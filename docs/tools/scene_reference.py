@@ -83,8 +83,10 @@ def type_name(tp: Any) -> str:
         inner = _strip_annotated(item)
         if _is_model(inner):
             return f"array of [{inner.__name__}](#{anchor(inner.__name__)})"
-        if _union_members(inner) is not None and all(_is_model(m) for m in _union_members(inner)):
-            return "array of tables, by `kind`"
+        members = _union_members(inner)
+        if members is not None and all(_is_model(m) for m in members):
+            return "array of tables by `kind`: " + ", ".join(
+                f"[{m.__name__}](#{anchor(m.__name__)})" for m in members)
         return f"[{type_name(item)}, ...]"
     if _is_model(tp):
         return f"table [{tp.__name__}](#{anchor(tp.__name__)})"

@@ -22,8 +22,8 @@ ROOT = Path(__file__).resolve().parents[2]
 RESULTS = ROOT / "bench" / "results"
 PAGE = ROOT / "docs" / "validation.md"
 
-# question -> (title, what it asks); tables appear in this order, unknown questions last
-QUESTIONS: dict[str, tuple[str, str]] = {
+# question -> (title, what it asks[, a figure]); tables appear in this order, unknown ones last
+QUESTIONS: dict[str, tuple[str, ...]] = {
     "speed": ("Speed", "How fast is the SPH solver, the demo and the test suite?"),
     "wave_decay": ("Wave decay", "How much of its height does an SPH wave lose per wavelength?"),
     "open_boundaries": ("Open-boundary wave flume",
@@ -31,13 +31,23 @@ QUESTIONS: dict[str, tuple[str, str]] = {
                         "(Cases of Verbrugghe et al. 2019, a flume one wavelength long.)"),
     "coupling": ("Coupling", "What does coupling cost, and how accurate is the coupled flume?"),
     "violent_flows": ("Violent flows", "Dam-break front and wall pressure against experiments."),
+    "still_water": ("Still water", "Does a tank at rest stay at rest, with hydrostatic pressure?"),
     "schemes": ("Schemes", "Riemann SPH and ISPH against WCSPH on the same code."),
+    "accuracy": ("Speed against accuracy",
+                 "Error against wall time per case, method and resolution (the quick preset of the "
+                 "sweep `wavesph plan` fits; data `wavesph/cases/data/accuracy_sweep.csv`). Methods: "
+                 "`wcsph_kdk` (h/dp √2, wall AV 1), `wcsph_kdk_h2_wallav0` (today's WCSPH defaults), "
+                 "`riemann_muscl`, `isph_bicgstab`; flume cases of Verbrugghe et al. (2019); "
+                 "`coupled`: 2 wavelengths of Boussinesq before the SPH zone, against SPH alone over "
+                 "the same length. Wall times under load.",
+                 "![speed-accuracy chart, quick preset, under load](figures/accuracy_quick.png)"),
     "bodies": ("Rigid bodies", "Floating and moving bodies against theory."),
     "boussinesq": ("Boussinesq model", "The far-field wave model against its own theory."),
     "stability": ("Stability suite",
                   "Which scenarios each integrator survives: stable (every measure within its "
                   "bound), noisy (ran through, the measure past its bound), unstable (stopped by "
-                  "the guard). Quick sizes; scenarios in wavesph/studies/stability.py."),
+                  "the guard). Quick sizes; scenarios in `wavesph/studies/stability.py`.",
+                  "![stability grid, quick preset](figures/stability_quick.png)"),
     "planning": ("Planning", "Does `wavesph plan` predict the accuracy and wall time of a run?"),
 }
 
@@ -119,11 +129,11 @@ def render(results: Path = RESULTS) -> str:
         group = [r for r in records if r["question"] == q]
         if not group:
             continue
-        title, ask = QUESTIONS.get(q, (q.replace("_", " ").capitalize(), ""))
+        title, ask, *figure = QUESTIONS.get(q, (q.replace("_", " ").capitalize(), ""))
         out += [f"## {title}", ""]
         if ask:
             out += [ask, ""]
-        out += table(group) + [""]
+        out += table(group) + [""] + [f + "\n" for f in figure]
     return "\n".join(out).rstrip() + "\n"
 
 
