@@ -36,7 +36,6 @@ from .store import GaugeWriter, RunStore, has_seal, is_sealed, read_gauge_rows
 log = logging.getLogger("wavesph.server")
 
 
-
 class Cancelled(Exception):
     """Raised inside a worker when the run's owner cancelled it."""
 
@@ -359,7 +358,7 @@ class RunManager:
 
     # ------------------------------------------------------------------ coupled
     async def _coupled(self, run: Run) -> None:
-        """Build the engine, then hold the slot until the client's session ends (see coupling.py)."""
+        """Build the engine, then hold the slot until the client's session ends (see doors.py)."""
         loop = asyncio.get_running_loop()
         try:
             run.engine = await loop.run_in_executor(self.builder, self.engine_factory,

@@ -196,7 +196,7 @@ def test_run_warns_when_a_scene_costs_far_more_than_the_plan(tmp_path):
 def test_shipped_sweep_data_plans_the_demo():
     rows = planning.sweep_data()
     assert rows and set(ACCURACY_COLUMNS) <= set(rows[0])
-    text = (ROOT / "cases" / planning.SWEEP_CSV).read_text()
+    text = (ROOT / "wavesph" / "cases" / planning.SWEEP_CSV).read_text()
     assert text.startswith("# made by: wavesph bench accuracy")
     from sph_core.scene import load_scene
 
