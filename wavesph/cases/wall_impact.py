@@ -34,7 +34,8 @@ WALL_HEIGHT = 1.2     # [m]
 COLUMN_LENGTH = 0.6   # [m]
 COLUMN_HEIGHT = 0.3   # [m] = H, the scale of the experiment's units
 SENSOR_Z = (0.003, 0.015, 0.030, 0.080)  # [m] above the bed, on the far wall
-LOBOVSKY_SENSOR1 = Path(__file__).resolve().parents[1] / "tests" / "data" / "lobovsky_2014_h300_sensor1.csv"
+LOBOVSKY_SENSOR1 = (Path(__file__).resolve().parents[2] / "tests" / "data"
+                    / "lobovsky_2014_h300_sensor1.csv")
 
 
 def lobovsky_scene(dp: float = 0.004, t_end: float = 2.0, probe_every: float = 2.5e-4,
