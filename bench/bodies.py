@@ -29,7 +29,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from cases.rigid_bodies import (archimedes_draft, box_draft, floating_box_scene,  # noqa: E402
+from wavesph.cases.rigid_bodies import (archimedes_draft, box_draft, floating_box_scene,  # noqa: E402
                                 hinged_flap_scene, spring_flap_period, zero_crossing_period,
                                 zero_gravity)
 from sph_core.particles import FLUID, M, VX, VZ  # noqa: E402
@@ -86,13 +86,13 @@ def _crossings(t: np.ndarray, y: np.ndarray) -> np.ndarray:
 def heave(dp: float, offset: float = 0.02, constants: dict | None = None,
           length: float = 3.2, t_end: float = 1.2, save: str | None = None) -> dict:
     """Undamped release ``offset`` too deep in a ``length`` closed tank, heave only, against
-    linear potential flow for the same tank and release (cases/heave_potential.py, converged: dx
+    linear potential flow for the same tank and release (wavesph/cases/heave_potential.py, converged: dx
     0.01 and 0.005 m give the same crossings within 0.3 %). Heave Z from the equilibrium position;
     the period measure is twice the time between its first two zero crossings (the motion is
     a heave mode coupled with the tank's sloshing, the same measure on both); the decay is the
     first half-cycle peak over the release offset, for both. ``constants``: [constants] of the
     scene (a study's one factor); ``save``: an .npz path for both series."""
-    from cases.heave_potential import heave_release
+    from wavesph.cases.heave_potential import heave_release
 
     d = archimedes_draft(DENSITY, HEIGHT)
     sim = _sim(floating_box_scene(dp=dp, breadth=BREADTH, height=HEIGHT, density=DENSITY,
@@ -145,11 +145,11 @@ SPRING_IN_WATER = 600.0   # N m/rad: natural frequency ~20 rad/s, radiation damp
 def spring_flap(dp: float) -> dict:
     """A bottom-hinged flap on a torsion spring in still water (0.3 m deep on both sides),
     started with a small rate, against linear wavemaker theory (added inertia and radiation
-    damping at the natural frequency, cases.rigid_bodies.spring_flap_in_water). The stiff spring
+    damping at the natural frequency, wavesph.cases.rigid_bodies.spring_flap_in_water). The stiff spring
     keeps the radiation damping small (a flap is an efficient wavemaker: at 10 rad/s it would
     be damped at ~0.8 of critical). Period: mean of the zero-crossing intervals over 1.5 s,
     before the radiated waves come back from the tank ends (~8 s)."""
-    from cases.rigid_bodies import spring_flap_in_water
+    from wavesph.cases.rigid_bodies import spring_flap_in_water
 
     ref = spring_flap_in_water(0.04, 0.4, 500.0, SPRING_IN_WATER, 0.3)
     t_end = 1.5
@@ -185,9 +185,9 @@ def spring_flap_air(dp: float) -> dict:
 
 def wedge(dp: float) -> dict:
     """Zhao et al. (1996) drop test: pressure along the face at 0.00435 s against Wagner's
-    theory with the run's own speed (cases/wedge_entry.py; the measured distributions were not
+    theory with the run's own speed (wavesph/cases/wedge_entry.py; the measured distributions were not
     at hand), and the SPH values at 0.0158 s (flow separated: no Wagner reference)."""
-    from cases.wedge_entry import TIMES, wedge_pressures, wedge_scene
+    from wavesph.cases.wedge_entry import TIMES, wedge_pressures, wedge_scene
 
     sim = _sim(wedge_scene(dp=dp))
     tic = time.perf_counter()
@@ -230,7 +230,7 @@ def momentum(dp: float) -> dict:
 
 def flume_throughput(dp: float, steps: int) -> list[dict]:
     """Particle-steps/s of the demo flume (closed, still water) without and with a floating box."""
-    from cases.demo_flume import demo_scene, depth_for
+    from wavesph.cases.demo_flume import demo_scene, depth_for
 
     base = demo_scene(dp, 10.0)
     base.pop("open_boundaries")
@@ -259,15 +259,15 @@ def flap_pitch(dp: float, t_end: float = 8.0) -> dict:
     waves H 0.04 m, T 1.4 s from the wave client, depth 0.24 m, flap 0.08 m thick, 500 kg/m^3,
     k = 20 N m/rad): pitch period (mean upward zero-crossing interval) and amplitude (half the
     peak-to-peak) over the last 3 wave periods, against the linear response of the flap in a
-    channel open on both sides (cases.rigid_bodies.flap_wave_response). Not seed 004's
+    channel open on both sides (wavesph.cases.rigid_bodies.flap_wave_response). Not seed 004's
     H 0.15 m, T 1.34 s: no published pitch amplitude for that set-up was found."""
     import csv
     import math
     import tempfile
 
-    from cases.demo_flume import (FLAP_SPRING, FLAP_THICKNESS, HEIGHT, PERIOD, depth_for,
+    from wavesph.cases.demo_flume import (FLAP_SPRING, FLAP_THICKNESS, HEIGHT, PERIOD, depth_for,
                                   run_demo)
-    from cases.rigid_bodies import flap_wave_response
+    from wavesph.cases.rigid_bodies import flap_wave_response
 
     d = depth_for(dp)
     tic = time.perf_counter()

@@ -3,7 +3,7 @@
     python bench/coupled_vs_sph.py [--dp 0.01] [--wavelengths 12] [--sph-only-seconds 3]
                                    [--modes two_way,absorption_only] [--out DIR]   (~30 min)
 
-The flume of cases/coupled_flume.py: regular waves (H = 0.04 m, T = 1.4 s, d = 0.24 m) from a
+The flume of wavesph/cases/coupled_flume.py: regular waves (H = 0.04 m, T = 1.4 s, d = 0.24 m) from a
 Boussinesq source --wavelengths wavelengths (12: 23.6 m) up-flume of an SPH zone (open inlet,
 1.2 m flat bed, 1:10 beach). Runs, at one particle spacing dp:
   reference        Boussinesq alone over the whole flume (beach to depth d/3, then a sponge)
@@ -40,8 +40,8 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from cases.coupled_flume import (FlumeCase, correlation, reference_run, rmse_over_h,  # noqa: E402
-                                  run_coupled, run_sph_only)
+from wavesph.cases.coupled_flume import (FlumeCase, correlation, reference_run,  # noqa: E402
+                                         rmse_over_h, run_coupled, run_sph_only)
 
 
 def _accuracy(c: FlumeCase, res: dict, gauge: str = "flat") -> dict:
@@ -73,7 +73,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--absorb", choices=("none", "client", "incident", "sph"), default=None,
                     help="who absorbs at the SPH inlet (default: the two-way boundary with the "
                          "client's incident-wave correction in two-way mode, the client in "
-                         "absorption-only; cases/coupled_flume.run_coupled)")
+                         "absorption-only; wavesph.cases.coupled_flume.run_coupled)")
     ap.add_argument("--h-over-dp", type=float, help="SPH smoothing length / dp (scene default)")
     ap.add_argument("--alpha-wall", type=float, help="SPH wall viscosity factor (scene default)")
     ap.add_argument("--out", type=Path, default=None, help="run directories (default: a temp dir)")

@@ -77,7 +77,7 @@ GOAL_SHARE = 0.02
 def beach_flume() -> dict:
     """The demo's flume (open inlet, 1:10 beach, closed end) at dp = 0.01 m (H/dp = 4): the
     top 0.314 m gives ceil(0.314 / (dp/2)) + 1 = 64 node levels at the inlet."""
-    from cases.demo_flume import demo_scene
+    from wavesph.cases.demo_flume import demo_scene
 
     scene = demo_scene(0.01, 100.0)
     d = scene["still_water_level"]

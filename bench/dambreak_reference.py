@@ -24,7 +24,7 @@ import numba
 import numpy as np
 
 from sph_core.progress import progress_bar
-from cases.dambreak import dambreak_scene, front_errors
+from wavesph.cases.dambreak import dambreak_scene, front_errors
 from sph_core.simulation import Simulation
 
 

@@ -35,7 +35,7 @@ import math
 import sys
 from pathlib import Path
 
-from cases.wave_flume import flume_case
+from wavesph.cases.wave_flume import flume_case
 from sph_core.absorption import ABSORPTION_KINDS, ABSORPTION_PROFILES, ABSORPTION_TRANSFERS
 from wave_client.theories import build_theory, wavenumber
 

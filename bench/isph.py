@@ -8,16 +8,16 @@
 so the kernels compile once); each line then carries its ``variant``.
 
 Cases (coarse; every wall time is of this process on whatever load the machine has):
-- still: still water d = 0.25 m, d/dp = 25 (tests/sph_core/test_hydrostatic.py's tank) for
+- still: still water d = 0.25 m, d/dp = 25 (tests/test_sph_core/test_hydrostatic.py's tank) for
   ``T_STILL`` s: bed pressure (pressure-line point dp/2 above the bed, mid-tank) over the second
   half: mean error against rho g d and std (noise); one line per PPE solver, PPE iterations per
   step, mean dt, wall s per simulated s;
-- dambreak: Martin & Moyce column a = 0.1 m, a/dp = 20, tank 5a (tests/cases/test_dambreak.py)
+- dambreak: Martin & Moyce column a = 0.1 m, a/dp = 20, tank 5a (tests/test_cases/test_dambreak.py)
   to T = t sqrt(2g/a) = 6 (the surge hits the right wall at T ~ 3.6): front error up to T = 3
   against Martin & Moyce and Koshizuka & Oka, the pressure noise at the right wall (1 cm above
-  the bed; std after a 10 Hz high-pass, cases.dambreak_obstacle.pressure_noise), mean dt, wall s
+  the bed; std after a 10 Hz high-pass, wavesph.cases.dambreak_obstacle.pressure_noise), mean dt, wall s
   per simulated s;
-- obstacle: seed 004's dam break on a tall structure in 2D (cases.dambreak_obstacle), dp 0.01 m:
+- obstacle: seed 004's dam break on a tall structure in 2D (wavesph.cases.dambreak_obstacle), dp 0.01 m:
   0.5 s (the impact peaks at ~0.33 s): peak force, its time, force noise; the traces go to
   runs/bench_isph/obstacle_<scheme>.csv.
 The first runs compile (numba); a warm-up scene runs first so wall times are of cached code.
@@ -33,8 +33,8 @@ from pathlib import Path
 
 import numpy as np
 
-from cases.dambreak import dambreak_scene, front_errors, martin_moyce_table
-from cases.dambreak_obstacle import pressure_noise, run_obstacle
+from wavesph.cases.dambreak import dambreak_scene, front_errors, martin_moyce_table
+from wavesph.cases.dambreak_obstacle import pressure_noise, run_obstacle
 from sph_core.scene import make_scene
 from sph_core.simulation import Simulation
 

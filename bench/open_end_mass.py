@@ -3,7 +3,7 @@ zero-mean oscillating flow.
 
     python bench/open_end_mass.py [--periods 5] [--dp 0.02] [--variants JSON]
 
-A flume 0.6 m long, still water 0.3 m deep (the test flume of tests/sph_core/test_open_boundary.py),
+A flume 0.6 m long, still water 0.3 m deep (the test flume of tests/test_sph_core/test_open_boundary.py),
 left end imposed, right end extrapolated; both ends impose a uniform horizontal flow
 u = U sin(2 pi t / T) (U 0.2 m/s, T 1 s) with a still surface: the imposed net flux is zero over
 each period, so the fluid count at whole periods should stay put. ``--variants``: a JSON list of

@@ -2,7 +2,7 @@
 
     python bench/option_cost.py [--dp 0.01] [--steps 2000] [--repeats 3] [--only WORD ...]
 
-The closed tank of cases.standing_wave (1.0 x 0.24 m of water, moving) stepped a fixed number
+The closed tank of wavesph.cases.standing_wave (1.0 x 0.24 m of water, moving) stepped a fixed number
 of steps per variant; variants are interleaved and repeated so that a change of machine load hits
 them alike. Each variant is the scene defaults with one option changed. Prints one JSON line per
 variant: particles, particle_steps_per_s (best of the repeats), ratio to the baseline, and

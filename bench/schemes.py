@@ -10,7 +10,7 @@ three scenes, all built by the cases' builders with ``scheme=`` (sph_core.scene.
   ``bed_p_noise_pa`` (its standard deviation);
 - Martin & Moyce's dam break (column a x 2a, a = 0.1 m, tank 4a, to T = t sqrt(2g/a) = 6; a/dp 20,
   quick 10): ``front_error`` (RMS relative error of the surge front for T <= 3, as
-  cases.sweeps), ``wall_pressure_noise_pa``: the standard deviation of the high-passed pressure
+  wavesph.studies.sweeps), ``wall_pressure_noise_pa``: the standard deviation of the high-passed pressure
   on the right wall at z = 0.2a (impact and after; the signal minus its centred moving average
   over 0.1 sqrt(a/g), sampled every 0.01 sqrt(a/g)), ``left_wall_pressure_noise_pa`` likewise
   at the column's wall (no impact: the collapse's smooth decay plus noise), ``impact_p_max_pa``;
@@ -39,9 +39,9 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 import numpy as np  # noqa: E402
 
-from cases.dambreak import dambreak_scene, front_errors  # noqa: E402
-from cases.schemes import RIEMANN_VARIANTS  # noqa: E402
-from cases.sweeps import OLD_DEFAULTS  # noqa: E402
+from wavesph.cases.dambreak import dambreak_scene, front_errors  # noqa: E402
+from wavesph.cases.schemes import RIEMANN_VARIANTS  # noqa: E402
+from wavesph.studies.sweeps import OLD_DEFAULTS  # noqa: E402
 
 # h/dp 2 without artificial viscosity against walls: the wave-decay study's best WCSPH options
 # (docs/wave_decay_study.md); every entry but the first uses them, so the schemes differ only in
@@ -145,7 +145,7 @@ def dambreak(overrides: dict[str, Any], quick: bool) -> dict[str, Any]:
 
 
 def wave(overrides: dict[str, Any], quick: bool) -> dict[str, Any]:
-    from cases.wave_decay import amplitude_profile
+    from wavesph.cases.wave_decay import amplitude_profile
     from wave_client.theories import build_theory
 
     height, period, depth = 0.04, 1.4, 0.24

@@ -11,7 +11,7 @@ the bed, fluid neighbours) and the lowest fluid pressure, one factor changed per
     face        dummies only at >= dp/2 below the polyline (fluid as base)
     no_slip     wall_slip = "no_slip"
     flat        no beach: the same depth on a flat bed (the lattice meets only flat walls)
-    wedge2      the wedge filled only where it holds >= 2 rows (cases/coupled_flume.SHORE_ROWS)
+    wedge2      the wedge filled only where it holds >= 2 rows (wavesph.cases.coupled_flume.SHORE_ROWS)
 
     NUMBA_NUM_THREADS=1 python bench/shoreline_at_rest.py --dp 0.02 --t-end 1.5 --variants base,band_half
 

@@ -26,7 +26,7 @@ import time
 COMPILE_PROBE = """
 import time
 t0 = time.perf_counter()
-from cases.dambreak import dambreak_scene
+from wavesph.cases.dambreak import dambreak_scene
 from sph_core.simulation import Simulation
 sim = Simulation(dambreak_scene(a=0.05, dp=0.005, t_end=0.01, integrator="{integrator}"))
 sim.advance_to(0.002)
@@ -76,7 +76,7 @@ def run_size(dp: float, steps: int, integrator: str, diagnostics: bool,
              cells_per_support: int | None) -> dict:
     import numba
 
-    from cases.dambreak import dambreak_scene
+    from wavesph.cases.dambreak import dambreak_scene
     from sph_core.simulation import Simulation
 
     scene = dambreak_scene(a=1.0, dp=dp, t_end=1.0, integrator=integrator)

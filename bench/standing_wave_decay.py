@@ -7,13 +7,13 @@
         [--scheme wcsph|riemann|isph] [--reconstruction muscl|none]
 
 The first sloshing mode of a tank half a wavelength long, the wave of bench/wave_decay.py
-(cases.standing_wave). Its amplitude decay rate in time over the group velocity is the decay
+(wavesph.cases.standing_wave). Its amplitude decay rate in time over the group velocity is the decay
 over distance a progressive wave would have from the same losses: comparable with
 bench/wave_decay.py's decay_per_m, without inlet, outlet or gauge.
 Prints one JSON line per dp: omega_error, beta_per_s, equiv_decay_per_m,
 equiv_loss_per_wavelength, beta_gauge_per_s, gauge_over_velocity_amplitude (the gauge's bias),
 ke_noise_over_ke0 (kinetic energy outside the first three modes over the initial, mean over the
-second half, and max), local_noise_over_ke0 (cases.particle_noise: velocity minus a local
+second half, and max), local_noise_over_ke0 (wavesph.cases.particle_noise: velocity minus a local
 quadratic fit, the measure bench/wave_decay.py --noise uses along the open flume; KE_0 is the
 standing wave's energy, rho0 g a^2 / 4 per metre), particles, steps, wall_s (jitted loop),
 particle_steps_per_s; then, given several dp, the convergence order of equiv_decay_per_m.
@@ -31,9 +31,9 @@ from pathlib import Path
 os.environ.setdefault("OMP_WAIT_POLICY", "passive")
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from cases.standing_wave import standing_wave_decay  # noqa: E402
-from cases.schemes import add_scheme_arguments, scheme_from_args  # noqa: E402
-from cases.wave_decay import convergence_orders  # noqa: E402
+from wavesph.cases.standing_wave import standing_wave_decay  # noqa: E402
+from wavesph.cases.schemes import add_scheme_arguments, scheme_from_args  # noqa: E402
+from wavesph.cases.wave_decay import convergence_orders  # noqa: E402
 
 
 def main(argv: list[str] | None = None) -> int:

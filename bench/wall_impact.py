@@ -1,7 +1,7 @@
 """Violent impact on a wall: do the walls hold, and how does the near-bed wall pressure compare
 with the experiment?
 
-Case: Lobovsky et al. (2014), H = 300 mm dam break (cases/wall_impact.py): column 0.6 x 0.3 m,
+Case: Lobovsky et al. (2014), H = 300 mm dam break (wavesph/cases/wall_impact.py): column 0.6 x 0.3 m,
 tank 1.61 m, sensor 1 on the far wall 3 mm above the bed, measured at 20 kHz (one realisation,
 tests/data/lobovsky_2014_h300_sensor1.csv). The sensors are sampled after every time step and
 resampled at the experiment's 20 kHz.
@@ -37,7 +37,7 @@ import time
 import numba
 import numpy as np
 
-from cases.wall_impact import COLUMN_HEIGHT, SENSOR_Z, lobovsky_scene, lobovsky_sensor1
+from wavesph.cases.wall_impact import COLUMN_HEIGHT, SENSOR_Z, lobovsky_scene, lobovsky_sensor1
 from sph_core.particles import P, WALL, X, Z
 from sph_core.probes import interpolate_points
 from sph_core.simulation import Simulation, UnstableError
@@ -173,7 +173,8 @@ def main() -> None:
     ap.add_argument("--alpha", type=float, default=None)
     ap.add_argument("--delta", type=float, default=None)
     ap.add_argument("--wall-height", type=float, default=None,
-                    help="[m] model walls (default cases.wall_impact.WALL_HEIGHT; the tank: 0.6)")
+                    help="[m] model walls (default wavesph.cases.wall_impact.WALL_HEIGHT; "
+                         "the tank: 0.6)")
     ap.add_argument("--alpha-wall", type=float, default=None, help="alpha_wall_factor")
     ap.add_argument("--wall-slip", choices=["no_slip", "free_slip"], default=None)
     ap.add_argument("--integrator", choices=["kdk", "symplectic_pc"], default=None)

@@ -16,8 +16,8 @@ outlet's reflection has come back to the inlet: resolves the decay to ~0.1 %/m (
 reflection pattern; docs/absorption.md), ~5x the particle-steps of the default flume.
 
 A flume one wavelength long with open ends driven by second-order Stokes theory (the wave of the
-coupled flume, cases/coupled_flume.py, by default), gauges from 2h past the inlet to 3/4 of the
-flume (cases/wave_decay.py). No coupling and no wave model but the theory: the SPH wave's own
+coupled flume, wavesph/cases/coupled_flume.py, by default), gauges from 2h past the inlet to 3/4 of the
+flume (wavesph/cases/wave_decay.py). No coupling and no wave model but the theory: the SPH wave's own
 loss, the floor under any coupled flume's error at that dp. Every option left out keeps the
 scene's default (sph_core.scene.Constants); c0 = c0_factor sqrt(g d) (the flume's default 10).
 
@@ -28,13 +28,13 @@ gauge), wall_s, particles, steps, particle_steps_per_s; then, given several dp, 
 convergence order of the decay between successive dp, log(decay_1/decay_2)/log(dp_1/dp_2).
 separated_decay_per_m, separated_k_over_k_theory (SPH's wavenumber: phase-speed error),
 separated_reflection: an incident and a reflected wave with one decay rate and wavenumber
-fitted to the complex amplitudes (cases.wave_decay.separated_decay).
+fitted to the complex amplitudes (wavesph.cases.wave_decay.separated_decay).
 ratio_first_half / ratio_second_half: the ratio over each half of the window (a loss that
 grows in time rather than along x shows here); mean_eta_error_mm: time-mean SPH minus theory
 elevation per gauge; level_drift_mm: change of the flume's mean level from its fluid count.
 boundary_counts: per end, fluid particles in / out and buffer particles created / removed.
 second_harmonic_ratio: |2 omega amplitude| of SPH over the theory's per gauge (a free second
-harmonic from the inlet beats along x). --noise (cases.particle_noise): noise_x_m, bin centres
+harmonic from the inlet beats along x). --noise (wavesph.cases.particle_noise): noise_x_m, bin centres
 (0.25 m); noise_fraction, the particle-noise kinetic energy (velocity minus a local quadratic
 fit) per bin over the wave's energy 0.5 rho0 g a^2 per bin, mean over the window; noise_t_s,
 noise_fraction_t: the same over the gauged span at each sample (every T/5 from the start).
@@ -52,8 +52,8 @@ from pathlib import Path
 os.environ.setdefault("OMP_WAIT_POLICY", "passive")  # before numba: shared, loaded cores
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from cases.wave_decay import amplitude_profile, convergence_orders, separated_decay  # noqa: E402
-from cases.schemes import add_scheme_arguments, scheme_from_args  # noqa: E402
+from wavesph.cases.wave_decay import amplitude_profile, convergence_orders, separated_decay  # noqa: E402
+from wavesph.cases.schemes import add_scheme_arguments, scheme_from_args  # noqa: E402
 from sph_core.absorption import ABSORPTION_KINDS, ABSORPTION_TRANSFERS  # noqa: E402
 from wave_client.theories import build_theory  # noqa: E402
 

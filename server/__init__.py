@@ -23,7 +23,7 @@ Coupling: WebSocket /runs/{id}/couple, or the TCP port; frames of protocol/PROTO
 reserves its run (even a queued one); WELCOME comes when the run is built and a stepping slot free.
 
 Inside, top to bottom (pyproject's import-linter contract): cli; main; routers | tcp;
-deps | theory_client; coupling; runs | flume_engine; engine | store | transports; schemas;
+deps | theory_client; doors; run_manager | flume_engine; engine | store | transports; schemas;
 theory_source | settings. The run manager gets the engine factory and the built-in source driver
 injected, so it knows neither the solver nor the doors.
 

@@ -9,7 +9,7 @@ from typing import Annotated
 
 from fastapi import Depends, HTTPException, Request, WebSocket
 
-from .runs import Run, RunManager
+from .run_manager import Run, RunManager
 
 
 def get_manager(request: Request) -> RunManager:

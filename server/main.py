@@ -14,7 +14,7 @@ from .deps import redact_tokens_in_server_logs
 from .engine import EngineFactory
 from .flume_engine import flume_engine
 from .routers import couple, pages, runs
-from .runs import RunManager
+from .run_manager import RunManager
 from .schemas import RunRequest
 from .settings import Settings
 from .tcp import start_tcp_server

@@ -38,6 +38,13 @@ class RunRequest(BaseModel):
                                                           "ends of a standalone run")
 
 
+# RunInfo.state's values, part of the HTTP surface: a client polling GET /runs/{id} waits for a
+# state in TERMINAL (the run manager sets them)
+QUEUED, WAITING, RUNNING = "queued", "waiting_for_client", "running"
+FINISHED, CANCELLED, FAILED, UNSTABLE = "finished", "cancelled", "failed", "unstable"
+TERMINAL = frozenset({FINISHED, CANCELLED, FAILED, UNSTABLE})
+
+
 class RunInfo(BaseModel):
     """GET /runs/{id}. ``status`` is ``state`` plus the reason, e.g. 'failed: client disconnected'."""
 

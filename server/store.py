@@ -150,7 +150,7 @@ class GaugeWriter:
         self._f.close()
 
 
-def read_gauges(path: Path) -> tuple[list[str], list[dict[str, float | None]]]:
+def read_gauge_rows(path: Path) -> tuple[list[str], list[dict[str, float | None]]]:
     """A gauge CSV as columns and rows; a dry gauge (empty, or 'dry' in older files) is None."""
     with open(path, newline="") as f:
         rows = list(csv.reader(f))

@@ -8,8 +8,8 @@ import logging
 from protocol import ErrorCode, Hello, ProtocolError
 from protocol.session import HELLO_LIMIT
 
-from .coupling import claim_run, error_frame, serve_client
-from .runs import RunManager
+from .doors import claim_run, error_frame, serve_client
+from .run_manager import RunManager
 from .transports import TcpDoor
 
 log = logging.getLogger("wavesph.server")

@@ -2,11 +2,11 @@
 
 The theory is wave_client's, driven by wave_client's own coupling core (``CouplingCore``). Its
 frames go through an in-memory transport (``TheoryClient``) to the same door logic
-(``server.coupling.serve_client``) that a WebSocket or TCP client reaches. So the run takes the
+(``server.doors.serve_client``) that a WebSocket or TCP client reaches. So the run takes the
 coupled run's path exactly: the theory samples the boundary nodes window by window as the client
 would, the engine solves the same windows, and gauges.csv, progress, saved states and resume are
 those of a coupled run; only the socket is missing. A coupled run of the same scene with the same
-theory and options gives the same gauges to round-off (tests/server/test_standalone_theory.py).
+theory and options gives the same gauges to round-off (tests/test_server/test_standalone_theory.py).
 The theory's own elevation at the gauges is written beside them, to theory.csv.
 """
 
@@ -19,8 +19,8 @@ from protocol import MAX_PAYLOAD, Bye, Error, Message, Nodes, Result, Welcome, d
 from protocol.session import HELLO_LIMIT
 from wave_client.coupling import CouplingCore, CouplingOptions, GaugeLog
 
-from .coupling import serve_client
-from .runs import Run, RunManager
+from .doors import serve_client
+from .run_manager import Run, RunManager
 
 log = logging.getLogger("wavesph.server")
 

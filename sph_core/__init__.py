@@ -13,5 +13,5 @@ containers the kernels take), neighbours (cell lists), kernels (Wendland C2), eo
 (the physical terms as jitted passes), open_boundary (the jitted open-end terms), step (the one
 jitted time loop), open_ends (open ends as a value of the run), simulation (the run), probes,
 output, progress (a terminal progress bar over a run). Named cases (dam break, flumes) live in
-the `cases` package; the commands in `wavesph_cli`.
+the `wavesph.cases` package; the commands in `wavesph.cli`.
 """

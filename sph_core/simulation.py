@@ -570,3 +570,18 @@ class Simulation:
             self.writer.close()
         if self.bodies.log:
             self.bodies.log.close()
+
+    def set_gravity(self, gx: float, gz: float) -> None:
+        """Replace gravity [m/s^2] (z up: the scene's own is (0, -g)) and re-evaluate the rates
+        at the current state, as at the start of a run. The particles are kept as they are: a
+        caller changing gravity sets the matching density field first. WCSPH only (the ISPH
+        stepper holds its own copy of the parameters)."""
+        if self.stepper is not None:
+            raise ValueError("set_gravity: WCSPH runs only (the ISPH stepper keeps its own gravity)")
+        ps = self.particles
+        self.prm = self.prm._replace(gx=float(gx), gz=float(gz))
+        ends, bd, _, riemann, _ = self._step_parts()
+        dt, n = step.initialise(ps.view, ps.view2, self.cells, self.prm, ends, bd, riemann, ps.n)
+        ps.swap()
+        ps.n = int(n)
+        self.dt = float(dt)

@@ -15,7 +15,7 @@ from types import SimpleNamespace
 
 import pytest
 
-import wavesph_cli
+import wavesph.cli
 from sph_core import progress
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -24,14 +24,14 @@ TANK = ROOT / "examples" / "scenes" / "still_water_tank.toml"
 
 def test_version(capsys):
     with pytest.raises(SystemExit) as exc:
-        wavesph_cli.main(["--version"])
+        wavesph.cli.main(["--version"])
     assert exc.value.code == 0 and capsys.readouterr().out.startswith("wavesph ")
 
 
-@pytest.mark.parametrize("name", sorted(wavesph_cli.COMMANDS))
+@pytest.mark.parametrize("name", sorted(wavesph.cli.COMMANDS))
 def test_every_option_with_a_default_shows_it_in_help(name):
-    parser = argparse.ArgumentParser(formatter_class=wavesph_cli.HelpFormatter)
-    importlib.import_module(wavesph_cli.COMMANDS[name][0]).add_arguments(parser)
+    parser = argparse.ArgumentParser(formatter_class=wavesph.cli.HelpFormatter)
+    importlib.import_module(wavesph.cli.COMMANDS[name][0]).add_arguments(parser)
     text = parser.format_help()
     for action in parser._actions:
         if action.option_strings and action.default not in (None, False, argparse.SUPPRESS):
@@ -42,7 +42,7 @@ def test_every_option_with_a_default_shows_it_in_help(name):
 @pytest.mark.parametrize("name", ["run", "demo", "couple", "waves"])
 def test_one_spelling_for_output(name):
     parser = argparse.ArgumentParser()
-    importlib.import_module(wavesph_cli.COMMANDS[name][0]).add_arguments(parser)
+    importlib.import_module(wavesph.cli.COMMANDS[name][0]).add_arguments(parser)
     spellings = {o for a in parser._actions for o in a.option_strings}
     assert {"-o", "--out"} <= spellings and "--output" not in spellings
 
@@ -54,14 +54,14 @@ def test_license_is_an_spdx_expression():
 
 def test_run_refuses_a_non_empty_out(tmp_path, capsys):
     (tmp_path / "probes.csv").write_text("an earlier run")
-    assert wavesph_cli.main(["run", str(TANK), "-o", str(tmp_path)]) == 2
+    assert wavesph.cli.main(["run", str(TANK), "-o", str(tmp_path)]) == 2
     assert "not empty" in capsys.readouterr().err
     assert [p.name for p in tmp_path.iterdir()] == ["probes.csv"]
 
 
 def test_run_options_are_honoured(tmp_path, capsys):
     out = tmp_path / "run"
-    code = wavesph_cli.main(["run", str(TANK), "--dp", "0.05", "--t-end", "0.02",
+    code = wavesph.cli.main(["run", str(TANK), "--dp", "0.05", "--t-end", "0.02",
                              "--snapshot-every", "0.01", "--threads", "1", "--no-progress",
                              "--out", str(out)])
     assert code == 0
@@ -73,11 +73,36 @@ def test_run_options_are_honoured(tmp_path, capsys):
     assert "t=" not in err  # --no-progress: no progress line
 
 
+def test_python_api_runs_a_scene_as_the_command_does(tmp_path):
+    import wavesph
+    from sph_core.scene import make_scene
+
+    scene = wavesph.load_scene(TANK)
+    data = scene.model_dump(mode="json")
+    scene = make_scene({**data, "dp": 0.05, "t_end": 0.02,
+                        "output": {**data["output"], "snapshot_every": 0.02}})
+    sim = wavesph.run_scene(scene, tmp_path / "run", progress=False)
+    assert sim.status == "completed" and sim.t == pytest.approx(0.02)
+    gauges = wavesph.read_gauges(tmp_path / "run" / "probes.csv")
+    assert list(gauges["t"]) == pytest.approx([0.0, 0.01, 0.02])
+    assert json.loads((tmp_path / "run" / "meta.json").read_text())["status"] == "completed"
+
+
+def test_python_m_wavesph_is_the_command(tmp_path):
+    import subprocess
+    import sys
+
+    out = subprocess.run([sys.executable, "-m", "wavesph", "--help"], capture_output=True,
+                         text=True, timeout=60, cwd=tmp_path)
+    assert out.returncode == 0 and "usage: wavesph" in out.stdout
+    assert all(name in out.stdout for name in wavesph.cli.COMMANDS)
+
+
 def test_run_rejects_bad_overrides(tmp_path, capsys):
-    assert wavesph_cli.main(["run", str(TANK), "--snapshot-every", "9", "-o", str(tmp_path / "a")]) == 2
+    assert wavesph.cli.main(["run", str(TANK), "--snapshot-every", "9", "-o", str(tmp_path / "a")]) == 2
     assert "snapshot_every" in capsys.readouterr().err
     with pytest.raises(SystemExit) as exc:
-        wavesph_cli.main(["run", str(TANK), "--dp", "-1"])
+        wavesph.cli.main(["run", str(TANK), "--dp", "-1"])
     assert exc.value.code == 2
 
 
@@ -89,7 +114,7 @@ def test_ctrl_c_is_one_line_exit_130_with_partial_results(tmp_path, capsys, monk
 
     monkeypatch.setattr(progress, "progress_lines", interrupting)
     out = tmp_path / "run"
-    code = wavesph_cli.main(["run", str(TANK), "--dp", "0.05", "--t-end", "0.05", "-o", str(out)])
+    code = wavesph.cli.main(["run", str(TANK), "--dp", "0.05", "--t-end", "0.05", "-o", str(out)])
     err = capsys.readouterr().err
     assert code == 130 and f"partial results in {out}" in err and "Traceback" not in err
     assert json.loads((out / "meta.json").read_text())["status"] == "interrupted"
@@ -98,7 +123,7 @@ def test_ctrl_c_is_one_line_exit_130_with_partial_results(tmp_path, capsys, monk
 def test_first_run_says_it_compiles(tmp_path, capsys, monkeypatch):
     monkeypatch.setattr(progress, "kernels_cached", lambda: False)
     out = tmp_path / "run"
-    assert wavesph_cli.main(["run", str(TANK), "--dp", "0.05", "--t-end", "0.01", "-o", str(out)]) == 0
+    assert wavesph.cli.main(["run", str(TANK), "--dp", "0.05", "--t-end", "0.01", "-o", str(out)]) == 0
     err = capsys.readouterr().err
     assert err.index("compiling kernels (first run only") < err.index("still_water_tank: t=")
 
@@ -121,14 +146,14 @@ def test_progress_off_a_terminal_is_throttled_lines():
 
 def test_demo_dambreak_honours_dp_and_t_end(tmp_path):
     out = tmp_path / "demo"
-    assert wavesph_cli.main(["demo", "--dambreak", "--dp", "0.01", "--t-end", "0.02",
+    assert wavesph.cli.main(["demo", "--dambreak", "--dp", "0.01", "--t-end", "0.02",
                              "--no-plot", "-o", str(out)]) == 0
     meta = json.loads((out / "meta.json").read_text())
     assert meta["config"]["dp"] == pytest.approx(0.01) and meta["t"] == pytest.approx(0.02)
 
 
 def test_demo_dambreak_refuses_a_dp_that_does_not_divide_the_column(tmp_path, capsys):
-    assert wavesph_cli.main(["demo", "--dambreak", "--dp", "0.03", "-o", str(tmp_path / "d")]) == 2
+    assert wavesph.cli.main(["demo", "--dambreak", "--dp", "0.03", "-o", str(tmp_path / "d")]) == 2
     assert "--dp" in capsys.readouterr().err
 
 
@@ -137,7 +162,7 @@ def test_serve_on_a_busy_port_is_one_line(tmp_path, capsys):
         busy.bind(("127.0.0.1", 0))
         busy.listen()
         port = busy.getsockname()[1]
-        code = wavesph_cli.main(["serve", "--port", str(port), "--tcp-port", "0",
+        code = wavesph.cli.main(["serve", "--port", str(port), "--tcp-port", "0",
                                  "--runs-dir", str(tmp_path)])
     err = capsys.readouterr().err
     assert code == 1 and f"--port {port}" in err and "not free" in err

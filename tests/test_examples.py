@@ -15,7 +15,7 @@ from pathlib import Path
 
 import pytest
 
-import wavesph_cli
+import wavesph.cli
 from sph_core.scene import load_scene, make_scene, split_scene_file
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -39,7 +39,7 @@ def _meta(out: Path) -> dict:
 @pytest.mark.parametrize("name", sorted(RUN_DP))
 def test_closed_tank_examples_run_to_their_end(tmp_path, name):
     out = tmp_path / "run"
-    code = wavesph_cli.main(["run", str(SCENES / name), "--dp", str(RUN_DP[name]), "-o", str(out),
+    code = wavesph.cli.main(["run", str(SCENES / name), "--dp", str(RUN_DP[name]), "-o", str(out),
                              "--no-progress"])
     meta = _meta(out)
     assert code == 0, meta.get("cause")
@@ -50,7 +50,7 @@ def test_closed_tank_examples_run_to_their_end(tmp_path, name):
 def _theory_run(scene_file: Path, dp: float, theory: str, **opts):
     """An open-boundary example driven by the built-in theory its comment documents, to its end
     (the standalone path: the same Simulation the server's standalone runs solve)."""
-    from cases.wave_flume import run_wave_flume
+    from wavesph.cases.wave_flume import run_wave_flume
     from wave_client.theories import build_theory
 
     data, _ = split_scene_file(tomllib.loads(scene_file.read_text()))
@@ -86,7 +86,7 @@ def test_flume_case_V_with_its_stream_function_source_runs_to_its_end():
 def test_wave_examples_run_to_their_end(tmp_path, config):
     """`wavesph waves examples/waves/<config> -o CSV` as their comments give it."""
     out = tmp_path / "gauges.csv"
-    assert wavesph_cli.main(["waves", str(ROOT / "examples" / "waves" / config), "-o", str(out),
+    assert wavesph.cli.main(["waves", str(ROOT / "examples" / "waves" / config), "-o", str(out),
                              "--no-progress"]) == 0
     rows = list(csv.reader(line for line in out.open() if not line.startswith("#")))
     end = tomllib.loads((ROOT / "examples" / "waves" / config).read_text())["grid"]["t_end"]
@@ -97,8 +97,8 @@ def test_wave_examples_run_to_their_end(tmp_path, config):
 @pytest.mark.parametrize("two_way", [True, False], ids=["two_way", "absorption_only"])
 def test_coupled_examples_run_to_their_end(tmp_path, two_way):
     """examples/coupled: the SPH zone coupled over a socket to the Boussinesq model, both modes
-    its README gives, at dp = 0.04 m (the files are generated from cases.coupled_flume at 0.02)."""
-    from cases.coupled_flume import FlumeCase, run_coupled
+    its README gives, at dp = 0.04 m (the files are generated from wavesph.cases.coupled_flume at 0.02)."""
+    from wavesph.cases.coupled_flume import FlumeCase, run_coupled
 
     res = run_coupled(FlumeCase(), 0.04, tmp_path, two_way=two_way)
     assert res["exit_code"] == 0 and res["state"] == "finished", res["status"]
@@ -114,7 +114,7 @@ def test_every_example_previews_without_solving(tmp_path, name):
         return int(re.search(rf'{what}="(\d+)"', head).group(1))
 
     out = tmp_path / "preview"
-    assert wavesph_cli.main(["run", str(SCENES / name), "--preview", "-o", str(out)]) == 0
+    assert wavesph.cli.main(["run", str(SCENES / name), "--preview", "-o", str(out)]) == 0
     meta = _meta(out)
     assert meta["status"] == "preview" and meta["steps"] == 0
     assert piece(out / "snapshots" / "particles_00000.vtu", "NumberOfPoints") == meta["n_particles"]

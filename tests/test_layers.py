@@ -2,7 +2,8 @@
 
 - The import-linter contracts of pyproject.toml ([tool.importlinter]; docs/ARCHITECTURE.md says
   why each holds) are kept.
-- `wavesph couple` with a theory runs without loading the SPH solver, numba or the server.
+- `wavesph couple` with a theory runs without loading the SPH solver, numba, the server or the
+  cases.
 - Every public top-level name (function, class, module-level constant) and every module name is
   defined once across the packages; the deliberate exceptions are listed below with their reason.
 """
@@ -18,25 +19,26 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
-PACKAGES = ("protocol", "sph_core", "wave_client", "server", "cases", "wavesph_cli")
+PACKAGES = ("protocol", "sph_core", "wave_client", "server", "wavesph")
 SCRIPTS = ("bench", "examples")  # scripts: their names are checked, their own `main` is not
 
 # name -> the files that may define it, and why. A name defined in one more place, or no longer
 # defined twice, fails the test: update this list with the code.
 ALLOWED: dict[str, tuple[set[str], str]] = {
     # deliberate
-    "module runs": ({"server/runs.py", "server/routers/runs.py"},
-                    "the run manager and its HTTP routes: each routers module is named for its URL"),
-    "module couple": ({"wavesph_cli/couple.py", "server/routers/couple.py"},
+    "module couple": ({"wavesph/cli/couple.py", "server/routers/couple.py"},
                       "`wavesph couple` and the /runs/{id}/couple endpoint: each named for its "
                       "command or URL"),
-    "log": ({"server/coupling.py", "server/main.py", "server/runs.py", "server/store.py",
+    "log": ({"server/doors.py", "server/main.py", "server/run_manager.py", "server/store.py",
              "server/tcp.py", "server/theory_client.py"},
             "the logging convention: one `log` per module"),
     "router": ({"server/routers/couple.py", "server/routers/runs.py"},
                "the FastAPI convention: one `router` per routers module"),
+    "load_scene": ({"sph_core/scene.py", "wavesph/__init__.py"},
+                   "the public API's one-line wrapper: `import wavesph` loads no solver (numba) "
+                   "until a call needs it"),
 }
-# the subcommand interface (wavesph_cli/*.py) and a script's entry point: the same by design
+# the subcommand interface (wavesph/cli/*.py) and a script's entry point: the same by design
 INTERFACE = {"main", "add_arguments"}
 
 
@@ -60,7 +62,7 @@ def defined_names() -> dict[str, set[str]]:
         for path in sorted((ROOT / top).rglob("*.py")):
             rel = path.relative_to(ROOT).as_posix()
             for name in _top_level_names(path):
-                if name in INTERFACE and (top in SCRIPTS or top == "wavesph_cli"):
+                if name in INTERFACE and (top in SCRIPTS or rel.startswith("wavesph/cli/")):
                     continue
                 where[name].add(rel)
             if top in PACKAGES and path.stem not in ("__init__", "__main__"):
@@ -88,10 +90,12 @@ def test_couple_with_a_theory_loads_no_sph_solver_numba_or_server():
     # a fresh interpreter: this one has numba loaded already. Port 1 refuses at once, so the
     # command goes through argument checks, the theory and the client's connect, then exits 1.
     probe = (
-        "import sys, wavesph_cli\n"
-        "code = wavesph_cli.main(['couple', '--url', 'tcp://127.0.0.1:1', '--run-id', 'r1',\n"
+        "import sys, wavesph.cli\n"
+        "code = wavesph.cli.main(['couple', '--url', 'tcp://127.0.0.1:1', '--run-id', 'r1',\n"
         "    '--model', 'stokes', '--H', '0.04', '--T', '1.4', '--d', '0.24', '--no-progress'])\n"
-        "loaded = sorted({m.split('.')[0] for m in sys.modules} & {'numba', 'sph_core', 'server', 'cases'})\n"
+        "heavy = ('numba', 'sph_core', 'server', 'wavesph.cases', 'wavesph.studies',\n"
+        "         'wavesph.local_server')\n"
+        "loaded = [h for h in heavy if any(m == h or m.startswith(h + '.') for m in sys.modules)]\n"
         "print(code, ','.join(loaded))\n")
     out = subprocess.run([sys.executable, "-c", probe], cwd=ROOT, capture_output=True, text=True,
                          timeout=120, env={"PYTHONPATH": str(ROOT), "PATH": "/usr/bin:/bin"})

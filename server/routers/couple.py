@@ -9,7 +9,7 @@ from fastapi import APIRouter, WebSocket
 from protocol import ErrorCode, Hello, ProtocolError
 from protocol.session import HELLO_LIMIT
 
-from ..coupling import claim_run, error_frame, serve_client
+from ..doors import claim_run, error_frame, serve_client
 from ..deps import websocket_subprotocol, websocket_token_ok
 from ..transports import WebSocketDoor
 

@@ -10,9 +10,9 @@ from fastapi import APIRouter, HTTPException, Query, Request, Response
 from fastapi.responses import FileResponse, StreamingResponse
 
 from ..deps import Auth, Manager, RunDep
-from ..runs import TERMINAL, QueueFull
-from ..schemas import RunInfo
-from ..store import read_gauges
+from ..run_manager import QueueFull
+from ..schemas import TERMINAL, RunInfo
+from ..store import read_gauge_rows
 from ..validation import BodyNotJson, RequestInvalid, parse_run_request
 
 router = APIRouter(prefix="/runs", tags=["runs"], dependencies=[Auth], responses={
@@ -109,7 +109,7 @@ async def get_gauges(run: RunDep, format: Literal["csv", "json"] = Query("csv"))
         raise HTTPException(404, f"run {run.info.id} has no gauge data yet")
     if format == "csv":
         return FileResponse(path, media_type="text/csv", filename=f"{run.info.id}-gauges.csv")
-    columns, rows = await asyncio.to_thread(read_gauges, path)
+    columns, rows = await asyncio.to_thread(read_gauge_rows, path)
     return Response(json.dumps({"columns": columns, "rows": rows}), media_type="application/json")
 
 
@@ -123,7 +123,7 @@ async def get_bodies(run: RunDep, format: Literal["csv", "json"] = Query("csv"))
         raise HTTPException(404, f"run {run.info.id} has no body data")
     if format == "csv":
         return FileResponse(paths[-1], media_type="text/csv", filename=f"{run.info.id}-bodies.csv")
-    columns, rows = await asyncio.to_thread(read_gauges, paths[-1])
+    columns, rows = await asyncio.to_thread(read_gauge_rows, paths[-1])
     return Response(json.dumps({"columns": columns, "rows": rows}), media_type="application/json")
 
 

@@ -1,7 +1,7 @@
 """Nwogu extended Boussinesq far-field wave model (1D horizontal, variable depth).
 
 `BoussinesqModel` satisfies `wave_client.model.WaveModel`; `wavesph waves SCENE.toml` runs it
-alone (`wave_scene.py`, `standalone.py`, `wavesph_cli/waves.py`).
+alone (`wave_scene.py`, `standalone.py`, `wavesph/cli/waves.py`).
 """
 
 from .dispersion import airy_celerity, nwogu_celerity, nwogu_wavenumber

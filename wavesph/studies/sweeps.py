@@ -1,0 +1,481 @@
+"""Speed against accuracy: sweeps of independent runs (case, method, dp) on dask.distributed.
+
+    points = accuracy_points(quick=True)
+    records = run_sweep(points, Path("runs/accuracy"), scheduler=None)   # LocalCluster
+    write_csv(records, out / "accuracy.csv"); plot_accuracy(records, out / "accuracy.png")
+
+A point is one run, scored by ``run_point`` (module-level, so a dask worker can import it). Each
+finished point is one JSON file ``DIR/points/<key>.json`` (the run store): a sweep run again skips
+the points already there (``retry_failed`` re-runs those that raised). A run the solver stopped
+(UnstableError) is a result, status ``unstable`` with the reason; any other exception is status
+``failed`` with its text; neither stops the sweep.
+
+Cases (``error`` is always a relative error, smaller is better):
+  flume_I ... flume_V  seed 002's validation waves (tests/data/wave_cases_seed002.csv) through the
+                       open-boundary flume of wavesph.cases.wave_flume: RMSE/H of the mid-flume gauge
+                       against the theory. H_over_dp: wave height / dp.
+  dambreak             Martin & Moyce's dam break (column a x 2a): RMS relative error of the surge
+                       front against Martin & Moyce for T = t sqrt(2g/a) <= 3 (Koshizuka & Oka's
+                       in ``extra``). H_over_dp: column height 2a / dp.
+  coupled              the coupled Boussinesq-SPH flume with a beach (wavesph.cases.coupled_flume), two
+                       methods: ``coupled`` (Boussinesq far field + SPH zone) and ``sph_only``
+                       (SPH over the same length): RMSE/H at the same flat-bed gauge against the
+                       Boussinesq-only reference. Runs with the default SPH method only (the
+                       server builds its scenes).
+
+Methods are a registry, name -> scene-constant overrides: adding a scheme or option is one line.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+import os
+import time
+import traceback
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Callable, Iterable
+
+from sph_core.scene import ISPH_H_OVER_DP
+
+from ..cases.schemes import RIEMANN_VARIANTS
+
+# name -> sph_core.scene.Constants overrides, and "scheme": the scene's [scheme] table (every
+# case builder takes ``scheme=``). The solver's schemes and options today: delta-SPH
+# WCSPH with the leapfrog (kdk, one force pass per step) or the DualSPHysics-style symplectic
+# predictor-corrector (two passes), the smoothing length h/dp (sqrt 2 or 2, the default), the
+# wall artificial viscosity (factor 0, the default, or 1) and particle shifting; Riemann SPH
+# (wavesph.cases.schemes.RIEMANN_VARIANTS) with h/dp 2 and no wall dissipation. A new scheme or option is
+# one line here. Every method names its h/dp and wall factor: the shipped sweep data
+# (wavesph/cases/data/accuracy_sweep.csv) were measured when the defaults were h/dp sqrt 2 and factor 1,
+# and a method must keep meaning what its rows measured.
+OLD_DEFAULTS = {"h_over_dp": 1.4142, "alpha_wall_factor": 1.0}
+METHODS: dict[str, dict[str, Any]] = {
+    "wcsph_kdk": {**OLD_DEFAULTS},
+    "wcsph_symplectic": {"integrator": "symplectic_pc", **OLD_DEFAULTS},
+    "wcsph_kdk_h2": {"h_over_dp": 2.0, "alpha_wall_factor": 1.0},
+    "wcsph_symplectic_h2": {"integrator": "symplectic_pc", "h_over_dp": 2.0,
+                            "alpha_wall_factor": 1.0},
+    # no artificial viscosity against walls: the wave-decay study's main finding
+    # (docs/wave_decay_study.md), and particle shifting on top of it
+    "wcsph_kdk_h2_wallav0": {"h_over_dp": 2.0, "alpha_wall_factor": 0.0},
+    "wcsph_kdk_h2_wallav0_shift": {"h_over_dp": 2.0, "alpha_wall_factor": 0.0,
+                                   "shifting": "fickian"},
+    **{name: {"h_over_dp": 2.0, "alpha_wall_factor": 0.0, "scheme": sch}
+       for name, sch in RIEMANN_VARIANTS.items()},
+    # ISPH at its h/dp sqrt 2; its wave flume is unstable (docs/schemes.md), so its flume points
+    # end "unstable" with the reason
+    "isph_amg": {"h_over_dp": ISPH_H_OVER_DP, "alpha_wall_factor": 0.0,
+                 "scheme": {"kind": "isph", "ppe_solver": "amg"}},
+    "isph_bicgstab": {"h_over_dp": ISPH_H_OVER_DP, "alpha_wall_factor": 0.0,
+                      "scheme": {"kind": "isph", "ppe_solver": "bicgstab"}},  # ISPH's default
+}
+# the coupled case's two ways to compute the same flume
+COUPLED_METHODS = ("coupled", "sph_only")
+
+ACCURACY_COLUMNS = ["case", "method", "dp", "H_over_dp", "error", "wall_s", "particles", "steps",
+               "status", "reason"]
+FLUME_CASES = ("I", "II", "III", "IV", "V")
+
+
+@dataclass(frozen=True)
+class Point:
+    """One run of a sweep. ``options``: case settings (durations, sizes) of the preset."""
+
+    case: str
+    method: str
+    dp: float
+    options: dict[str, Any] = field(default_factory=dict, hash=False, compare=False)
+
+    @property
+    def key(self) -> str:
+        return f"{self.case}__{self.method}__dp{self.dp:.6g}"
+
+
+# ---------------------------------------------------------------------------- presets
+def accuracy_points(quick: bool = False, methods: Iterable[str] | None = None) -> list[Point]:
+    """The points of the accuracy sweep. quick: <= 10 min on 2 quiet cores (two methods, two or
+    three coarse spacings, one measured period, flume cases I, IV, V); full: every method, three
+    spacings, every case (hours on 2 cores: case II at H/dp = 8 has 0.5 M particles)."""
+    if methods is None:
+        methods = ["wcsph_kdk", "wcsph_symplectic"] if quick else list(METHODS)
+    methods = list(methods)
+    unknown = [m for m in methods if m not in METHODS]
+    if unknown:
+        raise ValueError(f"unknown methods {unknown}; known: {sorted(METHODS)}")
+    cases = _read_cases()
+    pts: list[Point] = []
+    flumes = ("I", "IV", "V") if quick else FLUME_CASES   # quick: the cheap ones (few particles)
+    ratios = (2.0, 3.0) if quick else (3.0, 5.0, 8.0)          # H/dp of the wave cases
+    flume_opts = {"periods": 1.0 if quick else 3.0, "ramp_periods": 1.0}
+    for name in flumes:
+        h = float(cases[name]["H"])
+        pts += [Point(f"flume_{name}", m, round(h / r, 6), flume_opts) for m in methods for r in ratios]
+    a = 0.25 if quick else 0.5                                   # dam-break column width [m]
+    db_ratios = (6, 9, 12) if quick else (10, 20, 40)           # column height 2a / dp
+    pts += [Point("dambreak", m, round(2 * a / r, 6), {"a": a}) for m in methods for r in db_ratios]
+    c_opts = {"wavelengths": 2.0 if quick else 6.0, "compare_periods": 2.0 if quick else 4.0}
+    c_dps = (0.03,) if quick else (0.04, 0.02, 0.01)
+    pts += [Point("coupled", m, dp, c_opts) for m in COUPLED_METHODS for dp in c_dps]
+    return pts
+
+
+def _read_cases() -> dict[str, dict[str, str]]:
+    """Seed 002's validation table (a copy of tests/data/wave_cases_seed002.csv shipped in wavesph/cases/data)."""
+    text = _data_text("wave_cases_seed002.csv")
+    return {r["test"]: r for r in csv.DictReader(ln for ln in text.splitlines()
+                                                 if not ln.startswith("#"))}
+
+
+def _data_text(name: str) -> str:
+    from importlib import resources
+
+    return resources.files("wavesph.cases").joinpath(f"data/{name}").read_text()
+
+
+# ---------------------------------------------------------------------------- one point
+def _threads(n: int = 1) -> None:
+    """One numba thread per worker: dask runs one point per core."""
+    import numba
+
+    numba.set_num_threads(max(1, min(n, numba.config.NUMBA_NUM_THREADS)))
+
+
+def run_point(point: Point) -> dict[str, Any]:
+    """Run and score one point; never raises: the record's status says what happened."""
+    _threads(int(os.environ.get("WAVESPH_POINT_THREADS", "1")))
+    from sph_core.simulation import UnstableError
+
+    rec: dict[str, Any] = {"key": point.key, "case": point.case, "method": point.method,
+                           "dp": point.dp, "options": point.options}
+    tic = time.perf_counter()
+    try:
+        rec["warmup_s"] = round(warm_up_method(point.method), 3)
+        rec.update(_RUNNERS[point.case.split("_")[0]](point))
+        rec.setdefault("status", "ok")
+    except UnstableError as exc:
+        rec.update(status="unstable", reason=str(exc), t_fail=exc.t)
+    except Exception as exc:  # a failed point is a result of the sweep, not its end
+        rec.update(status="failed", reason=f"{type(exc).__name__}: {exc}",
+                   traceback=traceback.format_exc(limit=5))
+    rec["elapsed_s"] = round(time.perf_counter() - tic, 3)
+    _assert_finite(rec)
+    return rec
+
+
+_WARM: set[str] = set()
+
+
+def warm_up_method(method: str) -> float:
+    """Compile (or load from numba's cache) the jitted step of ``method`` for closed and open
+    tanks before a timed run, once per process: wall_s then measures the run, not the JIT
+    (a cold compile took 4 min of wall on the loaded 2-core machine). Returns its seconds."""
+    consts = METHODS.get(method, {})
+    sig = json.dumps(consts, sort_keys=True)   # the scheme table is a dict: not hashable
+    if sig in _WARM:
+        return 0.0
+    tic = time.perf_counter()
+    from sph_core.simulation import Simulation
+    from wave_client.theories import build_theory
+
+    from ..cases.dambreak import dambreak_scene
+    from ..cases.wave_flume import run_wave_flume, wave_flume_scene
+
+    sim = Simulation(dambreak_scene(a=0.1, dp=0.05, t_end=0.05, **consts))
+    sim.advance_to(0.01)
+    model = build_theory("linear", height=0.02, period=1.0, depth=0.2, ramp_time=1.0)
+    scene = wave_flume_scene(depth=0.2, wavelength=float(model.length), height=0.02, dp=0.05,
+                             t_end=0.1, probe_every=0.02, **consts)
+    run_wave_flume(scene, model, window=0.02, t_end=0.04)
+    _WARM.add(sig)
+    return time.perf_counter() - tic
+
+
+def _assert_finite(rec: dict[str, Any]) -> None:
+    """No NaN/inf in a record: a non-finite score means the run went wrong and says so."""
+    for k in ("error", "wall_s"):
+        v = rec.get(k)
+        if v is not None and not math.isfinite(v):
+            rec[k] = None
+            if rec.get("status") == "ok":
+                rec.update(status="unstable", reason=f"non-finite {k}")
+
+
+def _flume(point: Point) -> dict[str, Any]:
+    from wave_client.theories import build_theory
+
+    from ..cases.wave_flume import flume_case
+
+    row = _read_cases()[point.case.split("_", 1)[1]]
+    theory = {"standing": ("standing", {}), "linear": ("linear", {}),
+              "stokes2": ("stokes", {"order": 2}), "stokes3": ("stokes", {"order": 3}),
+              "stream_function": ("stream", {"n_fourier": 16})}[row["theory"]]
+    h, t, d = float(row["H"]), float(row["T"]), float(row["d"])
+    ramp = point.options.get("ramp_periods", 1.0) * t
+    model = build_theory(theory[0], height=h, period=t, depth=d, ramp_time=ramp, **theory[1])
+    res = flume_case(model, height=h, period=t, depth=d, wavelength=float(model.length),
+                     dp=point.dp, periods=point.options.get("periods", 1.0), ramp=ramp,
+                     standing=theory[0] == "standing", name=point.key,
+                     **METHODS[point.method])
+    return {"H_over_dp": h / point.dp, "error": res["rmse_over_H"], "wall_s": res["wall_s"],
+            "particles": res["particles"], "steps": res["steps"],
+            "extra": {"reflection": res["reflection"], "H": h, "T": t, "d": d,
+                      "simulated_s": None, "mean_level_m": res["mean_level_m"]}}
+
+
+def _dambreak(point: Point) -> dict[str, Any]:
+    import numpy as np
+
+    from sph_core.simulation import Simulation
+
+    from ..cases.dambreak import dambreak_scene, front_errors
+
+    a = float(point.options.get("a", 0.5))
+    t_end = 3.0 * math.sqrt(a / (2 * 9.81)) * 1.02   # T = t sqrt(2g/a) = 3, the table's span
+    scene = dambreak_scene(a=a, dp=point.dp, t_end=t_end, probe_every=0.005 * math.sqrt(a),
+                           **METHODS[point.method])
+    sim = Simulation(scene)
+    sim.advance_to(t_end)
+    hist = np.array([(r["t"], r["front_x"]) for r in sim.history if r["front_x"] is not None])
+    mm = front_errors(hist[:, 0], hist[:, 1], a, t_max=3.0)
+    ko = front_errors(hist[:, 0], hist[:, 1], a, t_max=3.0, table=_koshizuka_oka())
+    return {"H_over_dp": 2 * a / point.dp, "error": mm["rms_rel_error"], "wall_s": sim.wall_time,
+            "particles": sim.n_particles, "steps": sim.steps,
+            "extra": {"max_rel_error": mm["max_rel_error"], "ko_rms_rel_error": ko["rms_rel_error"],
+                      "a": a, "simulated_s": t_end}}
+
+
+def _koshizuka_oka() -> tuple[Any, Any]:
+    import numpy as np
+
+    text = _data_text("dambreak_koshizuka_oka_1996.csv")
+    rows = [ln for ln in text.splitlines() if ln and not ln.startswith("#")][1:]
+    data = np.array([[float(v) for v in r.split(",")] for r in rows])
+    return data[:, 0], data[:, 1]
+
+
+def _coupled(point: Point) -> dict[str, Any]:
+    import contextlib
+    import io
+    import shutil
+    import tempfile
+
+    from ..cases.coupled_flume import FlumeCase, reference_run, rmse_over_h, run_coupled, run_sph_only
+
+    c = FlumeCase(wavelengths=point.options.get("wavelengths", 2.0),
+                  compare_periods=point.options.get("compare_periods", 2.0)).at(point.dp)
+    log = io.StringIO()   # run_coupled reports a failed coupling on stderr: keep it as the reason
+    # the run's directory (meta.json, gauges, saved states) goes only when the point succeeded:
+    # a failed one keeps it to look into (or resume, POST /runs/{id}/resume on a server there)
+    tmp = Path(tempfile.mkdtemp(prefix="wavesph-sweep-"))
+    try:
+        if point.method == "coupled":
+            with contextlib.redirect_stderr(log):
+                res = run_coupled(c, point.dp, tmp, two_way=True)
+        elif point.method == "sph_only":
+            res = run_sph_only(c, point.dp, tmp)
+        else:
+            raise ValueError(f"coupled case: method must be one of {COUPLED_METHODS}")
+    except BaseException as exc:
+        exc.add_note(f"run data kept in {tmp}")
+        raise
+    if res["state"] != "finished" or "t" not in res:
+        failed = res.get("exit_code") == 1 or "unstable" not in str(res["status"])
+        return {"H_over_dp": c.height / point.dp, "status": "failed" if failed else "unstable",
+                "reason": f"run ended {res['state']}: {res['status']}"
+                          + (f"; client: {log.getvalue().strip()[-300:]}" if log.getvalue() else "")
+                          + f"; run data kept in {tmp}",
+                "wall_s": res["wall_s"],
+                "particles": res["particles"], "steps": res["steps"]}
+    shutil.rmtree(tmp, ignore_errors=True)
+    t, eta = res["t"], res["eta"]["flat"]
+    err = rmse_over_h(t, eta, reference_run(c, t)["flat"], c)
+    return {"H_over_dp": c.height / point.dp, "error": err, "wall_s": res["wall_s"],
+            "particles": res["particles"], "steps": res["steps"],
+            "extra": {"simulated_s": c.t_end, "wavelengths": c.wavelengths}}
+
+
+_RUNNERS: dict[str, Callable[[Point], dict[str, Any]]] = {
+    "flume": _flume, "dambreak": _dambreak, "coupled": _coupled}
+
+
+# ---------------------------------------------------------------------------- the sweep
+def _store(out: Path) -> Path:
+    d = out / "points"
+    d.mkdir(parents=True, exist_ok=True)
+    return d
+
+
+def load_record(out: Path, point: Point) -> dict[str, Any] | None:
+    path = out / "points" / f"{point.key}.json"
+    return json.loads(path.read_text()) if path.exists() else None
+
+
+def save_record(out: Path, rec: dict[str, Any]) -> None:
+    path = _store(out) / f"{rec['key']}.json"
+    tmp = path.with_suffix(".tmp")
+    tmp.write_text(json.dumps(rec, indent=1, default=float))
+    tmp.replace(path)   # a sweep killed mid-write leaves no half record behind
+
+
+def pending(points: list[Point], out: Path, retry_failed: bool = False) -> list[Point]:
+    """The points without a record in the store (and, with retry_failed, those that failed)."""
+    todo = []
+    for p in points:
+        rec = load_record(out, p)
+        if rec is None or (retry_failed and rec.get("status") == "failed"):
+            todo.append(p)
+    return todo
+
+
+def run_sweep(points: list[Point], out: Path, scheduler: str | None = None,
+              n_workers: int | None = None, retry_failed: bool = False, progress: bool = True,
+              runner: Callable[[Point], dict[str, Any]] = run_point,
+              desc: str = "sweep") -> list[dict[str, Any]]:
+    """Run the points not yet in ``out``'s store on dask.distributed (``scheduler``: an existing
+    scheduler's address, else a LocalCluster of processes, one thread each), saving each record as
+    it arrives; return the records of all ``points`` in order."""
+    from tqdm import tqdm
+
+    out = Path(out)
+    _store(out)
+    todo = pending(points, out, retry_failed)
+    if todo:
+        from dask.distributed import Client, LocalCluster, as_completed
+
+        cluster = None
+        if scheduler is None:
+            n = n_workers or max(1, min(len(todo), os.cpu_count() or 1))
+            # one numba/OpenMP thread per worker process (the workers are the parallelism); set
+            # only while the workers spawn: numba in this process refuses a changed thread count
+            saved = {v: os.environ.get(v) for v in ("NUMBA_NUM_THREADS", "OMP_NUM_THREADS")}
+            os.environ.update({v: "1" for v in saved})
+            try:
+                cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                                       dashboard_address=":0")   # any free port: no clash
+            finally:
+                for v, old in saved.items():
+                    if old is None:
+                        os.environ.pop(v, None)
+                    else:
+                        os.environ[v] = old
+        client = Client(scheduler or cluster)
+        try:
+            futures = client.map(runner, todo, key=[f"{desc}-{p.key}" for p in todo], pure=False)
+            where = {f.key: p for f, p in zip(futures, todo)}
+            bar = tqdm(total=len(points), initial=len(points) - len(todo), desc=desc,
+                       unit="point", disable=not progress)
+            for fut in as_completed(futures):
+                p = where[fut.key]
+                try:
+                    rec = fut.result()
+                except Exception as exc:   # the worker died (KilledWorker) or the task could not run
+                    rec = {"key": p.key, "case": p.case, "method": p.method, "dp": p.dp,
+                           "options": p.options, "status": "failed",
+                           "reason": f"{type(exc).__name__}: {exc}"}
+                save_record(out, rec)
+                bar.set_postfix_str(f"{p.key}: {rec.get('status')}", refresh=False)
+                bar.update(1)
+            bar.close()
+        finally:
+            client.close()
+            if cluster is not None:
+                cluster.close()
+    return [load_record(out, p) for p in points]   # type: ignore[misc]
+
+
+# ---------------------------------------------------------------------------- outputs
+def write_table(rows: list[dict[str, Any]], path: Path, columns: list[str],
+                formats: dict[str, str], command: str = "") -> None:
+    """A CSV of ``columns``, one row per record; numbers in ``formats`` columns written with that
+    format spec (``command`` as a # header line). accuracy.csv and stability.csv both."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with open(path, "w", newline="") as fh:
+        if command:
+            fh.write(f"# made by: {command}\n")
+        w = csv.DictWriter(fh, fieldnames=columns, extrasaction="ignore")
+        w.writeheader()
+        for r in rows:
+            row = {k: r.get(k) for k in columns}
+            for k, spec in formats.items():
+                if isinstance(row[k], (int, float)) and not isinstance(row[k], bool):
+                    row[k] = format(row[k], spec)
+            w.writerow(row)
+
+
+def write_csv(records: list[dict[str, Any]], path: Path, command: str = "") -> None:
+    """accuracy.csv: ACCURACY_COLUMNS, one row per point (``command`` as a # header line)."""
+    write_table(records, path, ACCURACY_COLUMNS,
+                {"error": ".6g", "wall_s": ".6g", "H_over_dp": ".6g"}, command)
+
+
+def read_csv(path: Path) -> list[dict[str, Any]]:
+    """Rows of an accuracy.csv with numbers parsed (empty cells: None)."""
+    with open(path) as fh:
+        rows = list(csv.DictReader(ln for ln in fh if not ln.startswith("#")))
+    num = {"dp": float, "H_over_dp": float, "error": float, "wall_s": float, "particles": int,
+           "steps": int}
+    return [{k: (num[k](v) if k in num and v not in ("", None) else (None if v == "" else v))
+             for k, v in r.items()} for r in rows]
+
+
+def plot_accuracy(records: list[dict[str, Any]], path: Path, title: str = "") -> None:
+    """Error (log y) against wall seconds (log x), one panel per case, one line per method, each
+    point labelled with its dp; unstable/failed points are not drawn (see the CSV)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    cases = sorted({r["case"] for r in records})
+    n = max(1, len(cases))
+    ncol = min(3, n)
+    nrow = math.ceil(n / ncol)
+    fig, axes = plt.subplots(nrow, ncol, figsize=(4.6 * ncol, 3.8 * nrow), squeeze=False)
+    # one colour per method on every panel, so a line reads the same across cases
+    methods = sorted({r["method"] for r in records})
+    colour = {m: f"C{k % 10}" for k, m in enumerate(methods)}
+    for ax, case in zip(axes.flat, cases):
+        for method in sorted({r["method"] for r in records if r["case"] == case}):
+            pts = sorted((r for r in records if r["case"] == case and r["method"] == method
+                          and r.get("status") == "ok" and r.get("error") and r.get("wall_s")),
+                         key=lambda r: -r["dp"])
+            bad = sum(1 for r in records if r["case"] == case and r["method"] == method
+                      and r.get("status") != "ok")
+            if not pts:  # named in the legend, so a missing line is not read as not run
+                ax.plot([], [], "x", color=colour[method], label=f"{method} (all {bad} unstable/failed)")
+                continue
+            label = method + (f" ({bad} unstable/failed)" if bad else "")
+            ax.plot([r["wall_s"] for r in pts], [r["error"] for r in pts], "o-", label=label,
+                    color=colour[method])
+            for r in pts:
+                ax.annotate(f"{r['dp']:g}", (r["wall_s"], r["error"]), fontsize=7,
+                            xytext=(3, 3), textcoords="offset points")
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_title(case, fontsize=10)
+        ax.set_xlabel("wall time [s]")
+        ax.set_ylabel("error (relative)")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=7)
+    for ax in list(axes.flat)[n:]:
+        ax.set_visible(False)
+    if title:
+        fig.suptitle(title, fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def records_summary(records: list[dict[str, Any]]) -> dict[str, int]:
+    out: dict[str, int] = {}
+    for r in records:
+        out[r.get("status", "?")] = out.get(r.get("status", "?"), 0) + 1
+    return out
+
+
+def point_from_dict(d: dict[str, Any]) -> Point:
+    return Point(d["case"], d["method"], float(d["dp"]), dict(d.get("options") or {}))
+
