@@ -136,10 +136,23 @@ def test_event_loop_is_not_blocked_by_stepping(tmp_path, factory):
             for _ in range(3):
                 r = srv.http.get(f"/runs/{run['id']}", timeout=10)
                 assert r.json()["state"] == "running" and r.json()["windows"] == 0
+                # the page says what a run without progress does (ux.md F3)
+                assert r.json()["detail"].startswith("first window")
         finally:
             gate.set()
         c.recv()
+        assert srv.http.get(f"/runs/{run['id']}").json()["detail"] is None
         bye(c)
+
+
+@pytest.mark.parametrize("cached, detail", [(True, "first window"),
+                                            (False, "first window: compiling SPH kernels (first run only)")])
+def test_run_detail_says_when_kernels_compile(monkeypatch, cached, detail):
+    import sph_core.progress
+    from server.runs import compile_detail
+
+    monkeypatch.setattr(sph_core.progress, "kernels_cached", lambda: cached)
+    assert compile_detail("first window") == detail
 
 
 def test_restart_lists_finished_runs_with_their_data(tmp_path, factory):

@@ -33,7 +33,9 @@ def test_wave_client_couples_an_airy_wave(srv, engines, door):
 
 
 def test_wavesph_couple_waits_while_its_run_is_queued(tmp_path, factory, capsys, monkeypatch):
-    """Issue 15: `wavesph couple` on a queued run waits (saying so) and then couples."""
+    """Issue 15: `wavesph couple` on a queued run waits (saying so) and then couples. The
+    server's WORKING frames (1.1 KEEPALIVE) make it say once that the server prepares the run
+    (ux.md F3: not a misleading "queued" line every 10 s)."""
     import argparse
     import threading
 
@@ -42,7 +44,7 @@ def test_wavesph_couple_waits_while_its_run_is_queued(tmp_path, factory, capsys,
     from wave_client.coupling import runner
 
     monkeypatch.setattr(runner, "WAIT_NOTE_EVERY", 0.2)
-    with live_server(tmp_path, factory, max_waiting=1) as srv:
+    with live_server(tmp_path, factory, max_waiting=1, keepalive_every=0.1) as srv:
         blocker = srv.create()
         srv.wait_state(blocker["id"], "waiting_for_client")
         run = srv.create(t_end=0.1)
@@ -57,7 +59,8 @@ def test_wavesph_couple_waits_while_its_run_is_queued(tmp_path, factory, capsys,
         assert couple_cli.main(args) == 0
         assert srv.wait_state(run["id"], "finished")["windows"] == 2
     err = capsys.readouterr().err
-    assert "the run is not started yet" in err
+    assert err.count("the server is preparing the run") == 1, err
+    assert "no WELCOME yet" not in err  # WORKING came every 0.1 s: the server was never silent
 
 
 def test_wave_client_names_its_log_columns_from_gauges(srv, engines, tmp_path):
