@@ -194,10 +194,11 @@ class RunManager:
             run.info.status = reason if reason.startswith(state) else f"{state}: {reason}"
         run.info.resumable = (state in (FAILED, CANCELLED) and _windowed(run.request)
                               and has_seal(run.state_file))
+        if state in TERMINAL or state == QUEUED:  # no stale "building" after a restart
+            run.info.detail = None
         if state in TERMINAL:
             run.info.ended = time.time()
             run.info.queue_position = None
-            run.info.detail = None
         log.info("run %s: %s", run.info.id, run.info.status)
         self.save(run)
         self._pulse()
