@@ -39,6 +39,8 @@ def test_wavesph_couple_waits_while_its_run_is_queued(tmp_path, factory, capsys,
     import argparse
     import threading
 
+    import httpx
+
     from server_harness import live_server
     from wavesph_cli import couple as couple_cli
     from wave_client.coupling import runner
@@ -54,9 +56,19 @@ def test_wavesph_couple_waits_while_its_run_is_queued(tmp_path, factory, capsys,
         args = parser.parse_args(["--url", f"ws://127.0.0.1:{srv.port}/runs/{run['id']}/couple",
                                   "--model", "linear", "--H", "0.02", "--T", "1.0",
                                   "--window", "0.05", "--timeout", "20", "--queue-timeout", "30"])
-        # the run starts only when the blocker ends, a second or so after the client came
-        threading.Timer(1.0, lambda: srv.http.delete(f"/runs/{blocker['id']}")).start()
+        # the run starts only when the blocker ends, a second or so after the client came; the
+        # timer thread has its own HTTP client (sharing srv.http across threads broke its socket)
+        deleted: list[int] = []
+
+        def end_blocker() -> None:
+            with httpx.Client(base_url=srv.url, headers=srv.http.headers, timeout=30) as http:
+                deleted.append(http.delete(f"/runs/{blocker['id']}").status_code)
+
+        timer = threading.Timer(1.0, end_blocker)
+        timer.start()
         assert couple_cli.main(args) == 0
+        timer.join(30)
+        assert deleted and 200 <= deleted[0] < 300, deleted
         assert srv.wait_state(run["id"], "finished")["windows"] == 2
     err = capsys.readouterr().err
     assert err.count("the server is preparing the run") == 1, err
