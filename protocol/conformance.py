@@ -17,7 +17,9 @@ windows, GET, GOBACK exactness (the redone window bit-identical), BYE. ``--error
 a second run that the kit spends on an out-of-order SOLVE inside a session (answered ERROR
 OUT_OF_ORDER with the SOLVE's seq; that run ends failed). The first run ends ``finished``.
 Client checks: HELLO first, frames numbered 1, 2, 3, ..., nodes asked before the first SET,
-windows contiguous with N finite values each, BYE at the end.
+windows contiguous with N finite values each, BYE at the end; a client that asks for KEEPALIVE
+(1.1) gets WORKING frames before WELCOME and before the first RESULT, and must wait through them.
+The server checks ask for KEEPALIVE too and check every WORKING frame's seq and elapsed.
 
 Imports only ``protocol`` (and the websockets package for ws://).
 """
@@ -37,7 +39,7 @@ import numpy as np
 from .errors import ErrorCode, ProtocolError
 from .framing import FrameDecoder, decode_frame, encode_frame
 from .messages import (Bye, Error, Gauges, Get, GetGauges, GetNodes, GoBack, Hello, Message, Nodes,
-                       Result, Set, Solve, Welcome)
+                       Result, Set, Solve, Welcome, Working)
 from .session import TIME_RTOL, Reply, Restore, SetWindow, SolveWindow, SphSession, Measure, PeerError
 from .wire import HEADER, MAGIC, NO_GAUGE, NO_SCENE_HASH, Capability, GaugeKind
 
@@ -153,15 +155,27 @@ def check_server(url: str, run_id: str = "", error_run_id: str | None = None, wi
         rep.check("handshake: HELLO -> WELCOME", False, f"cannot connect: {exc}")
         return rep
     seq = 0
+    working: list[str] = []  # WORKING frames seen (1.1 KEEPALIVE), and what was wrong with them
+    bad_working: list[str] = []
 
     def ask(msg: Message) -> tuple[int, Message] | None:
+        """The reply to ``msg``; WORKING frames for it (before WELCOME too) are checked, skipped."""
         nonlocal seq
         seq += 1
         conn.send(encode_frame(msg, seq))
-        return conn.recv()
+        last = -math.inf
+        while True:
+            got = conn.recv()
+            if got is None or not isinstance(got[1], Working):
+                return got
+            elapsed = got[1].elapsed
+            working.append(f"{msg.TYPE.name}: {elapsed:.3g} s")
+            if got[0] != seq or not (math.isfinite(elapsed) and elapsed >= max(last, 0.0)):
+                bad_working.append(f"seq {got[0]} for request {seq}, elapsed {elapsed!r}")
+            last = elapsed
 
     try:
-        want = int(Capability.GOBACK | Capability.GAUGE_INFO)
+        want = int(Capability.GOBACK | Capability.GAUGE_INFO | Capability.KEEPALIVE)
         got = ask(Hello(want, NO_SCENE_HASH, "" if ws and not run_id else run_id, "protocol.conformance"))
         if not rep.check("handshake: HELLO -> WELCOME", got is not None and isinstance(got[1], Welcome)
                          and got[0] == 1, _seen(got)):
@@ -228,6 +242,13 @@ def check_server(url: str, run_id: str = "", error_run_id: str | None = None, wi
         got = ask(Bye("conformance done"))
         rep.check("BYE -> BYE with the same seq, then close", got is not None
                   and isinstance(got[1], Bye) and got[0] == seq and conn.closed_after(), _seen(got))
+        if w.capabilities & Capability.KEEPALIVE:
+            rep.check("KEEPALIVE (1.1): WORKING only with the pending request's seq, elapsed growing",
+                      not bad_working, "; ".join(bad_working[:3]) or
+                      f"{len(working)} WORKING frames" + (f" ({', '.join(working[:3])})" if working else ""))
+        else:
+            rep.check("no WORKING without KEEPALIVE granted", not working, "; ".join(working[:3])
+                      or "KEEPALIVE not granted (a 1.0 server)")
     except (OSError, TimeoutError, ProtocolError) as exc:
         rep.check("session", False, f"{type(exc).__name__}: {exc}")
     finally:
@@ -298,7 +319,7 @@ def scripted_scene(t_end: float = 0.2, window_max: float = 0.05,
                    run_id: str = "conformance") -> tuple[Welcome, Nodes, Gauges]:
     """The scripted server's run: one inlet column of 8 nodes, two gauges, depth 0.3 m."""
     z = np.linspace(-0.29, 0.1, 8)
-    welcome = Welcome(int(Capability.GOBACK), NO_SCENE_HASH, g=9.81, depth=0.3,
+    welcome = Welcome(int(Capability.GOBACK | Capability.KEEPALIVE), NO_SCENE_HASH, g=9.81, depth=0.3,
                       still_water_level=0.3, z_ref=-0.15, t_start=0.0, t_end=t_end, dt_sph=1e-3,
                       window_max=window_max, idle_timeout=TIMEOUT, n_nodes=z.size, n_gauges=2,
                       max_payload=0, run_id=run_id, server="protocol.conformance")
@@ -341,6 +362,13 @@ def check_client(sock: socket.socket, report: Report | None = None, t_end: float
                 session = SphSession(*scripted_scene(t_end, run_id=run_id))
             action = session.receive(seq, msg)
             decoder.max_payload = session.max_payload
+            if isinstance(msg, Hello) or (isinstance(action, SolveWindow) and windows == 0):
+                # a client that asked for KEEPALIVE must wait through WORKING before WELCOME (a
+                # run being built) and before the first RESULT (the compile); None for 1.0
+                for elapsed in (0.0, 0.01):
+                    frame = session.working_frame(elapsed)
+                    if frame is not None:
+                        sock.sendall(frame)
             if isinstance(action, Reply):
                 sock.sendall(action.data)
                 if action.close:

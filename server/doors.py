@@ -18,7 +18,7 @@ import numpy as np
 
 from protocol import (NO_SCENE_HASH, Capability, ErrorCode, GaugeKind, Gauges, Nodes, ProtocolError,
                       Result, SphSession, Welcome, encode_frame)
-from protocol.messages import Error, Hello, Message
+from protocol.messages import Error, Hello, Message, Working
 from protocol.session import Measure, PeerError, Reply, Restore, SetWindow, SolveWindow
 
 from .engine import CouplingEngine, Measurement
@@ -46,10 +46,11 @@ def error_frame(code: ErrorCode, text: str, seq: int = 0) -> bytes:
 
 
 async def claim_run(manager: RunManager, run_id: str, hello: Hello,
-                    transport: DoorTransport) -> Run | None:
-    """The run a client's HELLO names, reserved for it at once and attached (a stepping slot
-    taken) when it is built and a slot is free; the client waits for WELCOME meanwhile. None if
-    the client left while waiting; ProtocolError (BUSY, CANCELLED, OUT_OF_ORDER,
+                    transport: DoorTransport, seq: int = 1) -> Run | None:
+    """The run a client's HELLO (frame ``seq``) names, reserved for it at once and attached (a
+    stepping slot taken) when it is built and a slot is free; the client waits for WELCOME
+    meanwhile, with a WORKING frame every ``keepalive_every`` s if it asked for KEEPALIVE (1.1).
+    None if the client left while waiting; ProtocolError (BUSY, CANCELLED, OUT_OF_ORDER,
     SCENE_MISMATCH) to refuse it. A refused client leaves the run as it was."""
     known = manager.runs.get(run_id)
     if known is not None and hello.scene_hash not in (NO_SCENE_HASH, bytes.fromhex(known.info.scene_hash)):
@@ -63,8 +64,17 @@ async def claim_run(manager: RunManager, run_id: str, hello: Hello,
         raise ProtocolError(ErrorCode.BUSY, str(exc)) from None
     attach = asyncio.ensure_future(manager.attach(run))
     recv = asyncio.ensure_future(transport.recv())
+    # the build (a first run compiles the SPH kernels) or a busy server can take minutes: a
+    # 1.1 client that asked is told the server is alive, so its read timeout need not cover it
+    every = manager.settings.keepalive_every if hello.capabilities & Capability.KEEPALIVE else None
+    tic = time.perf_counter()
     try:
-        await asyncio.wait({attach, recv}, return_when=asyncio.FIRST_COMPLETED)
+        while not (await asyncio.wait({attach, recv}, timeout=every,
+                                      return_when=asyncio.FIRST_COMPLETED))[0]:
+            try:
+                await transport.send(encode_frame(Working(time.perf_counter() - tic), seq))
+            except PeerGone:
+                return None
         if recv.done():
             if recv.result() is None:  # the client left; a ProtocolError passes through
                 return None
@@ -334,6 +344,7 @@ def _progress(manager: RunManager, run: Run, engine: CouplingEngine,
     if values:
         info.last_gauges = values
         info.windows += 1
+        info.detail = None
     wall = time.perf_counter() - connected
     if solve_time > 0:
         info.particle_steps_per_s = engine.n_particles * engine.steps / solve_time

@@ -191,6 +191,8 @@ class RunManager:
             run.info.status = reason if reason.startswith(state) else f"{state}: {reason}"
         run.info.resumable = (state in (FAILED, CANCELLED) and _windowed(run.request)
                               and has_seal(run.state_file))
+        if state in TERMINAL or state == QUEUED:  # no stale "building" after a restart
+            run.info.detail = None
         if state in TERMINAL:
             run.info.ended = time.time()
             run.info.queue_position = None
@@ -325,11 +327,14 @@ class RunManager:
         """Worker thread: build and advance the sph_core Simulation, reporting progress."""
         from sph_core.simulation import Simulation
 
+        run.info.detail = compile_detail("building the run")
         sim = Simulation(run.request.scene, run_dir=run.dir / "sph")
         run.info.particles = sim.n_particles
+        run.info.detail = compile_detail("first steps")
 
         def progress(s: Simulation) -> None:
             info = run.info
+            info.detail = None
             info.t, info.steps = s.t, s.steps
             info.particle_steps_per_s = (s.n_particles * s.steps / s.wall_time if s.wall_time > 0
                                          else None)
@@ -361,8 +366,8 @@ class RunManager:
         """Build the engine, then hold the slot until the client's session ends (see doors.py)."""
         loop = asyncio.get_running_loop()
         try:
-            run.engine = await loop.run_in_executor(self.builder, self.engine_factory,
-                                                    run.request, run.dir)
+            run.engine = await loop.run_in_executor(self.builder, self._build, run)
+            run.info.detail = None
             if run.resume_from is not None:
                 await loop.run_in_executor(self.builder, run.engine.load_state, run.resume_from)
             run.info.particles = run.engine.n_particles
@@ -381,6 +386,7 @@ class RunManager:
                 if self.source_driver is None:
                     raise RuntimeError("this server has no driver for built-in wave sources")
                 run.client_attached = True  # it took its stepping slot when it left the queue
+                run.info.detail = compile_detail("first window")
                 run.attached.set()
                 run.task_client = asyncio.get_running_loop().create_task(self.source_driver(self, run))
             while True:
@@ -406,6 +412,11 @@ class RunManager:
             if run.engine:
                 await loop.run_in_executor(self.builder, run.engine.close)
             self._release(run)
+
+    def _build(self, run: Run) -> CouplingEngine:
+        """Builder thread: the run's engine (the detail's check imports sph_core off the loop)."""
+        run.info.detail = compile_detail("building the run")
+        return self.engine_factory(run.request, run.dir)
 
     # ------------------------------------------------------------------ coupling clients
     def reserve(self, run_id: str) -> Run:
@@ -438,6 +449,8 @@ class RunManager:
             if run.info.state == WAITING and len(self.active) < self.settings.max_runs:
                 self.waiting.discard(run.info.id)
                 self.active.add(run.info.id)
+                if run.info.windows == 0:  # cleared by the first window's progress
+                    run.info.detail = compile_detail("first window")
                 run.attached.set()
                 self._schedule()  # its waiting place is free for the next queued coupled run
                 return
@@ -447,6 +460,17 @@ class RunManager:
         """Wake every door waiting in ``attach``: a state or a slot changed."""
         self._changed.set()
         self._changed = asyncio.Event()
+
+
+def compile_detail(doing: str) -> str:
+    """``doing``, with "compiling SPH kernels (first run only)" while numba's cache lacks them:
+    on a fresh install the first build and window of a server take minutes (ux.md F3)."""
+    try:
+        from sph_core.progress import kernels_cached
+        cold = not kernels_cached()
+    except Exception:  # noqa: BLE001 -- a detail for the page, never a failure
+        cold = False
+    return f"{doing}: compiling SPH kernels (first run only)" if cold else doing
 
 
 def _waits_for_client(request: RunRequest) -> bool:

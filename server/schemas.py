@@ -53,6 +53,7 @@ class RunInfo(BaseModel):
     state: str
     status: str
     reason: str | None = None
+    detail: str | None = None   # what a started run does before it shows progress (building, compiling)
     created: float
     started: float | None = None
     ended: float | None = None

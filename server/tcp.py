@@ -38,7 +38,7 @@ async def _handle(manager: RunManager, transport: TcpDoor) -> None:
             raise ProtocolError(ErrorCode.OUT_OF_ORDER, f"{msg.TYPE.name} before HELLO")
         if not msg.run_id:
             raise ProtocolError(ErrorCode.BUSY, "HELLO.run_id is empty: the TCP port needs the run id")
-        run = await claim_run(manager, msg.run_id, msg, transport)
+        run = await claim_run(manager, msg.run_id, msg, transport, seq)
         if run is None:
             return await transport.close()
     except ProtocolError as exc:

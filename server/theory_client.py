@@ -15,7 +15,7 @@ from __future__ import annotations
 import logging
 from pathlib import Path
 
-from protocol import MAX_PAYLOAD, Bye, Error, Message, Nodes, Result, Welcome, decode_frame
+from protocol import MAX_PAYLOAD, Bye, Error, Message, Nodes, Result, Welcome, Working, decode_frame
 from protocol.session import HELLO_LIMIT
 from wave_client.coupling import CouplingCore, CouplingOptions, GaugeLog
 
@@ -82,6 +82,8 @@ class TheoryClient:
             return []
         if isinstance(msg, Error):  # the door ends the session and sets the run's state
             return []
+        if core.session.keepalive(seq, msg):  # KEEPALIVE: a window solving longer than
+            return []                           # keepalive_every (a compile, a loaded machine)
         raise RuntimeError(f"theory source: unexpected {msg.TYPE.name} from the server")
 
     async def close(self) -> None:

@@ -34,7 +34,7 @@ async def couple_websocket(ws: WebSocket, run_id: str) -> None:
             raise ProtocolError(ErrorCode.OUT_OF_ORDER, f"{msg.TYPE.name} before HELLO")
         if msg.run_id not in ("", run_id):
             raise ProtocolError(ErrorCode.BUSY, f"HELLO.run_id {msg.run_id!r} differs from the URL's {run_id!r}")
-        run = await claim_run(manager, run_id, msg, transport)
+        run = await claim_run(manager, run_id, msg, transport, seq)
         if run is None:
             return await transport.close()
     except ProtocolError as exc:

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from protocol import FrameDecoder, GetNodes, Hello, Set, Solve, encode_frame
+from protocol import Error, ErrorCode, FrameDecoder, GetNodes, Hello, Set, Solve, Welcome, encode_frame
 from protocol.conformance import Report, main, check_client
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -92,3 +92,36 @@ def test_the_kit_exits_1_when_a_server_check_fails(capsys):
     out = capsys.readouterr().out.splitlines()
     assert out[0].startswith("FAIL malformed frame -> MALFORMED -- cannot connect")
     assert out[-1].startswith("FAILED: malformed frame -> MALFORMED, ")
+
+
+def test_wave_client_waits_through_working_before_welcome_and_result():
+    """wave_client asks for KEEPALIVE (1.1): the scripted server then sends WORKING before
+    WELCOME and before the first RESULT, and the client must couple through them."""
+    from wave_client.coupling import CouplingOptions, couple
+    from wave_client.theories.linear import AiryWave
+
+    def client(port: int) -> None:
+        couple(f"tcp://127.0.0.1:{port}", AiryWave(height=0.02, period=1.0, depth=0.3),
+               CouplingOptions(window=0.05), run_id="kit", timeout=30.0, progress=False)
+
+    rep = _scripted(client)
+    assert rep.ok, rep.lines
+    assert ("PASS", "at least one window solved", "4 windows") in rep.lines
+
+
+def test_a_client_that_asks_keepalive_but_rejects_early_working_fails():
+    """A client that asked for KEEPALIVE and takes WORKING for the reply to HELLO breaks the
+    session: the kit reports it."""
+    def strict(port: int) -> None:
+        with socket.create_connection(("127.0.0.1", port)) as sock:
+            dec = FrameDecoder()
+            sock.sendall(encode_frame(Hello(4, bytes(32), "x", "strict"), 1))
+            seq, first = dec.feed(sock.recv(1 << 16))[0]
+            if not isinstance(first, Welcome):  # a 1.1 client written before WORKING-before-WELCOME
+                sock.sendall(encode_frame(Error(int(ErrorCode.OUT_OF_ORDER), "expected WELCOME"), 2))
+            sock.settimeout(10)
+            while sock.recv(1 << 16):  # until the kit closes: closing first races its sends
+                pass
+
+    rep = _scripted(strict)
+    assert not rep.ok and "no ERROR from the client" in rep.failed()

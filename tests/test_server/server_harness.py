@@ -62,6 +62,16 @@ class LiveServer(InProcessServer):
             time.sleep(0.02)
 
 
+def wait_until(condition, what: str, timeout: float = 30.0) -> None:
+    """Poll ``condition()`` until true: a loaded machine delays what an idle one does at once
+    (e.g. the engine closes just after the run reads finished), so never assert it immediately."""
+    deadline = time.monotonic() + timeout
+    while not condition():
+        if time.monotonic() > deadline:
+            raise AssertionError(f"not within {timeout:g} s: {what}")
+        time.sleep(0.02)
+
+
 @contextmanager
 def live_server(tmp_path: Path, engine_factory=None, log_level: str = "warning", **settings):
     with LiveServer(tmp_path / "runs", engine_factory, log_level, **settings) as srv:

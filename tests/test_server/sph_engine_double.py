@@ -12,6 +12,7 @@ from __future__ import annotations
 import copy
 import dataclasses
 import math
+import threading
 import time
 
 import numpy as np
@@ -23,7 +24,7 @@ from sph_core.simulation import UnstableError
 
 class EngineDouble:
     def __init__(self, request: RunRequest, dt_sph: float = 1e-3, solve_delay: float = 0.0,
-                 unstable_after: float | None = None) -> None:
+                 unstable_after: float | None = None, gate: threading.Event | None = None) -> None:
         scene = request.scene
         swl = scene.still_water_level if scene.still_water_level is not None else max(
             b.z1 for b in scene.water_blocks)
@@ -38,6 +39,7 @@ class EngineDouble:
                                     [p.name for p in gauges])
         self.t, self.steps, self.n_particles = 0.0, 0, 1000
         self.solve_delay, self.unstable_after = solve_delay, unstable_after
+        self.gate = gate  # a solve waits until the test sets it (no timing guess under load)
         self.in_force = {"u": np.zeros(n), "w": np.zeros(n), "eta": np.zeros(n)}
         self.pending: tuple[float, float, dict[str, np.ndarray]] | None = None
         self.imposed: list[tuple[float, float, float]] = []  # (t, mean u, mean eta) per sub-step
@@ -54,6 +56,8 @@ class EngineDouble:
         t0, t1, new = self.pending
         if self.solve_delay:
             time.sleep(self.solve_delay)
+        if self.gate is not None and not self.gate.wait(60.0):
+            raise RuntimeError("test double: the gate was never opened")
         k = max(1, math.ceil((t1 - t0) / self.summary.dt_sph - 1e-9))
         for i in range(1, k + 1):
             s = i / k

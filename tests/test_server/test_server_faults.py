@@ -61,7 +61,6 @@ def test_duplicate_probe_names_are_named(srv):
 
 def test_request_validation_runs_off_the_event_loop(tmp_path, factory, monkeypatch):
     import threading
-    import time
 
     import httpx
 
@@ -69,20 +68,27 @@ def test_request_validation_runs_off_the_event_loop(tmp_path, factory, monkeypat
 
     real = runs_router.parse_run_request
 
+    entered, gate = threading.Event(), threading.Event()
+
     def slow(raw, settings, toml=False):  # stands for a heavy validation: no stalled server
-        time.sleep(1.0)
+        entered.set()
+        gate.wait(30.0)  # held until the test has been answered: no timing guess under load
         return real(raw, settings, toml)
 
     monkeypatch.setattr(runs_router, "parse_run_request", slow)
     with live_server(tmp_path, factory) as srv:
         done = []
         post = threading.Thread(target=lambda: done.append(
-            httpx.post(srv.url + "/runs", json=_coupled_body(), timeout=30).status_code))
+            httpx.post(srv.url + "/runs", json=_coupled_body(), timeout=60).status_code))
         post.start()
-        time.sleep(0.2)
-        for _ in range(3):  # each well under the 1 s validation
-            assert srv.http.get("/runs", timeout=0.5).status_code == 200
-        post.join(timeout=30)
+        try:
+            assert entered.wait(30.0), "the POST never reached its validation"
+            for _ in range(3):  # answered while the validation is still held
+                assert srv.http.get("/runs", timeout=10).status_code == 200
+            assert not done
+        finally:
+            gate.set()
+        post.join(timeout=60)
         assert done == [201]
 
 

@@ -119,7 +119,10 @@ def test_cancel_standalone_and_unknown_run(srv):
 
 
 def test_event_loop_is_not_blocked_by_stepping(tmp_path, factory):
-    with live_server(tmp_path, lambda r, d: factory(r, d, solve_delay=1.0)) as srv:
+    import threading
+
+    gate = threading.Event()  # the solve lasts until the test opens it: no timing guess
+    with live_server(tmp_path, lambda r, d: factory(r, d, gate=gate)) as srv:
         run = srv.create()
         srv.wait_state(run["id"], "waiting_for_client")
         c = TcpClient(srv.tcp_port)
@@ -128,12 +131,28 @@ def test_event_loop_is_not_blocked_by_stepping(tmp_path, factory):
         from protocol import Set, Solve
         import numpy as np
         c.request(Set(0.0, 0.05, np.zeros(n), np.zeros(n), np.zeros(n)), Solve())
-        # while the engine works for 1 s, HTTP answers (each request well under the 1 s solve)
-        for _ in range(3):
-            r = srv.http.get(f"/runs/{run['id']}", timeout=0.5)
-            assert r.json()["state"] == "running"
+        # while the engine is held in its solve, HTTP answers
+        try:
+            for _ in range(3):
+                r = srv.http.get(f"/runs/{run['id']}", timeout=10)
+                assert r.json()["state"] == "running" and r.json()["windows"] == 0
+                # the page says what a run without progress does (ux.md F3)
+                assert r.json()["detail"].startswith("first window")
+        finally:
+            gate.set()
         c.recv()
+        assert srv.http.get(f"/runs/{run['id']}").json()["detail"] is None
         bye(c)
+
+
+@pytest.mark.parametrize("cached, detail", [(True, "first window"),
+                                            (False, "first window: compiling SPH kernels (first run only)")])
+def test_run_detail_says_when_kernels_compile(monkeypatch, cached, detail):
+    import sph_core.progress
+    from server.runs import compile_detail
+
+    monkeypatch.setattr(sph_core.progress, "kernels_cached", lambda: cached)
+    assert compile_detail("first window") == detail
 
 
 def test_restart_lists_finished_runs_with_their_data(tmp_path, factory):

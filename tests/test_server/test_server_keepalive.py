@@ -61,3 +61,47 @@ def test_wave_client_waits_through_working_frames(tmp_path):
                         progress=False)
         assert len(report.records) == 2
         assert srv.wait_state(run["id"], "finished")["windows"] == 2
+
+
+def _frames_until(sock: socket.socket, dec: FrameDecoder, stop, limit: float) -> list:
+    """Frames read until ``stop(frames)`` or ``limit`` seconds of silence."""
+    got: list = []
+    sock.settimeout(limit)
+    while not stop(got):
+        try:
+            data = sock.recv(1 << 16)
+        except socket.timeout:
+            break
+        if not data:
+            break
+        got.extend(dec.feed(data))
+    return got
+
+
+def test_working_frames_before_welcome_while_the_run_is_not_ready(tmp_path, factory):
+    """A HELLO for a run that is queued (or being built, or waiting for a slot) waits for
+    WELCOME; a 1.1 client that asked for KEEPALIVE gets WORKING meanwhile (the HELLO's seq,
+    elapsed since the HELLO), a 1.0 client gets nothing but the WELCOME."""
+    with live_server(tmp_path, factory, max_waiting=1, keepalive_every=0.1) as srv:
+        blocker = srv.create()
+        srv.wait_state(blocker["id"], "waiting_for_client")
+        run = srv.create(t_end=0.1)
+        assert srv.http.get(f"/runs/{run['id']}").json()["state"] == "queued"
+        # 1.0: silence until WELCOME
+        with socket.create_connection(("127.0.0.1", srv.tcp_port), timeout=10) as sock:
+            sock.sendall(ClientSession().request(Hello(0, bytes(32), run["id"], "old client")))
+            assert _frames_until(sock, FrameDecoder(), lambda g: bool(g), 1.0) == []
+        # 1.1 with KEEPALIVE: WORKING frames, then WELCOME once the blocker is gone
+        cs, dec = ClientSession(), FrameDecoder()
+        with socket.create_connection(("127.0.0.1", srv.tcp_port), timeout=10) as sock:
+            sock.sendall(cs.request(Hello(int(Capability.KEEPALIVE), bytes(32), run["id"], "new")))
+            early = _frames_until(sock, dec, lambda g: len(g) >= 3, 10.0)
+            assert len(early) == 3 and all(isinstance(m, Working) and seq == cs.seq for seq, m in early)
+            elapsed = [m.elapsed for _, m in early]
+            assert elapsed == sorted(elapsed) and elapsed[0] > 0.05
+            assert srv.http.delete(f"/runs/{blocker['id']}").status_code in (200, 202, 204)
+            rest = _frames_until(sock, dec, lambda g: any(isinstance(m, Welcome) for _, m in g), 30.0)
+            assert rest and isinstance(rest[-1][1], Welcome)
+            assert all(isinstance(m, Working) for _, m in rest[:-1])
+            welcome = cs.reply(*rest[-1], expect=Welcome)
+            assert welcome.capabilities & Capability.KEEPALIVE

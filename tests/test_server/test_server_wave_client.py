@@ -33,16 +33,20 @@ def test_wave_client_couples_an_airy_wave(srv, engines, door):
 
 
 def test_wavesph_couple_waits_while_its_run_is_queued(tmp_path, factory, capsys, monkeypatch):
-    """Issue 15: `wavesph couple` on a queued run waits (saying so) and then couples."""
+    """Issue 15: `wavesph couple` on a queued run waits (saying so) and then couples. The
+    server's WORKING frames (1.1 KEEPALIVE) make it say once that the server prepares the run
+    (ux.md F3: not a misleading "queued" line every 10 s)."""
     import argparse
     import threading
+
+    import httpx
 
     from server_harness import live_server
     from wavesph.cli import couple as couple_cli
     from wave_client.coupling import runner
 
     monkeypatch.setattr(runner, "WAIT_NOTE_EVERY", 0.2)
-    with live_server(tmp_path, factory, max_waiting=1) as srv:
+    with live_server(tmp_path, factory, max_waiting=1, keepalive_every=0.1) as srv:
         blocker = srv.create()
         srv.wait_state(blocker["id"], "waiting_for_client")
         run = srv.create(t_end=0.1)
@@ -52,12 +56,23 @@ def test_wavesph_couple_waits_while_its_run_is_queued(tmp_path, factory, capsys,
         args = parser.parse_args(["--url", f"ws://127.0.0.1:{srv.port}/runs/{run['id']}/couple",
                                   "--model", "linear", "--H", "0.02", "--T", "1.0",
                                   "--window", "0.05", "--timeout", "20", "--queue-timeout", "30"])
-        # the run starts only when the blocker ends, a second or so after the client came
-        threading.Timer(1.0, lambda: srv.http.delete(f"/runs/{blocker['id']}")).start()
+        # the run starts only when the blocker ends, a second or so after the client came; the
+        # timer thread has its own HTTP client (sharing srv.http across threads broke its socket)
+        deleted: list[int] = []
+
+        def end_blocker() -> None:
+            with httpx.Client(base_url=srv.url, headers=srv.http.headers, timeout=30) as http:
+                deleted.append(http.delete(f"/runs/{blocker['id']}").status_code)
+
+        timer = threading.Timer(1.0, end_blocker)
+        timer.start()
         assert couple_cli.main(args) == 0
+        timer.join(30)
+        assert deleted and 200 <= deleted[0] < 300, deleted
         assert srv.wait_state(run["id"], "finished")["windows"] == 2
     err = capsys.readouterr().err
-    assert "the run is not started yet" in err
+    assert err.count("the server is preparing the run") == 1, err
+    assert "no WELCOME yet" not in err  # WORKING came every 0.1 s: the server was never silent
 
 
 def test_wave_client_names_its_log_columns_from_gauges(srv, engines, tmp_path):

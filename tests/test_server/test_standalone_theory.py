@@ -110,3 +110,16 @@ def test_cancelled_theory_run_keeps_its_data_and_resumes_to_the_end(tmp_path):
     assert t.size == done["windows"] == 50 and np.all(np.diff(t) > 0)
     np.testing.assert_allclose(t[-1], 1.0)
     assert (run_dir / "theory.csv").exists() and (run_dir / "theory.1.csv").exists()
+
+
+def test_standalone_theory_run_waits_through_working_frames(tmp_path, factory):
+    """reliability.md defect 1: a window solving longer than keepalive_every (the compile, a
+    loaded machine) sends the built-in client WORKING frames; it waits, as a socket client does."""
+    slow = lambda request, run_dir: factory(request, run_dir, solve_delay=0.05)  # noqa: E731
+    with live_server(tmp_path, slow, keepalive_every=0.01) as srv:
+        r = srv.http.post("/runs", json={"scene": {**FLUME, "t_end": 0.1}, "mode": "standalone",
+                                         "source": {**SOURCE, "window": 0.05}})
+        assert r.status_code == 201, r.text
+        info = srv.wait_state(r.json()["id"], "finished", "failed", "unstable", timeout=60)
+    assert info["state"] == "finished", info["status"]
+    assert info["windows"] == 2

@@ -297,7 +297,7 @@ def test_vanished_peer_times_out(transport):
             with pytest.raises(CouplingTimeout, match=r"within 0.4 s \(window 2/10\)"):
                 await run_coupling(peer.url, AiryWave(H, T, DEPTH), CouplingOptions(window=WINDOW),
                                    run_id="r1", timeout=0.4, progress=False)
-            assert time.perf_counter() - t0 < 3.0
+            assert time.perf_counter() - t0 < 10.0  # the 0.4 s timeout, not the 120 s default
             await asyncio.wait_for(fake.done.wait(), 5.0)
 
     run(scenario())

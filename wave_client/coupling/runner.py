@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import asyncio
 import json
+import math
 import os
 import sys
 import time
@@ -33,7 +34,8 @@ from wave_client.coupling.core import (CouplingCore, CouplingError, CouplingOpti
                                        ServerEnded, WindowRecord)
 from wave_client.coupling.transport import TransportClosed, open_transport, parse_url
 
-WAIT_NOTE_EVERY = 10.0  # [s] between "still waiting for the run to start" lines
+WAIT_NOTE_EVERY = 10.0  # [s] between "still waiting for the run to start" lines (1.0 server)
+WAIT_NOTE_EVERY_WORKING = 60.0  # [s] between "still preparing" lines (WORKING before WELCOME)
 
 
 class CouplingTimeout(CouplingError):
@@ -159,7 +161,7 @@ async def run_coupling(url: str, model: ModelSource, options: CouplingOptions | 
         await transport.send([core.hello()])
         stage, waited = f"waiting for the run to start (up to {queue_timeout:g} s)", timeout
         timeout = queue_timeout
-        welcome = await _await_welcome(transport, queue_timeout, progress)
+        welcome = await _await_welcome(transport, core, queue_timeout, progress)
         stage, timeout = "handshake", waited
         await transport.send([core.on_welcome(*welcome)])
         core.on_nodes(*await transport.recv(timeout))
@@ -232,22 +234,35 @@ async def _reply(transport, core: CouplingCore, timeout: float):
             return reply
 
 
-async def _await_welcome(transport, limit: float, progress: bool):
-    """The server's answer to HELLO, which waits while the run is queued or every stepping slot
-    of the server is busy: up to ``limit`` s, saying so every WAIT_NOTE_EVERY s."""
+async def _await_welcome(transport, core: CouplingCore, limit: float, progress: bool):
+    """The server's answer to HELLO, which waits while the run is queued, being built (a first
+    run compiles the SPH kernels) or every stepping slot of the server is busy: up to ``limit``
+    s. A 1.1 server sends WORKING meanwhile (KEEPALIVE): said once, then every
+    WAIT_NOTE_EVERY_WORKING s; a silent (1.0) server is noted every WAIT_NOTE_EVERY s."""
     loop = asyncio.get_running_loop()
     start = loop.time()
+    noted = -math.inf  # when the last "preparing" line was printed
     while True:
         left = limit - (loop.time() - start)
         if left <= 0:
             raise TimeoutError
         try:
-            return await transport.recv(min(left, WAIT_NOTE_EVERY))
+            reply = await transport.recv(min(left, WAIT_NOTE_EVERY))
         except TimeoutError:
             if progress and loop.time() - start < limit:
-                print(f"wavesph couple: the run is not started yet (queued, or the server's "
-                      f"stepping slots are busy); reserved for us, waiting "
+                print(f"wavesph couple: no WELCOME yet (the run is queued, being built, or the "
+                      f"server's stepping slots are busy); reserved for us, waiting "
                       f"{loop.time() - start:.0f} s", file=sys.stderr, flush=True)
+            continue
+        if not core.session.keepalive(*reply):
+            return reply
+        now = loop.time()
+        if progress and now - noted >= WAIT_NOTE_EVERY_WORKING:
+            print("wavesph couple: the server is preparing the run (a first run compiles the SPH "
+                  "kernels, 1-5 min; or it waits for a stepping slot)..." if noted < 0 else
+                  f"wavesph couple: the server is still preparing the run ({now - start:.0f} s)",
+                  file=sys.stderr, flush=True)
+            noted = now
 
 
 def _keep(report: CouplingReport, err: CouplingError) -> CouplingError:

@@ -78,7 +78,11 @@ def main(args: argparse.Namespace) -> int:
             print(f"\nwavesph demo: interrupted; partial results in {out}", file=sys.stderr)
             return 130
     from wavesph.cases.demo_flume import GAUGES, demo_figures, depth_for, plot_demo, run_demo
+    from sph_core.progress import kernels_cached
 
+    if not kernels_cached():  # else the first window's minutes of numba look like a hang (ux F3)
+        print("wavesph demo: compiling SPH kernels (first run only, 1-5 min) ...", file=sys.stderr,
+              flush=True)
     out.mkdir(parents=True, exist_ok=True)
     tic = time.perf_counter()
     try:
