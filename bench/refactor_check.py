@@ -24,12 +24,9 @@ ROWS = ("x", "z", "vx", "vz", "rho", "p")
 
 
 def _scenes() -> dict:
-    try:
-        from wavesph.cases.dambreak import dambreak_scene
-        from wavesph.cases.rigid_bodies import floating_box_scene
-    except ImportError:   # the layout before the cases moved into the wavesph package
-        from cases.dambreak import dambreak_scene
-        from cases.rigid_bodies import floating_box_scene
+    from wavesph.cases.dambreak import dambreak_scene
+    from wavesph.cases.rigid_bodies import floating_box_scene
+
     force = {"kind": "force", "name": "wall", "x0": 0.75, "x1": 0.85, "z0": 0.0, "z1": 0.5}
     point = {"kind": "point", "name": "pt", "x": 0.1, "z": 0.05}
     db = dict(a=0.2, dp=0.01, t_end=1.0, tank_length=0.8, probes=[force, point])

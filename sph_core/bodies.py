@@ -23,7 +23,7 @@ Loads (``body_loads``): the force on body particle k is minus the sum of the pai
 exerts on its fluid neighbours, -sum_i m_i a_ik with a_ik the very pair term of fluid_pass
 (pressure + Monaghan AV + Lo & Shao laminar, with the Adami wall state of k), computed as a gather
 over body particles (no scatter, no race), then summed per body. Fluid + body momentum is thus
-conserved to round-off (tests/sph_core/test_bodies.py).
+conserved to round-off (tests/test_sph_core/test_bodies.py).
 
 Dynamics (per metre of span):
     free:    m dU/dt = F_x - k_x (x - x0) - c_x U,   m dW/dt = F_z + m g_z - k_z (z - z0) - c_z W,

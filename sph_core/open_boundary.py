@@ -74,7 +74,7 @@ GHOST_DET_MIN = 1e-3
 # continuum rho0 g (z_s - z) (kernel truncation: at h/dp 2 and rest the top fluid row, dp/2 below
 # the surface, carries ~195 Pa against 98 at dp 0.02, the next row +11 %, deeper rows within a
 # few %), and a buffer holding the continuum profile there pulls the fluid's surface corner into
-# it (4 cm/s in still water; tests/sph_core/test_open_boundary.py). Below the band the imposed
+# it (4 cm/s in still water; tests/test_sph_core/test_open_boundary.py). Below the band the imposed
 # hydrostatic pressure stands (seed 002's inlet). The band is h: the top two rows at h/dp 2.
 SURFACE_BAND_H = 1.0
 # per-end counters[b, :]

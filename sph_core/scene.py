@@ -191,7 +191,7 @@ class Constants(_Model):
     delta: float = Field(0.1, ge=0, description="delta-SPH density diffusion coefficient")
     # the wave's loss to artificial viscosity against the bed does not converge with dp (the
     # boundary layer is far thinner than dp): 6.1 -> 1.8 %/m (closed tank, dp 0.02) without it.
-    # A violent surge over a bed wants it back (dam break: cases/dambreak.py sets 1).
+    # A violent surge over a bed wants it back (dam break: wavesph/cases/dambreak.py sets 1).
     alpha_wall_factor: float = Field(0.0, ge=0, description=(
         "artificial viscosity against walls = this x alpha (DualSPHysics' ViscoBoundFactor); "
         "0 (default) for waves, 1 for violent flows on a bed (the dam-break case); applies "
@@ -387,7 +387,7 @@ OUTLET_PRESSURE = "extrapolated"
 INLET_PRESSURE = "hydrostatic"
 # ... of an ISPH inlet: extrapolated. ISPH puts p = 0 on its surface particles' centres, dp/2 below
 # the surface, so its pressure is ~rho0 g dp/2 below the continuum hydrostatic one a hydrostatic
-# buffer holds; in the still open flume (d 0.3 m, dp 0.02, tests/sph_core/test_open_boundary.py)
+# buffer holds; in the still open flume (d 0.3 m, dp 0.02, tests/test_sph_core/test_open_boundary.py)
 # that pushed the inlet's surface corner at 0.10 m/s within 0.1 s and the run blew up at 0.87 s;
 # extrapolated, the flume stays still (docs/schemes.md "ISPH with open ends and bodies").
 ISPH_INLET_PRESSURE = "extrapolated"

@@ -161,14 +161,14 @@ def test_demo_dambreak_refuses_a_dp_that_does_not_divide_the_column(tmp_path, ca
 def test_demo_says_it_compiles_kernels_on_a_cold_cache(tmp_path, capsys, monkeypatch, cached):
     """ux.md F3: before the coupled demo's first window (minutes of numba on a fresh install)
     the demo says so, and only then."""
-    import cases.demo_flume
+    import wavesph.cases.demo_flume
 
     def interrupted(*args, **kwargs):  # stands for the run: the line must come before it
         raise KeyboardInterrupt
 
     monkeypatch.setattr(progress, "kernels_cached", lambda: cached)
-    monkeypatch.setattr(cases.demo_flume, "run_demo", interrupted)
-    assert wavesph_cli.main(["demo", "--no-plot", "-o", str(tmp_path / "d")]) == 130
+    monkeypatch.setattr(wavesph.cases.demo_flume, "run_demo", interrupted)
+    assert wavesph.cli.main(["demo", "--no-plot", "-o", str(tmp_path / "d")]) == 130
     said = "compiling SPH kernels (first run only" in capsys.readouterr().err
     assert said is not cached
 

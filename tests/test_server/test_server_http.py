@@ -149,7 +149,7 @@ def test_event_loop_is_not_blocked_by_stepping(tmp_path, factory):
                                             (False, "first window: compiling SPH kernels (first run only)")])
 def test_run_detail_says_when_kernels_compile(monkeypatch, cached, detail):
     import sph_core.progress
-    from server.runs import compile_detail
+    from server.run_manager import compile_detail
 
     monkeypatch.setattr(sph_core.progress, "kernels_cached", lambda: cached)
     assert compile_detail("first window") == detail

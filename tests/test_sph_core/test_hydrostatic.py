@@ -27,7 +27,7 @@ ISPH_STILL = ("ISPH: unstable at t = 2.89 s of 3.19 (12 particles excluded befor
 # against WCSPH's 35 s and 24 s (2 shared cores, load 4-6, 2026-11-26, `pytest --durations=0`):
 # slow. The default run keeps Riemann's still-water checks at the same bounds (pressure 3 %,
 # speed 1 % of sqrt(g d)) in the open-ended flume (6 s),
-# tests/sph_core/test_open_boundary.py::test_still_water_with_open_ends_*[riemann]
+# tests/test_sph_core/test_open_boundary.py::test_still_water_with_open_ends_*[riemann]
 @pytest.fixture(scope="module", params=["wcsph", pytest.param("riemann", marks=pytest.mark.slow),
                                         pytest.param("isph", marks=[
     pytest.mark.slow, pytest.mark.xfail(strict=True, reason=ISPH_STILL)])])
