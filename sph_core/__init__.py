@@ -9,9 +9,36 @@
     sim.close()
 
 Modules: scene (config), geometry (particle layout), particles (SoA storage), state (the typed
-containers the kernels take), neighbours (cell lists), kernels (Wendland C2), eos (Tait), wcsph
-(the physical terms as jitted passes), open_boundary (the jitted open-end terms), step (the one
-jitted time loop), open_ends (open ends as a value of the run), simulation (the run), probes,
-output, progress (a terminal progress bar over a run). Named cases (dam break, flumes) live in
-the `wavesph.cases` package; the commands in `wavesph.cli`.
+containers the kernels take), neighbours (cell lists), pairs (the one neighbour walk), terms (the
+per-pair terms), kernels (Wendland C2), eos (Tait), wcsph (the passes and integrators),
+open_boundary (the jitted open-end terms), step (the one jitted time loop), open_ends (open ends
+as a value of the run), simulation (the run), probes, output, progress (a terminal progress bar
+over a run). Named cases (dam break, flumes) live in `wavesph.cases`; the commands in
+`wavesph.cli`.
+
+The compiled kernels are cached on disk (numba ``cache=True``) in a folder named by a hash of
+this package's sources: numba checks only a function's own file, and a kernel holds the code of
+every function it calls from other modules (``step.run`` holds every pass), so after an edit of
+one module the old folder would serve stale machine code. ``NUMBA_CACHE_DIR`` (if set) is the
+parent of that folder, else ``~/.cache/wavesph``.
 """
+
+import hashlib
+import os
+from pathlib import Path
+
+import numba
+
+
+def _kernel_cache_dir() -> str:
+    """The on-disk kernel cache of this exact source tree (module docstring)."""
+    h = hashlib.sha1()
+    for path in sorted(Path(__file__).parent.rglob("*.py")):
+        h.update(path.read_bytes())
+    base = os.environ.get("NUMBA_CACHE_DIR") or os.path.join(
+        os.environ.get("XDG_CACHE_HOME") or os.path.join(Path.home(), ".cache"), "wavesph")
+    return os.path.join(base, f"kernels-{h.hexdigest()[:16]}")
+
+
+# before any submodule's @njit(cache=True) builds its cache locator
+numba.config.CACHE_DIR = _kernel_cache_dir()

@@ -145,69 +145,68 @@ def _set_prescribed(bd, b, t_pos, t_vel):
         bd.acc[b, c] = 0.0
 
 
+# the stages of the integrators a body follows (``_advance``)
+KICK_DRIFT, KICK, PREDICT, CORRECT = range(4)
+
+
 @njit(cache=True)
-def bodies_kick_drift(bd, t, dt):
-    """kdk first half: qd += dt/2 acc, q += dt qd (prescribed: q(t + dt), qd(t + dt/2))."""
+def _advance(bd, t, dt, stage):
+    """One integrator stage of every body (t: the step's start); prescribed bodies take their
+    motion at the stage's time instead."""
     if not bd.active:
         return
     hdt = 0.5 * dt
     for b in range(bd.nb):
+        if stage == PREDICT:
+            for c in range(3):
+                bd.qn[b, c] = bd.q[b, c]
+                bd.qdn[b, c] = bd.qd[b, c]
         mo = bd.motion[b]
         if mo == FREE or mo == HINGED:
             for c in range(3):
-                bd.qd[b, c] += hdt * bd.acc[b, c]
-                bd.q[b, c] += dt * bd.qd[b, c]
+                if stage == KICK_DRIFT:
+                    bd.qd[b, c] += hdt * bd.acc[b, c]
+                    bd.q[b, c] += dt * bd.qd[b, c]
+                elif stage == KICK:
+                    bd.qd[b, c] += 0.5 * dt * bd.acc[b, c]
+                elif stage == PREDICT:
+                    bd.q[b, c] += hdt * bd.qd[b, c]
+                    bd.qd[b, c] += hdt * bd.acc[b, c]
+                else:
+                    u = bd.qdn[b, c] + dt * bd.acc[b, c]
+                    bd.q[b, c] = bd.qn[b, c] + 0.5 * dt * (u + bd.qdn[b, c])
+                    bd.qd[b, c] = u
         elif mo == PRESCRIBED:
-            _set_prescribed(bd, b, t + dt, t + hdt)
+            if stage == KICK_DRIFT:
+                _set_prescribed(bd, b, t + dt, t + hdt)
+            elif stage == PREDICT:
+                _set_prescribed(bd, b, t + hdt, t + hdt)
+            else:
+                _set_prescribed(bd, b, t + dt, t + dt)
+
+
+@njit(cache=True)
+def bodies_kick_drift(bd, t, dt):
+    """kdk first half: qd += dt/2 acc, q += dt qd (prescribed: q(t + dt), qd(t + dt/2))."""
+    _advance(bd, t, dt, KICK_DRIFT)
 
 
 @njit(cache=True)
 def bodies_kick(bd, t, dt):
     """kdk second half: qd += dt/2 acc (prescribed: qd(t + dt)); t is the step's start."""
-    if not bd.active:
-        return
-    for b in range(bd.nb):
-        mo = bd.motion[b]
-        if mo == FREE or mo == HINGED:
-            for c in range(3):
-                bd.qd[b, c] += 0.5 * dt * bd.acc[b, c]
-        elif mo == PRESCRIBED:
-            _set_prescribed(bd, b, t + dt, t + dt)
+    _advance(bd, t, dt, KICK)
 
 
 @njit(cache=True)
 def bodies_predict(bd, t, dt):
     """Symplectic predictor: save (q, qd); q += dt/2 qd, qd += dt/2 acc."""
-    if not bd.active:
-        return
-    hdt = 0.5 * dt
-    for b in range(bd.nb):
-        for c in range(3):
-            bd.qn[b, c] = bd.q[b, c]
-            bd.qdn[b, c] = bd.qd[b, c]
-        mo = bd.motion[b]
-        if mo == FREE or mo == HINGED:
-            for c in range(3):
-                bd.q[b, c] += hdt * bd.qd[b, c]
-                bd.qd[b, c] += hdt * bd.acc[b, c]
-        elif mo == PRESCRIBED:
-            _set_prescribed(bd, b, t + hdt, t + hdt)
+    _advance(bd, t, dt, PREDICT)
 
 
 @njit(cache=True)
 def bodies_correct(bd, t, dt):
     """Symplectic corrector: qd = qdn + dt acc^{n+1/2}, q = qn + dt/2 (qd + qdn)."""
-    if not bd.active:
-        return
-    for b in range(bd.nb):
-        mo = bd.motion[b]
-        if mo == FREE or mo == HINGED:
-            for c in range(3):
-                u = bd.qdn[b, c] + dt * bd.acc[b, c]
-                bd.q[b, c] = bd.qn[b, c] + 0.5 * dt * (u + bd.qdn[b, c])
-                bd.qd[b, c] = u
-        elif mo == PRESCRIBED:
-            _set_prescribed(bd, b, t + dt, t + dt)
+    _advance(bd, t, dt, CORRECT)
 
 
 @njit(cache=True)

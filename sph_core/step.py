@@ -12,9 +12,9 @@ append).
 Only the kernels a scene uses are compiled: each optional part of the step is an argument that
 is None when the scene has none of it, and numba prunes an ``if x is None`` branch on an
 argument before it types the rest, so a closed WCSPH tank never compiles the open-end, body,
-Riemann, shifting or predictor-corrector kernels (``step_parts`` builds them from a Simulation).
-Each combination compiles once and is cached; the stages below are inlined into ``run`` and
-``initialise``, so only those two are compiled per combination:
+Riemann, shifting or predictor-corrector kernels (``step_parts`` builds them from a Simulation;
+each combination compiles once and is cached; the stages are not ``inline="always"``: inlined
+into ``run`` they returned a wrong particle count, numba 0.68.1):
     ends     OpenEnds, or None (closed tank)
     bd       Bodies, or None (no rigid bodies)
     pc       True: the symplectic predictor-corrector; None: kdk leapfrog
@@ -86,7 +86,7 @@ def step_parts(ends, bd, integrator: str, riemann: bool, shifting: bool) -> tupl
             True if shifting else None)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _forces(ps, n, cells, prm, bd, riemann):
     """Rates of every fluid particle (ax, az, drho) and body (acc) at the current, sorted state."""
     wall_pass(ps, n, cells, prm)
@@ -98,7 +98,7 @@ def _forces(ps, n, cells, prm, bd, riemann):
         body_loads(ps, n, cells, prm, bd)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _shift(ps, n, cells, prm, dt, v2max, shift):
     """Particle shifting after the update (shifting.py), if on: Fickian or delta-plus."""
     if shift is not None:
@@ -108,13 +108,13 @@ def _shift(ps, n, cells, prm, dt, v2max, shift):
             shift_particles(ps, n, cells, prm, dt)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _place(ps, n, bd):
     if bd is not None:
         place_bodies(ps, n, bd)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _body_v2max(bd):
     if bd is None:
         return 0.0
@@ -137,7 +137,7 @@ def initialise(ps, ps2, cells, prm, ends, bd, riemann, n):
     return stable_dt(max(v2max, _body_v2max(bd)), a2max, rmax, prm), n
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _step_kdk(ps, ps2, cells, prm, ends, bd, riemann, shift, n, t, dt):
     """One leapfrog step; the state ends in ps2. Returns (n, status, n_flag, v2max, a2max, rmax)."""
     # a particle that left the tank box finishes the step like the others (the sort clamps it
@@ -165,7 +165,7 @@ def _step_kdk(ps, ps2, cells, prm, ends, bd, riemann, shift, n, t, dt):
     return _verdict(n, n_bad, n_band, n_out, v2max, a2max, rmax)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _step_pc(ps, ps2, cells, prm, ends, bd, riemann, shift, n, t, dt):
     """One symplectic predictor-corrector step; the state ends in ps2. Same returns as _step_kdk."""
     n = sort_by_cell(ps, ps2, N_SORTED_PC, n, cells)
@@ -192,7 +192,7 @@ def _step_pc(ps, ps2, cells, prm, ends, bd, riemann, shift, n, t, dt):
     return _verdict(n, n_bad, n_band, n_out, v2max, a2max, rmax)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _verdict(n, n_bad, n_band, n_out, v2max, a2max, rmax):
     """Status after a completed step (the guards in the order they are reported)."""
     if n_bad > 0:
