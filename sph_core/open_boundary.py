@@ -13,14 +13,14 @@ x_f, outward normal n_x (-1 left, +1 right); d = (x - x_f) n_x is the depth into
 Every step, for buffer particle i of end b (the window [t0, t1] holds the source's samples,
 interpolated linearly in time and linearly in z between the nodes):
     u_i = u(z_i, t) + du_b P_b(z_i),  w_i = w(z_i, t),  x_i += dt u_i  (z_i fixed: layers level)
-    du_b = n_x (eta_meas,b - eta_gauge,b(t)) G  if absorbing   (seed 002 correction; the gain G
-           in the ends' sqgd: sqrt(g/d) there, Biesel's piston gain at the period "linear", see
-           sph_core.absorption; by default a causal filter of e following it per frequency);
-           P_b the correction's vertical profile (ends.corr_prof on the nodes: 1 for a piston,
-           linear theory's cosh k(z + d) at the wave period for the "mode" profile)
-    surface z_s,b = swl + eta_b(t)  (elevation imposed)  or, extrapolated, swl + eta_meas,b (surface
-    "gauge") or swl + eta_b(t) + (eta_meas,b - eta_gauge,b(t)) (surface "face": the source's
-    elevation at the face plus the gauge's mismatch)
+    du_b = n_x G[eta_meas,b - eta_gauge,b(t)]  if absorbing   (seed 002 correction; G a causal
+           filter of the mismatch following Biesel's piston gain per frequency, its direct
+           gain in the ends' sqgd, see sph_core.absorption); P_b the correction's vertical
+           profile (ends.corr_prof on the nodes: linear theory's cosh k(z + d) at the wave
+           period, 1 when no period is known)
+    surface z_s,b = swl + eta_b(t)  (elevation imposed)  or, extrapolated,
+    swl + eta_b(t) + (eta_meas,b - eta_gauge,b(t)) (the source's elevation at the face plus the
+    gauge's mismatch)
     active (interacts as fluid) iff z_i < z_s,b;  rho_i = rho0 (1 + rho0 g (z_s,b - z_i)/B)^(1/7)
     (hydrostatic below the imposed or measured surface; Tait EOS, same form as the initial state),
     or, at an end with ghost extrapolation (OpenEnds.ghost; seed 002's outlet), and at a
@@ -127,9 +127,9 @@ def window_weight(t, win_t):
 @njit(cache=True)
 def boundary_state(b, r, dt, ends):
     """(z_s, du) of end b: the surface the buffer uses and the absorption velocity correction
-    du = n_x [G e + sum_j c_j x_j], e = eta_meas - eta_gauge, each x_j the mismatch low-passed
-    with time constant tau_j (advanced by dt here, exactly for e constant over the step; all
-    c_j = 0 for a plain gain; sph_core.absorption). A dry gauge counts as no mismatch."""
+    du = n_x [D e + sum_j c_j x_j], e = eta_meas - eta_gauge, each x_j the mismatch low-passed
+    with time constant tau_j (advanced by dt here, exactly for e constant over the step;
+    sph_core.absorption). A dry gauge counts as no mismatch."""
     eta_th = (1.0 - r) * ends.win_eta[b, 0] + r * ends.win_eta[b, 1]
     etag_th = (1.0 - r) * ends.win_etag[b, 0] + r * ends.win_etag[b, 1]
     em = ends.eta_meas[b]
@@ -138,18 +138,16 @@ def boundary_state(b, r, dt, ends):
         e = em - etag_th if math.isfinite(em) else 0.0
         du = ends.sqgd[b] * e
         for j in range(ends.filt_c.shape[1]):
-            c = ends.filt_c[b, j]
-            if c != 0.0:
-                xj = ends.filt_x[b, j]
-                xj += (e - xj) * (1.0 - math.exp(-dt / ends.filt_tau[b, j]))
-                ends.filt_x[b, j] = xj
-                du += c * xj
+            xj = ends.filt_x[b, j]
+            xj += (e - xj) * (1.0 - math.exp(-dt / ends.filt_tau[b, j]))
+            ends.filt_x[b, j] = xj
+            du += ends.filt_c[b, j] * xj
         du *= ends.nx[b]
     eta = eta_th
     if not ends.imposed[b] and math.isfinite(em):
-        # measured surface: the gauge's reading, or carried to the face by the source (the
-        # target wave's own phase over the gauge offset; only the mismatch is read at the gauge)
-        eta = eta_th + (em - etag_th) if ends.surface_at_face[b] else em
+        # measured surface carried to the face by the source (the target wave's own phase over
+        # the gauge offset; only the mismatch is read at the gauge)
+        eta = eta_th + (em - etag_th)
     zs = ends.swl[b] + eta
     # the surface never leaves the tank (validated data; a measured one could overshoot)
     zs = min(max(zs, ends.z_bed[b]), ends.z_top[b])

@@ -77,13 +77,12 @@ def _limited(sx, sz, tangential, nx, nz, max_shift):
 
 
 # next to an open end's buffer (an active buffer particle within 2h; scene
-# constants.shift_open_end): 0 "full" shift, 1 "tangential" (no component along the face
-# normal, x), 2 "none". The buffer is a lattice moved by the imposed flow, and the crossing rules
-# count fluid in and out by where particles are: a shift beside it moves fluid that the imposed
-# flux did not carry. Measured (docs/wave_decay_study.md, 2026-11-23 "flume-vs-tank gap",
-# oscillating flow through both ends, delta-plus): "tangential" gains water fast (the vertical
-# shift alone beside the buffer's fixed rows), "none" keeps the count as without shifting.
-SHIFT_OPEN_END = {"full": 0, "tangential": 1, "none": 2}
+# constants.shift_open_end): 0 "full" shift, 1 "none". The buffer is a lattice moved by the
+# imposed flow, and the crossing rules count fluid in and out by where particles are: a shift
+# beside it moves fluid that the imposed flux did not carry. Measured (docs/wave_decay_study.md
+# "flume-vs-tank gap", oscillating flow through both ends, delta-plus): "none" keeps the count
+# as without shifting ("tangential", retired: docs/decisions/shift_open_end.md, gained water).
+SHIFT_OPEN_END = {"full": 0, "none": 1}
 
 
 @njit(cache=True, inline="always")
@@ -108,16 +107,10 @@ def _near_buffer(i, ps, cells, h):
 
 @njit(cache=True, inline="always")
 def _open_end_limited(i, ps, cells, prm, sx, sz, tangential, nx, nz, max_shift):
-    """_limited, with the open-end rule (prm.shift_open) applied after the surface projection and
-    before the cap for a particle beside a buffer."""
-    rule = prm.shift_open
-    if rule != 0 and _near_buffer(i, ps, cells, prm.h):
-        sx, sz = _limited(sx, sz, tangential, nx, nz, math.inf)
-        if rule == 1:
-            sx = 0.0
-        else:
-            sx = sz = 0.0
-        return _limited(sx, sz, False, nx, nz, max_shift)
+    """_limited, or no shift at all for a particle beside a buffer under the open-end rule
+    prm.shift_open "none"."""
+    if prm.shift_open != 0 and _near_buffer(i, ps, cells, prm.h):
+        return 0.0, 0.0
     return _limited(sx, sz, tangential, nx, nz, max_shift)
 
 
