@@ -57,8 +57,10 @@ from numba import njit, prange
 
 from .eos import density, pressure
 from .kernels import f_of_q, w_of_q
-from .neighbours import block_of, cell_at
+from .neighbours import cell_at
+from .pairs import fluid_only, fluidlike, gather
 from .particles import FLUID, INACTIVE, INLET, OUTLET
+from .probes import _mass_pair  # the boundary gauge is an elevation probe's line
 
 # idle buffer particles: above the boundary's surface, kept in place but not interacting.
 # End b has active kind INLET + b and idle kind INLET_IDLE + b.
@@ -281,6 +283,26 @@ def update_buffers(ps, n, t1, dt, ends, prm):
     return buffer_transitions(ps, n, ends, r, zs0, du0, zs1, du1)
 
 
+@njit(cache=True, inline="always")
+def _ghost_pair(i, j, dx, dz, r2, ps, ctx, a):
+    """The moment sums of ghost_pressure (in its order a00 a01 a02 a10 a11 a12 a20 a21 a22 b0 b1
+    b2) for fluid neighbour j of the node; ctx = (h, alpha_w, alpha_f)."""
+    h = ctx[0]
+    rx = -dx  # r_j = x_j - x_g
+    rz = -dz
+    q = math.sqrt(r2) / h
+    v = ps.m[j] / ps.rho[j]
+    w = v * w_of_q(q, ctx[1])
+    fv = v * f_of_q(q, ctx[2]) * h  # h-scaled gradient weight: F r_j h, with r_j / h below
+    sx = rx / h
+    sz = rz / h
+    pj = ps.p[j]
+    return (a[0] + w, a[1] + w * sx, a[2] + w * sz,
+            a[3] + fv * rx, a[4] + fv * rx * sx, a[5] + fv * rx * sz,
+            a[6] + fv * rz, a[7] + fv * rz * sx, a[8] + fv * rz * sz,
+            a[9] + w * pj, a[10] + fv * rx * pj, a[11] + fv * rz * pj)
+
+
 @njit(cache=True)
 def ghost_pressure(ps, cells, xg, zg, prm):
     """First-order consistent SPH interpolation of the fluid pressure at a ghost node (xg, zg)
@@ -292,47 +314,11 @@ def ghost_pressure(ps, cells, xg, zg, prm):
     matrix is the identity for a full, regular support). Returns (p_g, p_x, p_z, order): order 1
     if the determinant exceeds GHOST_DET_MIN, 0 for the Shepard value sum V W p / sum V W with no
     gradient, -1 if the node has no fluid neighbour."""
-    x = ps.x
-    z = ps.z
-    kind = ps.kind
-    cell_start = cells.start
-    ncx = cells.ncx
     h = prm.h
-    aw = prm.alpha_w
-    af = prm.alpha_f
-    s2 = 4.0 * h * h
-    cxl, cxh, czl, czh = block_of(cell_at(xg, zg, cells), cells)
-    a00 = a01 = a02 = a10 = a11 = a12 = a20 = a21 = a22 = 0.0
-    b0 = b1 = b2 = 0.0
-    for zz in range(czl, czh + 1):
-        row = zz * ncx
-        for j in range(cell_start[row + cxl], cell_start[row + cxh + 1]):
-            if kind[j] != FLUID:
-                continue
-            dx = x[j] - xg
-            dz = z[j] - zg
-            r2 = dx * dx + dz * dz
-            if r2 >= s2:
-                continue
-            q = math.sqrt(r2) / h
-            v = ps.m[j] / ps.rho[j]
-            w = v * w_of_q(q, aw)
-            fv = v * f_of_q(q, af) * h  # h-scaled gradient weight: F r_j h, with r_j / h below
-            sx = dx / h
-            sz = dz / h
-            pj = ps.p[j]
-            a00 += w
-            a01 += w * sx
-            a02 += w * sz
-            a10 += fv * dx
-            a11 += fv * dx * sx
-            a12 += fv * dx * sz
-            a20 += fv * dz
-            a21 += fv * dz * sx
-            a22 += fv * dz * sz
-            b0 += w * pj
-            b1 += fv * dx * pj
-            b2 += fv * dz * pj
+    s = gather(-1, xg, zg, cell_at(xg, zg, cells), ps, cells, 4.0 * h * h, fluid_only,
+               _ghost_pair, (h, prm.alpha_w, prm.alpha_f),
+               (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0))
+    a00, a01, a02, a10, a11, a12, a20, a21, a22, b0, b1, b2 = s
     if a00 <= 0.0:
         return 0.0, 0.0, 0.0, -1
     det = (a00 * (a11 * a22 - a12 * a21) - a01 * (a10 * a22 - a12 * a20)
@@ -402,32 +388,15 @@ def surface_z(ps, cells, xp, z_lo, z_hi, dz, prm):
     rho_f(z) = sum_j m_j W(x - x_j) over fluid and active buffer particles on points z_lo + k dz;
     the surface is the highest z where rho_f falls through rho0/2 (linear between points).
     Returns NaN when no point reaches rho0/2 (dry)."""
-    x = ps.x
-    z = ps.z
-    m = ps.m
-    kind = ps.kind
-    cell_start = cells.start
-    ncx = cells.ncx
     h = prm.h
-    aw = prm.alpha_w
     level = 0.5 * prm.rho0
     s2 = 4.0 * h * h
     nz = int((z_hi - z_lo) / dz) + 1
     prev = 0.0
     for k in range(nz - 1, -1, -1):
         zk = z_lo + k * dz
-        cxl, cxh, czl, czh = block_of(cell_at(xp, zk, cells), cells)
-        s = 0.0
-        for zz in range(czl, czh + 1):
-            row = zz * ncx
-            for j in range(cell_start[row + cxl], cell_start[row + cxh + 1]):
-                kj = kind[j]
-                if kj == FLUID or kj == INLET or kj == OUTLET:
-                    ddx = xp - x[j]
-                    ddz = zk - z[j]
-                    r2 = ddx * ddx + ddz * ddz
-                    if r2 < s2:
-                        s += m[j] * w_of_q(math.sqrt(r2) / h, aw)
+        s = gather(-1, xp, zk, cell_at(xp, zk, cells), ps, cells, s2, fluidlike, _mass_pair,
+                   (h, prm.alpha_w), 0.0)
         if s >= level:
             if k == nz - 1:
                 return zk
