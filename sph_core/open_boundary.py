@@ -168,8 +168,8 @@ def _end_of(k):
 @njit(parallel=True, cache=True)
 def buffer_update(ps, n, dt, r, zs0, du0, zs1, du1, ends, prm):
     """Impose velocity, move, (de)activate and set hydrostatic density of every buffer particle."""
+    # the rows written as locals (``ps.x[i] = ...`` inside a prange writes nothing, numba 0.68.1)
     x = ps.x
-    z = ps.z
     vx = ps.vx
     vz = ps.vz
     rho_ = ps.rho
@@ -178,9 +178,6 @@ def buffer_update(ps, n, dt, r, zs0, du0, zs1, du1, ends, prm):
     ax = ps.ax
     az = ps.az
     kind = ps.kind
-    zn = ends.zn
-    win_u = ends.win_u
-    win_w = ends.win_w
     rho0 = prm.rho0
     bb = prm.b
     gam = prm.gamma
@@ -189,11 +186,12 @@ def buffer_update(ps, n, dt, r, zs0, du0, zs1, du1, ends, prm):
         b = _end_of(kind[i])
         if b < 0:
             continue
-        zi = z[i]
+        zi = ps.z[i]
         zs = zs0 if b == 0 else zs1
         du = du0 if b == 0 else du1
-        u = profile_value(zn[b], win_u[b], r, zi) + du * node_value(zn[b], ends.corr_prof[b], zi)
-        w = profile_value(zn[b], win_w[b], r, zi)
+        zn = ends.zn[b]
+        u = profile_value(zn, ends.win_u[b], r, zi) + du * node_value(zn, ends.corr_prof[b], zi)
+        w = profile_value(zn, ends.win_w[b], r, zi)
         vx[i] = u
         vz[i] = w
         x[i] += dt * u
@@ -345,28 +343,23 @@ def buffer_extrapolate(ps, n, cells, ends, prm):
     hydrostatic option). A ghost node without fluid keeps the hydrostatic value of buffer_update.
     A hydrostatic end extrapolates too, but only within SURFACE_BAND_H h below its surface z_s:
     there the SPH fluid's equilibrium is not the continuum rho0 g (z_s - z) (module docstring)."""
-    x = ps.x
-    z = ps.z
-    p_ = ps.p
+    p_ = ps.p  # the rows written as locals (see buffer_update)
     rho = ps.rho
-    kind = ps.kind
-    ghost = ends.ghost
-    x_face = ends.x_face
-    zs = ends.zs
     band = SURFACE_BAND_H * prm.h
     rho0 = prm.rho0
     bb = prm.b
     gam = prm.gamma
     for i in prange(n):
-        k = kind[i]
+        k = ps.kind[i]
         if k != INLET and k != OUTLET:
             continue
         b = 0 if k == INLET else 1
-        if not ghost[b] and z[i] < zs[b] - band:
+        zi = ps.z[i]
+        if not ends.ghost[b] and zi < ends.zs[b] - band:
             continue
-        xi = x[i]
-        xg = 2.0 * x_face[b] - xi
-        pg, px, pz, order = ghost_pressure(ps, cells, xg, z[i], prm)
+        xi = ps.x[i]
+        xg = 2.0 * ends.x_face[b] - xi
+        pg, px, pz, order = ghost_pressure(ps, cells, xg, zi, prm)
         if order < 0:
             continue
         p = max(pg + (xi - xg) * px, 0.0)

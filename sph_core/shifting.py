@@ -133,12 +133,7 @@ def _move(ps, n):
 def shift_particles(ps, n, cells, prm, dt):
     """Shift every fluid particle of the sorted state ``ps`` by A = ``prm.shift_a`` (see the
     module docstring); |dr| <= 0.05 h << the cell size, so the cell lists stay valid."""
-    vx = ps.vx
-    vz = ps.vz
-    kind = ps.kind
     h = prm.h
-    coef = prm.shift_a
-    fs_div = prm.shift_fs_div
     max_shift = 0.05 * h
     sxr = ps.xn    # scratch rows (see the module docstring), zeroed: non-fluid slots stay put
     szr = ps.zn
@@ -147,15 +142,17 @@ def shift_particles(ps, n, cells, prm, dt):
     svz = ps.vzn
     ps.f[XN:RHON + 1, :n] = 0.0
     for i in prange(n):
-        if kind[i] != FLUID:
+        if ps.kind[i] != FLUID:
             continue
         # B, grad C and the (unrenormalised) gradients of rho and v for the first-order carry
-        s = moments(i, ps, cells, prm, ps.rho, vx, vz, True)
-        dcoef = coef * h * math.sqrt(vx[i] * vx[i] + vz[i] * vz[i]) * dt
+        s = moments(i, ps, cells, prm, ps.rho, ps.vx, ps.vz, True)
+        vxi = ps.vx[i]
+        vzi = ps.vz[i]
+        dcoef = prm.shift_a * h * math.sqrt(vxi * vxi + vzi * vzi) * dt
         sx = -dcoef * s.gx
         sz = -dcoef * s.gz
         nx = nz = 0.0
-        tangential = s.mxx + s.mzz < fs_div  # div r = trace B
+        tangential = s.mxx + s.mzz < prm.shift_fs_div  # div r = trace B
         if tangential:
             # renormalised normal: grad C itself is parallel to the shift and cannot split it
             nx, nz = _surface_normal(s, s.mxx * s.mzz - s.mxz * s.mxz)
@@ -213,7 +210,6 @@ def shift_particles_dplus(ps, n, cells, prm, dt, umax):
     surface particles and those within 2h of one keep only dr - (dr . n) n. With
     ``prm.shift_carry`` the shifted particle's rho and v are carried to the new position by
     their renormalised gradients (first-order Taylor). See the module docstring for the rows."""
-    kind = ps.kind
     h = prm.h
     coef = prm.shift_a * h * umax * dt
     carry = prm.shift_carry
@@ -239,7 +235,7 @@ def shift_particles_dplus(ps, n, cells, prm, dt, umax):
     ps.f[GPX:GWZ + 1, :n] = 0.0
     # pass 1: B, lambda, the normal, the shift, the gradients; the surface scan
     for i in prange(n):
-        if kind[i] == FLUID:
+        if ps.kind[i] == FLUID:
             s = moments(i, ps, cells, prm, ps.rho, ps.vx, ps.vz, True)
             bxx = s.mxx
             bxz = s.mxz
@@ -269,7 +265,7 @@ def shift_particles_dplus(ps, n, cells, prm, dt, umax):
                         flag[i] = FS_SURFACE
     # pass 2: the surface and its vicinity (within 2h of a surface particle) shift tangentially
     for i in prange(n):
-        if kind[i] == FLUID and flag[i] != FS_ISOLATED:
+        if ps.kind[i] == FLUID and flag[i] != FS_ISOLATED:
             near = flag[i] == FS_SURFACE
             if not near:
                 near = gather(i, ps.x[i], ps.z[i], ps.cell[i], ps, cells, s2, fluid_only,
