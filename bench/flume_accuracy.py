@@ -2,11 +2,8 @@
 
     python bench/flume_accuracy.py --case III [--dp 0.01] [--periods 5] [--no-absorb]
     python bench/flume_accuracy.py --theory stokes --H 0.08 --T 2.0 --d 1.0 --dp 0.01
-    python bench/flume_accuracy.py --theory stokes2 --H 0.02 --d 0.2 --kd 1.2 --absorption shallow
     python bench/flume_accuracy.py --theory stream_function --H 0.02 --d 0.2 --dp 0.005 \
-        --kd 1.2 2.0 --absorption linear filter --h-over-dp 2 --alpha-wall 0   # one line each
-    python bench/flume_accuracy.py --theory stream_function --H 0.02 --d 0.2 --dp 0.005 \
-        --kd 2.0 --periods 2 --profile uniform mode    # the correction's vertical profile
+        --kd 1.2 2.0 --h-over-dp 2 --alpha-wall 0   # one line each
 
 Runs one case of the seed 002 validation table (tests/data/wave_cases_seed002.csv, cases I-VI)
 or any regular wave through a flume one wavelength long (standing wave: half a wavelength, faces
@@ -18,9 +15,7 @@ fit without decay reads that as reflection), reflection_3g (the plain fit over m
 either side), reflection_steady (with --steady: nine gauges, decay, over the periods after the
 outlet's start-up emission has passed them; the standard window above holds it at large kd),
 reflection_harmonics (Mansard & Funke per harmonic, first and bound second, nine
-gauges with decay), none for the standing wave; absorption (the open ends' gain: linear
-omega/(k d) at the wave period, the seed 002 shallow sqrt(g/d), or the filter following
-omega/(k d) per frequency; sph_core.absorption), kd; wall_s, particles, steps, particle_steps_per_s,
+gauges with decay), none for the standing wave; kd; wall_s, particles, steps, particle_steps_per_s,
 boundary counts, the mean water level at mid-flume (mean_level_m), the change of the flume's
 water volume per length since the start (level_drift_m) and the gauges' mean level over the
 last period (level_last_period_m).
@@ -36,7 +31,6 @@ import sys
 from pathlib import Path
 
 from wavesph.cases.wave_flume import flume_case
-from sph_core.absorption import ABSORPTION_KINDS, ABSORPTION_PROFILES, ABSORPTION_TRANSFERS
 from wave_client.theories import build_theory, wavenumber
 
 CASES_CSV = Path(__file__).resolve().parents[1] / "tests" / "data" / "wave_cases_seed002.csv"
@@ -58,9 +52,7 @@ def case_theory(theory: str, height: float, period: float, depth: float, ramp: f
 
 def run_flume_case(theory: str, height: float, period: float, depth: float, dp: float, periods: float,
                    ramp_periods: float = 1.0, absorb: bool = True, case: str | None = None,
-                   absorption: str = "linear", transfer: str = "piston",
-                   surface: str = "face", profile: str | None = None, steady: bool = False,
-                   **constants) -> dict:
+                   steady: bool = False, **constants) -> dict:
     ramp = ramp_periods * period
     model = case_theory(theory, height, period, depth, ramp)
     if theory == "irregular":  # flume length and gauges from the peak wave
@@ -70,9 +62,7 @@ def run_flume_case(theory: str, height: float, period: float, depth: float, dp: 
     out = flume_case(model, height=height, period=period, depth=depth, wavelength=wavelength,
                      dp=dp, periods=periods, ramp=ramp, standing=theory == "standing",
                      absorb=(absorb, absorb), regular=theory != "irregular",
-                     name=f"flume_{case or theory}", absorption=absorption,
-                     absorption_transfer=transfer, right_surface=surface,
-                     absorption_profile=profile, steady=steady, **constants)
+                     name=f"flume_{case or theory}", steady=steady, **constants)
     return {"case": case, "theory": theory, **constants, **out}
 
 
@@ -90,18 +80,6 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--periods", type=float, default=5.0, help="periods measured after the ramp")
     ap.add_argument("--ramp-periods", type=float, default=1.0)
     ap.add_argument("--no-absorb", action="store_true", help="switch the seed 002 correction off")
-    ap.add_argument("--absorption", choices=ABSORPTION_KINDS, nargs="+", default=["filter"],
-                    help="gain of the correction (sph_core.absorption; several: one run each)")
-    ap.add_argument("--transfer", choices=ABSORPTION_TRANSFERS, nargs="+", default=["piston"],
-                    help="ideal gain of the correction: Biesel's piston transfer function or "
-                         "the depth-mean velocity omega/(k d) (several: one run each)")
-    ap.add_argument("--surface", choices=["gauge", "face"], default="face",
-                    help="the outlet buffer's surface: the gauge's reading, or the theory's "
-                         "elevation at the face plus the gauge's mismatch")
-    ap.add_argument("--profile", choices=ABSORPTION_PROFILES, nargs="+", default=[None],
-                    help="vertical profile of the correction: uniform (a piston) or linear "
-                         "theory's cosh k(z + d) at the wave period (several: one run each; "
-                         "default: the scene's)")
     ap.add_argument("--steady", action="store_true",
                     help="also run until the outlet's start-up emission has passed the gauges "
                          "and print reflection_steady over --periods periods after it")
@@ -125,14 +103,9 @@ def main(argv: list[str] | None = None) -> int:
         ap.error("give --case, or --theory with --H --d and --T or --kd")
     dp = a.dp if a.dp else height / 10.0
     for period in periods_s:
-        for absorption in a.absorption:
-            for transfer in a.transfer:
-                for profile in a.profile:
-                    out = run_flume_case(theory, height, period, depth, dp, a.periods,
-                                         a.ramp_periods, not a.no_absorb, a.case, absorption,
-                                         transfer, a.surface, profile, a.steady,
-                                         **constants)
-                    print(json.dumps(out), flush=True)
+        out = run_flume_case(theory, height, period, depth, dp, a.periods, a.ramp_periods,
+                             not a.no_absorb, a.case, a.steady, **constants)
+        print(json.dumps(out), flush=True)
     return 0
 
 

@@ -3,7 +3,9 @@
 Runs a fixed set of small scenes a fixed number of steps and saves (``--save``) or compares
 (``--compare``) the final particle state, ordered by particle id. Scenes cover every pass:
 WCSPH with both integrators, Riemann SPH with MUSCL, Fickian and delta-plus shifting, a free
-floating body, force and point probes.
+floating body, force and point probes, and a short flume with open ends driven by a linear wave
+(imposed inlet, extrapolated outlet: buffers, ghost pressure, boundary gauges, absorption) whose
+shifting stops beside the buffers (``shift_open_end = "none"``).
 
     python bench/refactor_check.py --save /tmp/ref.npz          # on the code before the change
     python bench/refactor_check.py --compare /tmp/ref.npz       # after it
@@ -23,6 +25,29 @@ import numpy as np
 ROWS = ("x", "z", "vx", "vz", "rho", "p")
 
 
+def _flume(shifting: str) -> tuple:
+    """A 0.6 m flume, depth 0.2 m, open both ends, driven by an Airy wave (H 2 cm, T 1 s)."""
+    from sph_core.boundary_data import WaveModelBoundary
+    from sph_core.open_ends import flume_nodes
+    from sph_core.scene import make_scene
+    from wave_client.theories.linear import AiryWave
+
+    d, dp = 0.2, 0.02
+    scene = make_scene({
+        "name": f"flume_open_{shifting}", "dp": dp, "t_end": 10.0, "still_water_level": d,
+        "tank": {"x0": 0.0, "x1": 0.6, "z0": 0.0, "z1": d + 0.1},
+        "water_blocks": [{"x0": 0.0, "x1": 0.6, "z0": 0.0, "z1": d}],
+        "constants": {"c0": 10.0 * (9.81 * d) ** 0.5, "shifting": shifting,
+                      "shift_open_end": "none"},
+        "probes": [{"kind": "elevation", "name": "mid", "x": 0.3}],
+        "open_boundaries": [{"side": "left", "elevation": "imposed"},
+                            {"side": "right", "elevation": "extrapolated"}]})
+    wave = AiryWave(0.02, 1.0, d, ramp_time=0.5)
+    sources = {side: WaveModelBoundary(wave, nd, d, nd.x_face)
+               for side, nd in flume_nodes(scene).items()}
+    return scene, sources
+
+
 def _scenes() -> dict:
     from wavesph.cases.dambreak import dambreak_scene
     from wavesph.cases.rigid_bodies import floating_box_scene
@@ -37,13 +62,16 @@ def _scenes() -> dict:
         "wcsph_fickian": dambreak_scene(**db, shifting="fickian"),
         "wcsph_dplus": dambreak_scene(**db, shifting="dplus"),
         "floating_box": floating_box_scene(dp=0.02, tank_length=0.8, t_end=1.0),
+        "flume_open_dplus": _flume("dplus"),
+        "flume_open_fickian": _flume("fickian"),
     }
 
 
 def _run(scene, steps: int) -> tuple[dict, dict, int]:
     from sph_core.simulation import Simulation
 
-    sim = Simulation(scene)
+    scene, sources = scene if isinstance(scene, tuple) else (scene, None)
+    sim = Simulation(scene, sources=sources, window=0.02) if sources else Simulation(scene)
     sim.advance_steps(steps)
     ps = sim.particles
     n = ps.n

@@ -5,9 +5,9 @@
         [--h-over-dp 2.0] [--alpha 0.01] [--slip no_slip|free_slip] [--c0-factor 10] [--delta 0.1]
         [--cfl 0.25] [--integrator kdk|symplectic_pc] [--nu 1e-6] [--alpha-wall 1.0]
         [--shifting none|fickian|dplus] [--shift-a 2.0]
-        [--shift-fs-div 1.8] [--shift-open-end full|tangential|none] [--flume-wavelengths 1]
+        [--shift-fs-div 1.8] [--shift-open-end full|none] [--flume-wavelengths 1]
         [--gauge-wavelengths 0.75] [--n-gauges 12]
-        [--long] [--noise] [--absorption filter|linear|shallow] [--transfer piston|flux]
+        [--long] [--noise]
         [--scheme wcsph|riemann|isph] [--reconstruction muscl|none]
 
 --long: a flume 3 wavelengths long, 36 gauges over 2.25 wavelengths, the window after the
@@ -54,7 +54,6 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from wavesph.cases.wave_decay import amplitude_profile, convergence_orders, separated_decay  # noqa: E402
 from wavesph.cases.schemes import add_scheme_arguments, scheme_from_args  # noqa: E402
-from sph_core.absorption import ABSORPTION_KINDS, ABSORPTION_TRANSFERS  # noqa: E402
 from wave_client.theories import build_theory  # noqa: E402
 
 
@@ -78,10 +77,6 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--noise", action="store_true",
                     help="sample the particle-noise energy along x and in time (diagnostic)")
     ap.add_argument("--n-gauges", type=int, default=12, help="number of elevation gauges")
-    ap.add_argument("--absorption", choices=ABSORPTION_KINDS, help="both ends' correction "
-                    "(scene default if unset)")
-    ap.add_argument("--transfer", choices=ABSORPTION_TRANSFERS,
-                    help="the correction's ideal gain (scene default if unset)")
     ap.add_argument("--h-over-dp", type=float, help="smoothing length / dp (scene default if unset)")
     ap.add_argument("--alpha", type=float, help="artificial viscosity coefficient")
     ap.add_argument("--slip", choices=["no_slip", "free_slip"], help="wall (bed) condition")
@@ -94,7 +89,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--shift-a", type=float, help="shifting coefficient A (Lind et al. 2012)")
     ap.add_argument("--shift-fs-div", type=float, help="free-surface position-divergence limit")
     ap.add_argument("--shift-dplus-scale", type=float, help="dplus: multiplier on CFL Ma (2h)^2")
-    ap.add_argument("--shift-open-end", choices=["full", "tangential", "none"],
+    ap.add_argument("--shift-open-end", choices=["full", "none"],
                     help="shifting next to an open end's buffer")
     ap.add_argument("--no-shift-carry", action="store_true",
                     help="do not Taylor-carry rho, v of a shifted particle")
@@ -116,8 +111,6 @@ def main(argv: list[str] | None = None) -> int:
     scheme = scheme_from_args(a)
     if a.long:
         a.flume_wavelengths, a.gauge_wavelengths, a.n_gauges = 3.0, 2.25, 36
-    ends = {k: v for k, v in {"absorption": a.absorption,
-                              "absorption_transfer": a.transfer}.items() if v is not None}
     c0 = a.c0_factor * math.sqrt(9.81 * a.d)
     decays = []
     for dp in a.dp:
@@ -128,7 +121,7 @@ def main(argv: list[str] | None = None) -> int:
                                  outlet_absorb=not a.no_outlet_absorb,
                                  gauge_wavelengths=a.gauge_wavelengths, n_gauges=a.n_gauges,
                                  wait_reflection=a.long, noise=a.noise,
-                                 c0=c0, scheme=scheme, **ends, **cst)
+                                 c0=c0, scheme=scheme, **cst)
         length = float(model.length)
         decays.append(prof.decay_per_m)
         sep_decay, sep_k, sep_kr = separated_decay(prof.x, prof.amp, prof.k)

@@ -13,14 +13,14 @@ x_f, outward normal n_x (-1 left, +1 right); d = (x - x_f) n_x is the depth into
 Every step, for buffer particle i of end b (the window [t0, t1] holds the source's samples,
 interpolated linearly in time and linearly in z between the nodes):
     u_i = u(z_i, t) + du_b P_b(z_i),  w_i = w(z_i, t),  x_i += dt u_i  (z_i fixed: layers level)
-    du_b = n_x (eta_meas,b - eta_gauge,b(t)) G  if absorbing   (seed 002 correction; the gain G
-           in the ends' sqgd: sqrt(g/d) there, Biesel's piston gain at the period "linear", see
-           sph_core.absorption; by default a causal filter of e following it per frequency);
-           P_b the correction's vertical profile (ends.corr_prof on the nodes: 1 for a piston,
-           linear theory's cosh k(z + d) at the wave period for the "mode" profile)
-    surface z_s,b = swl + eta_b(t)  (elevation imposed)  or, extrapolated, swl + eta_meas,b (surface
-    "gauge") or swl + eta_b(t) + (eta_meas,b - eta_gauge,b(t)) (surface "face": the source's
-    elevation at the face plus the gauge's mismatch)
+    du_b = n_x G[eta_meas,b - eta_gauge,b(t)]  if absorbing   (seed 002 correction; G a causal
+           filter of the mismatch following Biesel's piston gain per frequency, its direct
+           gain in the ends' sqgd, see sph_core.absorption); P_b the correction's vertical
+           profile (ends.corr_prof on the nodes: linear theory's cosh k(z + d) at the wave
+           period, 1 when no period is known)
+    surface z_s,b = swl + eta_b(t)  (elevation imposed)  or, extrapolated,
+    swl + eta_b(t) + (eta_meas,b - eta_gauge,b(t)) (the source's elevation at the face plus the
+    gauge's mismatch)
     active (interacts as fluid) iff z_i < z_s,b;  rho_i = rho0 (1 + rho0 g (z_s,b - z_i)/B)^(1/7)
     (hydrostatic below the imposed or measured surface; Tait EOS, same form as the initial state),
     or, at an end with ghost extrapolation (OpenEnds.ghost; seed 002's outlet), and at a
@@ -57,8 +57,10 @@ from numba import njit, prange
 
 from .eos import density, pressure
 from .kernels import f_of_q, w_of_q
-from .neighbours import block_of, cell_at
+from .neighbours import cell_at
+from .pairs import fluid_only, fluidlike, gather
 from .particles import FLUID, INACTIVE, INLET, OUTLET
+from .probes import _mass_pair  # the boundary gauge is an elevation probe's line
 
 # idle buffer particles: above the boundary's surface, kept in place but not interacting.
 # End b has active kind INLET + b and idle kind INLET_IDLE + b.
@@ -127,9 +129,9 @@ def window_weight(t, win_t):
 @njit(cache=True)
 def boundary_state(b, r, dt, ends):
     """(z_s, du) of end b: the surface the buffer uses and the absorption velocity correction
-    du = n_x [G e + sum_j c_j x_j], e = eta_meas - eta_gauge, each x_j the mismatch low-passed
-    with time constant tau_j (advanced by dt here, exactly for e constant over the step; all
-    c_j = 0 for a plain gain; sph_core.absorption). A dry gauge counts as no mismatch."""
+    du = n_x [D e + sum_j c_j x_j], e = eta_meas - eta_gauge, each x_j the mismatch low-passed
+    with time constant tau_j (advanced by dt here, exactly for e constant over the step;
+    sph_core.absorption). A dry gauge counts as no mismatch."""
     eta_th = (1.0 - r) * ends.win_eta[b, 0] + r * ends.win_eta[b, 1]
     etag_th = (1.0 - r) * ends.win_etag[b, 0] + r * ends.win_etag[b, 1]
     em = ends.eta_meas[b]
@@ -138,18 +140,16 @@ def boundary_state(b, r, dt, ends):
         e = em - etag_th if math.isfinite(em) else 0.0
         du = ends.sqgd[b] * e
         for j in range(ends.filt_c.shape[1]):
-            c = ends.filt_c[b, j]
-            if c != 0.0:
-                xj = ends.filt_x[b, j]
-                xj += (e - xj) * (1.0 - math.exp(-dt / ends.filt_tau[b, j]))
-                ends.filt_x[b, j] = xj
-                du += c * xj
+            xj = ends.filt_x[b, j]
+            xj += (e - xj) * (1.0 - math.exp(-dt / ends.filt_tau[b, j]))
+            ends.filt_x[b, j] = xj
+            du += ends.filt_c[b, j] * xj
         du *= ends.nx[b]
     eta = eta_th
     if not ends.imposed[b] and math.isfinite(em):
-        # measured surface: the gauge's reading, or carried to the face by the source (the
-        # target wave's own phase over the gauge offset; only the mismatch is read at the gauge)
-        eta = eta_th + (em - etag_th) if ends.surface_at_face[b] else em
+        # measured surface carried to the face by the source (the target wave's own phase over
+        # the gauge offset; only the mismatch is read at the gauge)
+        eta = eta_th + (em - etag_th)
     zs = ends.swl[b] + eta
     # the surface never leaves the tank (validated data; a measured one could overshoot)
     zs = min(max(zs, ends.z_bed[b]), ends.z_top[b])
@@ -168,8 +168,8 @@ def _end_of(k):
 @njit(parallel=True, cache=True)
 def buffer_update(ps, n, dt, r, zs0, du0, zs1, du1, ends, prm):
     """Impose velocity, move, (de)activate and set hydrostatic density of every buffer particle."""
+    # the rows written as locals (``ps.x[i] = ...`` inside a prange writes nothing, numba 0.68.1)
     x = ps.x
-    z = ps.z
     vx = ps.vx
     vz = ps.vz
     rho_ = ps.rho
@@ -178,9 +178,6 @@ def buffer_update(ps, n, dt, r, zs0, du0, zs1, du1, ends, prm):
     ax = ps.ax
     az = ps.az
     kind = ps.kind
-    zn = ends.zn
-    win_u = ends.win_u
-    win_w = ends.win_w
     rho0 = prm.rho0
     bb = prm.b
     gam = prm.gamma
@@ -189,11 +186,12 @@ def buffer_update(ps, n, dt, r, zs0, du0, zs1, du1, ends, prm):
         b = _end_of(kind[i])
         if b < 0:
             continue
-        zi = z[i]
+        zi = ps.z[i]
         zs = zs0 if b == 0 else zs1
         du = du0 if b == 0 else du1
-        u = profile_value(zn[b], win_u[b], r, zi) + du * node_value(zn[b], ends.corr_prof[b], zi)
-        w = profile_value(zn[b], win_w[b], r, zi)
+        zn = ends.zn[b]
+        u = profile_value(zn, ends.win_u[b], r, zi) + du * node_value(zn, ends.corr_prof[b], zi)
+        w = profile_value(zn, ends.win_w[b], r, zi)
         vx[i] = u
         vz[i] = w
         x[i] += dt * u
@@ -283,6 +281,26 @@ def update_buffers(ps, n, t1, dt, ends, prm):
     return buffer_transitions(ps, n, ends, r, zs0, du0, zs1, du1)
 
 
+@njit(cache=True, inline="always")
+def _ghost_pair(i, j, dx, dz, r2, ps, ctx, a):
+    """The moment sums of ghost_pressure (in its order a00 a01 a02 a10 a11 a12 a20 a21 a22 b0 b1
+    b2) for fluid neighbour j of the node; ctx = (h, alpha_w, alpha_f)."""
+    h = ctx[0]
+    rx = -dx  # r_j = x_j - x_g
+    rz = -dz
+    q = math.sqrt(r2) / h
+    v = ps.m[j] / ps.rho[j]
+    w = v * w_of_q(q, ctx[1])
+    fv = v * f_of_q(q, ctx[2]) * h  # h-scaled gradient weight: F r_j h, with r_j / h below
+    sx = rx / h
+    sz = rz / h
+    pj = ps.p[j]
+    return (a[0] + w, a[1] + w * sx, a[2] + w * sz,
+            a[3] + fv * rx, a[4] + fv * rx * sx, a[5] + fv * rx * sz,
+            a[6] + fv * rz, a[7] + fv * rz * sx, a[8] + fv * rz * sz,
+            a[9] + w * pj, a[10] + fv * rx * pj, a[11] + fv * rz * pj)
+
+
 @njit(cache=True)
 def ghost_pressure(ps, cells, xg, zg, prm):
     """First-order consistent SPH interpolation of the fluid pressure at a ghost node (xg, zg)
@@ -294,47 +312,11 @@ def ghost_pressure(ps, cells, xg, zg, prm):
     matrix is the identity for a full, regular support). Returns (p_g, p_x, p_z, order): order 1
     if the determinant exceeds GHOST_DET_MIN, 0 for the Shepard value sum V W p / sum V W with no
     gradient, -1 if the node has no fluid neighbour."""
-    x = ps.x
-    z = ps.z
-    kind = ps.kind
-    cell_start = cells.start
-    ncx = cells.ncx
     h = prm.h
-    aw = prm.alpha_w
-    af = prm.alpha_f
-    s2 = 4.0 * h * h
-    cxl, cxh, czl, czh = block_of(cell_at(xg, zg, cells), cells)
-    a00 = a01 = a02 = a10 = a11 = a12 = a20 = a21 = a22 = 0.0
-    b0 = b1 = b2 = 0.0
-    for zz in range(czl, czh + 1):
-        row = zz * ncx
-        for j in range(cell_start[row + cxl], cell_start[row + cxh + 1]):
-            if kind[j] != FLUID:
-                continue
-            dx = x[j] - xg
-            dz = z[j] - zg
-            r2 = dx * dx + dz * dz
-            if r2 >= s2:
-                continue
-            q = math.sqrt(r2) / h
-            v = ps.m[j] / ps.rho[j]
-            w = v * w_of_q(q, aw)
-            fv = v * f_of_q(q, af) * h  # h-scaled gradient weight: F r_j h, with r_j / h below
-            sx = dx / h
-            sz = dz / h
-            pj = ps.p[j]
-            a00 += w
-            a01 += w * sx
-            a02 += w * sz
-            a10 += fv * dx
-            a11 += fv * dx * sx
-            a12 += fv * dx * sz
-            a20 += fv * dz
-            a21 += fv * dz * sx
-            a22 += fv * dz * sz
-            b0 += w * pj
-            b1 += fv * dx * pj
-            b2 += fv * dz * pj
+    s = gather(-1, xg, zg, cell_at(xg, zg, cells), ps, cells, 4.0 * h * h, fluid_only,
+               _ghost_pair, (h, prm.alpha_w, prm.alpha_f),
+               (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0))
+    a00, a01, a02, a10, a11, a12, a20, a21, a22, b0, b1, b2 = s
     if a00 <= 0.0:
         return 0.0, 0.0, 0.0, -1
     det = (a00 * (a11 * a22 - a12 * a21) - a01 * (a10 * a22 - a12 * a20)
@@ -361,28 +343,23 @@ def buffer_extrapolate(ps, n, cells, ends, prm):
     hydrostatic option). A ghost node without fluid keeps the hydrostatic value of buffer_update.
     A hydrostatic end extrapolates too, but only within SURFACE_BAND_H h below its surface z_s:
     there the SPH fluid's equilibrium is not the continuum rho0 g (z_s - z) (module docstring)."""
-    x = ps.x
-    z = ps.z
-    p_ = ps.p
+    p_ = ps.p  # the rows written as locals (see buffer_update)
     rho = ps.rho
-    kind = ps.kind
-    ghost = ends.ghost
-    x_face = ends.x_face
-    zs = ends.zs
     band = SURFACE_BAND_H * prm.h
     rho0 = prm.rho0
     bb = prm.b
     gam = prm.gamma
     for i in prange(n):
-        k = kind[i]
+        k = ps.kind[i]
         if k != INLET and k != OUTLET:
             continue
         b = 0 if k == INLET else 1
-        if not ghost[b] and z[i] < zs[b] - band:
+        zi = ps.z[i]
+        if not ends.ghost[b] and zi < ends.zs[b] - band:
             continue
-        xi = x[i]
-        xg = 2.0 * x_face[b] - xi
-        pg, px, pz, order = ghost_pressure(ps, cells, xg, z[i], prm)
+        xi = ps.x[i]
+        xg = 2.0 * ends.x_face[b] - xi
+        pg, px, pz, order = ghost_pressure(ps, cells, xg, zi, prm)
         if order < 0:
             continue
         p = max(pg + (xi - xg) * px, 0.0)
@@ -404,32 +381,15 @@ def surface_z(ps, cells, xp, z_lo, z_hi, dz, prm):
     rho_f(z) = sum_j m_j W(x - x_j) over fluid and active buffer particles on points z_lo + k dz;
     the surface is the highest z where rho_f falls through rho0/2 (linear between points).
     Returns NaN when no point reaches rho0/2 (dry)."""
-    x = ps.x
-    z = ps.z
-    m = ps.m
-    kind = ps.kind
-    cell_start = cells.start
-    ncx = cells.ncx
     h = prm.h
-    aw = prm.alpha_w
     level = 0.5 * prm.rho0
     s2 = 4.0 * h * h
     nz = int((z_hi - z_lo) / dz) + 1
     prev = 0.0
     for k in range(nz - 1, -1, -1):
         zk = z_lo + k * dz
-        cxl, cxh, czl, czh = block_of(cell_at(xp, zk, cells), cells)
-        s = 0.0
-        for zz in range(czl, czh + 1):
-            row = zz * ncx
-            for j in range(cell_start[row + cxl], cell_start[row + cxh + 1]):
-                kj = kind[j]
-                if kj == FLUID or kj == INLET or kj == OUTLET:
-                    ddx = xp - x[j]
-                    ddz = zk - z[j]
-                    r2 = ddx * ddx + ddz * ddz
-                    if r2 < s2:
-                        s += m[j] * w_of_q(math.sqrt(r2) / h, aw)
+        s = gather(-1, xp, zk, cell_at(xp, zk, cells), ps, cells, s2, fluidlike, _mass_pair,
+                   (h, prm.alpha_w), 0.0)
         if s >= level:
             if k == nz - 1:
                 return zk

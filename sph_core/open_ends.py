@@ -121,15 +121,13 @@ class OpenBoundaries:
             e.swl[b] = swl
             e.zs[b] = swl   # at rest until the first update
             period = o.absorption_period or source_period(sources.get(o.side))
-            q = profile_wavenumber(o.absorption_profile, c.g, depth, period)
+            q = profile_wavenumber(c.g, depth, period)
             e.sqgd[b], e.filt_tau[b], e.filt_c[b] = absorption_filter(
-                o.absorption, c.g, depth, abs(nd.x_gauge - nd.x_face), period,
-                o.absorption_transfer, q)
+                c.g, depth, abs(nd.x_gauge - nd.x_face), period, q)
             # the profile above the still-water level continues linear theory's cosh (crests)
             e.corr_prof[b] = correction_profile((nd.z - nd.z_bed) / depth, q)
             e.absorb[b] = o.absorb
             e.imposed[b] = o.elevation == "imposed"
-            e.surface_at_face[b] = o.surface == "face"
             e.ghost[b] = buffer_pressure(o, scene.scheme.kind) == "extrapolated"
             e.x_gauge[b] = nd.x_gauge
             e.z_bed[b] = nd.z_bed

@@ -23,12 +23,17 @@ class SceneError(ValueError):
 
 # Options measured and retired (docs/decisions/KEY.md: what, the figure, why not): a scene that
 # still sets one gets a one-line error naming that page. (table model, key) -> the values still
-# accepted (the retired option's surviving default), if any.
+# accepted (the retired option's surviving default, or the values a kept field still has).
 RETIRED: dict[tuple[str, str], tuple[Any, ...]] = {
     ("Constants", "kernel_correction"): ("off",),
     ("Scheme", "limiter"): ("vanleer",),
     ("Scheme", "low_dissipation"): (False,),
     ("Scheme", "low_dissipation_eta"): (),
+    ("Constants", "shift_open_end"): ("full", "none"),
+    ("OpenBoundary", "absorption"): ("filter",),
+    ("OpenBoundary", "absorption_transfer"): ("piston",),
+    ("OpenBoundary", "absorption_profile"): ("mode",),
+    ("OpenBoundary", "surface"): ("face",),
 }
 
 
@@ -48,11 +53,11 @@ class _Model(BaseModel):
         kept = {}
         for key, value in data.items():
             accepted = RETIRED.get((cls.__name__, key))
-            if accepted is None:
-                kept[key] = value
-            elif value not in accepted:
+            if accepted is not None and value not in accepted:
                 raise ValueError(f"{key}: {value!r} was measured and retired "
                                  f"(see {retired_page(key)})")
+            if accepted is None or key in cls.model_fields:
+                kept[key] = value  # a field keeping some values validates them itself
         return kept
 
 
@@ -207,9 +212,9 @@ class Constants(_Model):
     shift_carry: bool = Field(True, description=(
         "carry the shifted particle's density and velocity to its new position (first-order "
         "Taylor); without it the shift diffuses the velocity field"))
-    shift_open_end: Literal["full", "tangential", "none"] = Field("full", description=(
+    shift_open_end: Literal["full", "none"] = Field("full", description=(
         "shifting of a fluid particle with an open end's active buffer particle within 2h: "
-        "full, tangential (no component along the face normal, x), none (sph_core.shifting)"))
+        "full or none (sph_core.shifting)"))
     shift_fs_div: float = Field(1.8, gt=0, lt=2, description=(
         "position divergence below which a particle counts as near the free surface (2D: 2 "
         "inside the fluid) and shifts only tangentially"))
@@ -399,43 +404,23 @@ class OpenBoundary(_Model):
 
     Buffer particles take the velocity of a boundary-data source (see ``sph_core.boundary_data``).
     ``elevation``: ``imposed`` takes the source's elevation (inlet of seed 002); ``extrapolated``
-    takes the one measured by the boundary gauge inside the fluid (outlet): with ``surface``
-    "face" (default) the source's elevation at the face plus the gauge's mismatch, with "gauge"
-    the gauge's reading itself (2h inside the face: it lags the wave at the buffer). ``absorb`` applies the
-    seed 002 correction u = u_theory + n_x (eta_measured - eta_theory) sqrt(g/d), n_x the outward
-    normal (-1 left, +1 right). The gauge stands ``gauge_offset`` [m] inside the face (default 2h).
-    ``absorption`` picks the correction's gain (``sph_core.absorption``): ``linear`` omega/(k d) at
-    the wave period (``absorption_period``, else the source theory's period; sqrt(g/d) when
-    neither is known), ``shallow`` the seed 002 sqrt(g/d) at every kd, ``filter`` (default,
-    measured best: docs/absorption.md) a causal filter following the ideal gain frequency by
-    frequency, delayed by the gauge's offset (exact at the wave period when one is known).
-    ``absorption_transfer`` is that ideal gain: ``piston`` (default) Biesel's transfer function
-    of a depth-uniform wave maker, ``flux`` omega/(k d) (low by 19 % at kd 2).
-    ``absorption_profile``: the correction's vertical profile, ``mode`` (default) linear
-    theory's cosh k(z + d) at the wave period (its gain by the same projection as Biesel's),
-    ``uniform`` a piston, whose evanescent near field the gauge reads back (at kd 2: 19 % of
-    its wave at 2h, H/dp 4)."""
+    takes the source's elevation at the face plus the mismatch measured by the boundary gauge
+    inside the fluid (outlet). ``absorb`` applies the seed 002 correction
+    u = u_theory + n_x G (eta_measured - eta_theory), n_x the outward normal (-1 left, +1 right),
+    with the gauge ``gauge_offset`` [m] inside the face (default 2h). The gain G is a causal
+    filter following Biesel's piston transfer function frequency by frequency, delayed by the
+    gauge's offset and exact at the wave period (``absorption_period``, else the source
+    theory's); the correction's vertical profile is linear theory's cosh k(z + d) at that period
+    (uniform when no period is known); ``sph_core.absorption``, docs/absorption.md. The plain
+    gains (``absorption`` shallow/linear), the flux transfer, the uniform profile and the
+    gauge's own reading as the outlet's surface were measured and retired (docs/decisions/)."""
 
     side: Literal["left", "right"]
     elevation: Literal["imposed", "extrapolated"] = "imposed"
     absorb: bool = True
-    absorption: Literal["shallow", "linear", "filter"] = "filter"
-    surface: Literal["gauge", "face"] = Field(
-        "face", description="an extrapolated end's buffer surface: the boundary gauge's "
-                             "reading, or the source's elevation at the face plus the gauge's "
-                             "mismatch (the target wave carried over the gauge offset)")
-    absorption_transfer: Literal["piston", "flux"] = Field(
-        "piston", description="ideal gain of the depth-uniform correction: Biesel's piston "
-                              "transfer function, or the depth-mean velocity omega/(k d) "
-                              "(sph_core.absorption.transfer_gain)")
-    absorption_profile: Literal["uniform", "mode"] = Field(
-        "mode", description="vertical profile of the correction: linear theory's orbital "
-                            "velocity cosh k(z + d) at the wave period (default: no evanescent "
-                            "near field for the gauge to read back; uniform when no period is "
-                            "known), or uniform over the depth (a piston; "
-                            "sph_core.absorption.correction_profile, docs/absorption.md)")
-    absorption_period: float | None = Field(None, gt=0, description="wave period [s] of the "
-                                            "linear absorption gain (None: the source's)")
+    absorption_period: float | None = Field(None, gt=0, description=(
+        "wave period [s] where the absorption filter is exact and whose mode profiles the "
+        "correction (None: the source's)"))
     gauge_offset: float | None = Field(None, gt=0, description="boundary gauge distance inside the face [m]")
     pressure: Literal["hydrostatic", "extrapolated"] | None = Field(
         None, description="buffer pressure: hydrostatic below the buffer's surface, or "

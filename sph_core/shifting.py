@@ -32,6 +32,8 @@ the wave of bench/wave_decay.py: none for the better at h/dp 2 (docs/wave_decay_
 delta-plus uses 11 scratch rows (xn, zn, vxn, vzn, rhon and the MUSCL gradient rows gpx..gwz,
 which riemann_gradients rewrites before every use) for three passes: B, lambda, the normal, the
 shift, the gradients and the surface scan; the vicinity test and the projection; the move.
+Every neighbour walk here (the moments, the surface scan, the vicinity and open-end tests) is
+``pairs.gather`` with a term of this module.
 """
 
 from __future__ import annotations
@@ -40,8 +42,8 @@ import math
 
 from numba import njit, prange
 
-from .neighbours import block_of
-from .particles import FLUID, INLET, OUTLET
+from .pairs import fluid_only, gather, interacting
+from .particles import FLUID, GPX, GWZ, INLET, OUTLET, RHO, RHON, X, XN
 from .renormalisation import moments, smallest_eigenvalue, solve
 
 
@@ -77,47 +79,39 @@ def _limited(sx, sz, tangential, nx, nz, max_shift):
 
 
 # next to an open end's buffer (an active buffer particle within 2h; scene
-# constants.shift_open_end): 0 "full" shift, 1 "tangential" (no component along the face
-# normal, x), 2 "none". The buffer is a lattice moved by the imposed flow, and the crossing rules
-# count fluid in and out by where particles are: a shift beside it moves fluid that the imposed
-# flux did not carry. Measured (docs/wave_decay_study.md, 2026-11-23 "flume-vs-tank gap",
-# oscillating flow through both ends, delta-plus): "tangential" gains water fast (the vertical
-# shift alone beside the buffer's fixed rows), "none" keeps the count as without shifting.
-SHIFT_OPEN_END = {"full": 0, "tangential": 1, "none": 2}
+# constants.shift_open_end): 0 "full" shift, 1 "none". The buffer is a lattice moved by the
+# imposed flow, and the crossing rules count fluid in and out by where particles are: a shift
+# beside it moves fluid that the imposed flux did not carry. Measured (docs/wave_decay_study.md
+# "flume-vs-tank gap", oscillating flow through both ends, delta-plus): "none" keeps the count
+# as without shifting ("tangential", retired: docs/decisions/shift_open_end.md, gained water).
+SHIFT_OPEN_END = {"full": 0, "none": 1}
+
+
+@njit(cache=True, inline="always")
+def _active_buffer(k):
+    """Active open-end buffer particles alone."""
+    return k == INLET or k == OUTLET
+
+
+@njit(cache=True, inline="always")
+def _any_pair(i, j, dx, dz, r2, ps, ctx, a):
+    """True once any neighbour has been seen."""
+    return True
 
 
 @njit(cache=True, inline="always")
 def _near_buffer(i, ps, cells, h):
     """Is an active open-end buffer particle within 2h of particle i?"""
-    x = ps.x
-    z = ps.z
-    kind = ps.kind
-    s2 = 4.0 * h * h
-    cxl, cxh, czl, czh = block_of(ps.cell[i], cells)
-    for zz in range(czl, czh + 1):
-        row = zz * cells.ncx
-        for j in range(cells.start[row + cxl], cells.start[row + cxh + 1]):
-            kj = kind[j]
-            if kj == INLET or kj == OUTLET:
-                dx = x[i] - x[j]
-                dz = z[i] - z[j]
-                if dx * dx + dz * dz < s2:
-                    return True
-    return False
+    return gather(i, ps.x[i], ps.z[i], ps.cell[i], ps, cells, 4.0 * h * h, _active_buffer,
+                  _any_pair, 0, False)
 
 
 @njit(cache=True, inline="always")
 def _open_end_limited(i, ps, cells, prm, sx, sz, tangential, nx, nz, max_shift):
-    """_limited, with the open-end rule (prm.shift_open) applied after the surface projection and
-    before the cap for a particle beside a buffer."""
-    rule = prm.shift_open
-    if rule != 0 and _near_buffer(i, ps, cells, prm.h):
-        sx, sz = _limited(sx, sz, tangential, nx, nz, math.inf)
-        if rule == 1:
-            sx = 0.0
-        else:
-            sx = sz = 0.0
-        return _limited(sx, sz, False, nx, nz, max_shift)
+    """_limited, or no shift at all for a particle beside a buffer under the open-end rule
+    prm.shift_open "none"."""
+    if prm.shift_open != 0 and _near_buffer(i, ps, cells, prm.h):
+        return 0.0, 0.0
     return _limited(sx, sz, tangential, nx, nz, max_shift)
 
 
@@ -125,61 +119,40 @@ def _open_end_limited(i, ps, cells, prm, sx, sz, tangential, nx, nz, max_shift):
 def _move(ps, n):
     """Apply the gathered shifts and carries (rows xn, zn and rhon, vxn, vzn) to every fluid
     particle: a separate loop, so that no particle's sums saw a neighbour already moved."""
-    # rows as locals: ``ps.x[i] = ...`` inside a prange writes nothing (numba 0.68.1)
-    x = ps.x
-    z = ps.z
-    rho = ps.rho
-    vx = ps.vx
-    vz = ps.vz
-    xn = ps.xn
-    zn = ps.zn
-    rhon = ps.rhon
-    vxn = ps.vxn
-    vzn = ps.vzn
-    kind = ps.kind
+    # through the storage f (a local: ``ps.x[i] = ...`` inside a prange writes nothing, numba
+    # 0.68.1): x, z, vx, vz += xn, zn, vxn, vzn (rows X..VZ and XN..VZN), rho += rhon
+    f = ps.f
     for i in prange(n):
-        if kind[i] == FLUID:
-            x[i] += xn[i]
-            z[i] += zn[i]
-            rho[i] += rhon[i]
-            vx[i] += vxn[i]
-            vz[i] += vzn[i]
+        if ps.kind[i] == FLUID:
+            for r in range(4):
+                f[X + r, i] += f[XN + r, i]
+            f[RHO, i] += f[RHON, i]
 
 
 @njit(parallel=True, cache=True)
 def shift_particles(ps, n, cells, prm, dt):
     """Shift every fluid particle of the sorted state ``ps`` by A = ``prm.shift_a`` (see the
     module docstring); |dr| <= 0.05 h << the cell size, so the cell lists stay valid."""
-    x = ps.x
-    z = ps.z
-    vx = ps.vx
-    vz = ps.vz
-    rho = ps.rho
-    kind = ps.kind
     h = prm.h
-    coef = prm.shift_a
-    fs_div = prm.shift_fs_div
     max_shift = 0.05 * h
-    sxr = ps.xn    # scratch rows (see the module docstring)
+    sxr = ps.xn    # scratch rows (see the module docstring), zeroed: non-fluid slots stay put
     szr = ps.zn
     srho = ps.rhon
     svx = ps.vxn
     svz = ps.vzn
+    ps.f[XN:RHON + 1, :n] = 0.0
     for i in prange(n):
-        sxr[i] = 0.0
-        szr[i] = 0.0
-        srho[i] = 0.0
-        svx[i] = 0.0
-        svz[i] = 0.0
-        if kind[i] != FLUID:
+        if ps.kind[i] != FLUID:
             continue
         # B, grad C and the (unrenormalised) gradients of rho and v for the first-order carry
-        s = moments(i, ps, cells, prm, rho, vx, vz, True)
-        dcoef = coef * h * math.sqrt(vx[i] * vx[i] + vz[i] * vz[i]) * dt
+        s = moments(i, ps, cells, prm, ps.rho, ps.vx, ps.vz, True)
+        vxi = ps.vx[i]
+        vzi = ps.vz[i]
+        dcoef = prm.shift_a * h * math.sqrt(vxi * vxi + vzi * vzi) * dt
         sx = -dcoef * s.gx
         sz = -dcoef * s.gz
         nx = nz = 0.0
-        tangential = s.mxx + s.mzz < fs_div  # div r = trace B
+        tangential = s.mxx + s.mzz < prm.shift_fs_div  # div r = trace B
         if tangential:
             # renormalised normal: grad C itself is parallel to the shift and cannot split it
             nx, nz = _surface_normal(s, s.mxx * s.mzz - s.mxz * s.mxz)
@@ -199,9 +172,30 @@ def shift_particles(ps, n, cells, prm, dt):
 
 LAMBDA_ISOLATED = 0.2    # lambda_i (smallest eigenvalue of B_i) at or below: a splash / jet, no shift
 LAMBDA_INTERIOR = 0.75   # above: full support, not a surface candidate (Marrone et al. 2010)
-FS_INTERIOR = 0.0        # flags of pass 1 (stored in the scratch row ps.guz)
+FS_INTERIOR = 0.0        # flags of pass 1 (stored in the scratch row ps.guz; 0: zeroed rows)
 FS_SURFACE = 1.0
 FS_ISOLATED = 2.0
+
+
+@njit(cache=True, inline="always")
+def _scan_pair(i, j, dx, dz, r2, ps, ctx, occupied):
+    """Marrone et al. 2010's scan: is neighbour j in the region around T = r_i + h n, the
+    umbrella |e . n| + |e x n| < h (e = r_j - T) within sqrt(2) h of i, else the circle |e| < h?
+    ctx = (T_x, T_z, n_x, n_z, h, 2 h^2)."""
+    if occupied:
+        return True
+    ex = ps.x[j] - ctx[0]
+    ez = ps.z[j] - ctx[1]
+    h = ctx[4]
+    if r2 >= ctx[5]:
+        return ex * ex + ez * ez < h * h
+    return (abs(ex * ctx[2] + ez * ctx[3]) + abs(ez * ctx[2] - ex * ctx[3])) < h
+
+
+@njit(cache=True, inline="always")
+def _surface_pair(i, j, dx, dz, r2, ps, ctx, near):
+    """Is neighbour j a surface particle (pass 1's flag, in row guz)?"""
+    return near or ps.guz[j] == FS_SURFACE
 
 
 @njit(parallel=True, cache=True)
@@ -216,15 +210,6 @@ def shift_particles_dplus(ps, n, cells, prm, dt, umax):
     surface particles and those within 2h of one keep only dr - (dr . n) n. With
     ``prm.shift_carry`` the shifted particle's rho and v are carried to the new position by
     their renormalised gradients (first-order Taylor). See the module docstring for the rows."""
-    x = ps.x
-    z = ps.z
-    vx = ps.vx
-    vz = ps.vz
-    rho = ps.rho
-    kind = ps.kind
-    cell = ps.cell
-    cell_start = cells.start
-    ncx = cells.ncx
     h = prm.h
     coef = prm.shift_a * h * umax * dt
     carry = prm.shift_carry
@@ -245,16 +230,13 @@ def shift_particles_dplus(ps, n, cells, prm, dt, umax):
     guz = ps.gux
     gwx = ps.gwx
     gwz = ps.gwz
+    # every scratch row zeroed (the flag to FS_INTERIOR, 0)
+    ps.f[XN:RHON + 1, :n] = 0.0
+    ps.f[GPX:GWZ + 1, :n] = 0.0
     # pass 1: B, lambda, the normal, the shift, the gradients; the surface scan
     for i in prange(n):
-        sxr[i] = 0.0
-        szr[i] = 0.0
-        snx[i] = 0.0
-        snz[i] = 0.0
-        flag[i] = FS_INTERIOR
-        grx[i] = grz[i] = gux[i] = guz[i] = gwx[i] = gwz[i] = 0.0
-        if kind[i] == FLUID:
-            s = moments(i, ps, cells, prm, rho, vx, vz, True)
+        if ps.kind[i] == FLUID:
+            s = moments(i, ps, cells, prm, ps.rho, ps.vx, ps.vz, True)
             bxx = s.mxx
             bxz = s.mxz
             bzz = s.mzz
@@ -274,48 +256,20 @@ def shift_particles_dplus(ps, n, cells, prm, dt, umax):
                 snz[i] = nz
                 if (nx != 0.0 or nz != 0.0) and lam <= LAMBDA_INTERIOR:
                     # scan: is any neighbour in the region around T = r_i + h n?
-                    xi = x[i]
-                    zi = z[i]
-                    tx = xi + h * nx
-                    tz = zi + h * nz
-                    occupied = False
-                    cxl, cxh, czl, czh = block_of(cell[i], cells)
-                    for zz in range(czl, czh + 1):
-                        row = zz * ncx
-                        for j in range(cell_start[row + cxl], cell_start[row + cxh + 1]):
-                            kj = kind[j]
-                            if occupied or j == i or kj < FLUID or kj > OUTLET:
-                                continue
-                            dx = x[j] - xi
-                            dz = z[j] - zi
-                            r2 = dx * dx + dz * dz
-                            if r2 >= s2:
-                                continue
-                            ex = x[j] - tx
-                            ez = z[j] - tz
-                            if r2 >= scan2:
-                                occupied = ex * ex + ez * ez < h * h
-                            else:
-                                occupied = (abs(ex * nx + ez * nz)
-                                            + abs(ez * nx - ex * nz)) < h
+                    xi = ps.x[i]
+                    zi = ps.z[i]
+                    occupied = gather(i, xi, zi, ps.cell[i], ps, cells, s2, interacting,
+                                      _scan_pair, (xi + h * nx, zi + h * nz, nx, nz, h, scan2),
+                                      False)
                     if not occupied:
                         flag[i] = FS_SURFACE
     # pass 2: the surface and its vicinity (within 2h of a surface particle) shift tangentially
     for i in prange(n):
-        if kind[i] == FLUID and flag[i] != FS_ISOLATED:
+        if ps.kind[i] == FLUID and flag[i] != FS_ISOLATED:
             near = flag[i] == FS_SURFACE
             if not near:
-                xi = x[i]
-                zi = z[i]
-                cxl, cxh, czl, czh = block_of(cell[i], cells)
-                for zz in range(czl, czh + 1):
-                    row = zz * ncx
-                    for j in range(cell_start[row + cxl], cell_start[row + cxh + 1]):
-                        if near or flag[j] != FS_SURFACE or kind[j] != FLUID:
-                            continue
-                        dx = xi - x[j]
-                        dz = zi - z[j]
-                        near = dx * dx + dz * dz < s2
+                near = gather(i, ps.x[i], ps.z[i], ps.cell[i], ps, cells, s2, fluid_only,
+                              _surface_pair, 0, False)
             sx, sz = _open_end_limited(i, ps, cells, prm, sxr[i], szr[i], near, snx[i], snz[i],
                                        max_shift)
             sxr[i] = sx

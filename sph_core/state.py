@@ -127,7 +127,7 @@ class Params(NamedTuple):
     wall_ga: float = 0.0
     wall_g0: float = 0.0
     wall_gb: float = 0.0
-    # shifting next to an open end's buffer (shifting.SHIFT_OPEN_END): 0 full, 1 tangential, 2 none
+    # shifting next to an open end's buffer (shifting.SHIFT_OPEN_END): 0 full, 1 none
     shift_open: int = 0
 
 
@@ -145,7 +145,7 @@ class OpenEnds(NamedTuple):
     nx: np.ndarray        # outward normal (-1 left, +1 right)
     length: np.ndarray    # buffer width [m]
     swl: np.ndarray       # still-water level [m]
-    sqgd: np.ndarray      # gain G of the absorption correction [1/s] (sph_core.absorption)
+    sqgd: np.ndarray      # direct gain D of the absorption filter [1/s] (sph_core.absorption)
     absorb: np.ndarray    # bool[2]: absorption correction on
     imposed: np.ndarray   # bool[2]: surface imposed (else measured)
     ghost: np.ndarray     # bool[2]: buffer pressure extrapolated from ghost nodes
@@ -165,11 +165,8 @@ class OpenEnds(NamedTuple):
     counters: np.ndarray  # int64[2, 4]: C_IN, C_OUT, C_CREATED, C_REMOVED
     next_id: np.ndarray   # int64[1]: id of the next created particle
     filt_tau: np.ndarray  # [2, N_FILTER] time constants of the absorption filter [s]
-    filt_c: np.ndarray    # [2, N_FILTER] its gains [1/s] (0: plain gain sqgd; sph_core.absorption)
+    filt_c: np.ndarray    # [2, N_FILTER] its gains [1/s] (sph_core.absorption)
     filt_x: np.ndarray    # [2, N_FILTER] its state: the mismatch low-passed with each tau [m]
-    # bool[2]: a measured (extrapolated) surface is the source's elevation at the face plus the
-    # gauge's mismatch (else the gauge's reading itself; scene.OpenBoundary.surface)
-    surface_at_face: np.ndarray
     # [2, nodes]: the absorption correction's vertical profile on zn (depth mean 1 below the
     # still-water level; all ones: a depth-uniform piston; sph_core.absorption.correction_profile)
     corr_prof: np.ndarray
@@ -185,5 +182,4 @@ def closed_ends(capacity: int, n_nodes: int = 2) -> OpenEnds:
                     np.zeros((2, 2, n_nodes)), np.zeros((2, 2, n_nodes)), np.zeros((2, 2)),
                     np.zeros((2, 2)), np.full(2, np.nan), z2(), np.zeros((2, 4), dtype=np.int64),
                     np.zeros(1, dtype=np.int64), np.ones((2, N_FILTER)),
-                    np.zeros((2, N_FILTER)), np.zeros((2, N_FILTER)), b2(),
-                    np.ones((2, n_nodes)))
+                    np.zeros((2, N_FILTER)), np.zeros((2, N_FILTER)), np.ones((2, n_nodes)))

@@ -1,4 +1,5 @@
-"""The open ends' absorption gain (sph_core.absorption) and how a flume picks it."""
+"""The open ends' absorption gain (sph_core.absorption), how a flume picks it, and the retired
+absorption options' scene errors."""
 
 from __future__ import annotations
 
@@ -8,12 +9,12 @@ import numpy as np
 import pytest
 
 from sph_core import open_boundary as ob
-from sph_core.absorption import (absorption_filter, absorption_gain, correction_profile,
-                                 filter_reflection, linear_wavenumber, profile_wavenumber,
-                                 source_period, transfer_gain)
+from sph_core.absorption import (absorption_filter, correction_profile, filter_reflection,
+                                 linear_wavenumber, profile_wavenumber, source_period,
+                                 transfer_gain)
 from sph_core.boundary_data import WaveModelBoundary
 from sph_core.open_ends import OpenBoundaries, flume_nodes
-from sph_core.scene import make_scene
+from sph_core.scene import SceneError, make_scene
 from sph_core.state import closed_ends
 from wave_client.theories import build_theory
 from wave_client.theories import wavenumber as theory_wavenumber
@@ -21,40 +22,33 @@ from wave_client.theories import wavenumber as theory_wavenumber
 G, D = 9.81, 0.3
 
 
-@pytest.mark.parametrize("kd", [0.3, 0.75, 1.2, 2.0])
-def test_flux_gain_is_the_depth_mean_velocity_of_a_linear_wave(kd):
-    """G = omega/(k d): the depth mean of Airy's u = a omega cosh k(z+d)/sinh kd over the
-    elevation amplitude a (integrated numerically here), = sqrt(g/d) sqrt(tanh kd / kd)."""
-    k = kd / D
-    omega = math.sqrt(G * k * math.tanh(kd))
-    gain = absorption_gain("linear", G, D, 2 * math.pi / omega, transfer="flux")
-    n = 2000
-    mean_u = sum(omega * math.cosh(k * (D * (j + 0.5) / n)) / math.sinh(kd) for j in range(n)) / n
-    assert gain == pytest.approx(mean_u, rel=1e-6)
-    assert gain == pytest.approx(math.sqrt(G / D * math.tanh(kd) / kd), rel=1e-9)
-    assert gain < absorption_gain("shallow", G, D, 2 * math.pi / omega)
+def _piston(period: float | None) -> float:
+    """Biesel's piston gain at the wave period (sqrt(g/d), its long-wave limit, for None)."""
+    if period is None:
+        return math.sqrt(G / D)
+    omega = 2 * math.pi / period
+    return float(transfer_gain(omega, linear_wavenumber(omega, D, G) * D))
 
 
 @pytest.mark.parametrize("kd", [0.3, 0.75, 1.2, 2.0])
 def test_piston_gain_swallows_the_progressive_mode(kd):
-    """The default (Biesel) gain: a depth-uniform U cancels an outgoing Airy wave of amplitude a
-    at the end iff U and the wave's u(z) = a omega cosh k(z+d)/sinh kd have the same projection
-    on the progressive mode cosh k(z+d) (the rest goes into evanescent modes, which carry no
-    wave away); both integrals done numerically here. Above the flux gain by 19 % at kd 2."""
+    """Biesel's gain: a depth-uniform U cancels an outgoing Airy wave of amplitude a at the end
+    iff U and the wave's u(z) = a omega cosh k(z+d)/sinh kd have the same projection on the
+    progressive mode cosh k(z+d) (the rest goes into evanescent modes, which carry no wave
+    away); both integrals done numerically here. Above the depth-mean velocity omega/(k d)
+    (the retired "flux" transfer) by 19 % at kd 2."""
     k = kd / D
     omega = math.sqrt(G * k * math.tanh(kd))
-    gain = absorption_gain("linear", G, D, 2 * math.pi / omega)
+    gain = _piston(2 * math.pi / omega)
     n = 4000
     zs = [D * (j + 0.5) / n for j in range(n)]  # height above the bed
     wave = sum(omega * math.cosh(k * z) ** 2 / math.sinh(kd) for z in zs)
     mode = sum(math.cosh(k * z) for z in zs)
     assert gain == pytest.approx(wave / mode, rel=1e-6)
-    flux = absorption_gain("linear", G, D, 2 * math.pi / omega, transfer="flux")
+    flux = omega / kd
     assert gain > flux
     if kd == 2.0:
         assert gain / flux == pytest.approx(1.19, abs=0.005)
-    with pytest.raises(ValueError, match="absorption_transfer"):
-        absorption_gain("linear", G, D, 1.0, transfer="deep")
 
 
 @pytest.mark.parametrize("q", [0.0, 0.8, 2.0])
@@ -72,49 +66,43 @@ def test_profiled_gain_swallows_the_progressive_mode(q, kd):
     assert prof.mean() == pytest.approx(1.0, rel=1e-6)  # same flux as the piston
     phi = np.cosh(kd * s)
     want = omega * np.sum(phi ** 2) / (math.sinh(kd) * np.sum(prof * phi))
-    assert transfer_gain(omega, kd, "piston", q) == pytest.approx(want, rel=1e-6)
+    assert transfer_gain(omega, kd, q) == pytest.approx(want, rel=1e-6)
     if q == kd:
-        assert transfer_gain(omega, kd, "piston", q) == pytest.approx(omega / kd, rel=1e-9)
+        assert transfer_gain(omega, kd, q) == pytest.approx(omega / kd, rel=1e-9)
         # the surface velocity per unit elevation is Airy's omega / tanh kd
         assert want * prof[-1] == pytest.approx(omega / math.tanh(kd), rel=2e-3)
-    if q == 0.0:
-        assert transfer_gain(omega, kd, "piston", q) == pytest.approx(
-            absorption_gain("linear", G, D, 2 * math.pi / omega), rel=1e-9)
+    if q == 0.0:  # Biesel's closed form
+        assert transfer_gain(omega, kd, q) == pytest.approx(
+            omega * (math.sinh(2 * kd) + 2 * kd) / (4 * math.sinh(kd) ** 2), rel=1e-9)
     with pytest.raises(ValueError, match="profile_kd"):
-        transfer_gain(omega, kd, "piston", -1.0)
+        transfer_gain(omega, kd, -1.0)
 
 
 def test_mode_profile_of_the_flume_is_its_wave_period():
-    """absorption_profile "mode": the ends' correction profile is cosh k(z + d) at the source's
-    period (k from linear dispersion), depth mean 1 below still water; "uniform" all ones;
+    """The ends' correction profile is cosh k(z + d) at the source's period (k from linear
+    dispersion), depth mean 1 below still water; all ones (a piston) with no period known;
     the filter is then fitted to the profiled gain, exact at the wave period."""
-    ends = _ends("filter", profile="mode")
+    ends = _ends()
     kd0 = linear_wavenumber(2 * math.pi, D, G) * D
-    assert profile_wavenumber("mode", G, D, 1.0) == pytest.approx(kd0)
-    assert profile_wavenumber("mode", G, D, None) == 0.0
+    assert profile_wavenumber(G, D, 1.0) == pytest.approx(kd0)
+    assert profile_wavenumber(G, D, None) == 0.0
     zn = ends.ends.zn[1]
     want = np.cosh(kd0 * zn / D) * kd0 / math.sinh(kd0)
     assert np.allclose(ends.ends.corr_prof[1], want, rtol=1e-12)
-    assert (_ends("filter").ends.corr_prof == 1.0).all()
+    assert (_ends(sources=False).ends.corr_prof == 1.0).all()
     e = ends.ends
     refl = filter_reflection(e.sqgd[1], e.filt_tau[1], e.filt_c[1], G, D,
                              abs(ends.nodes["right"].x_gauge - ends.nodes["right"].x_face),
-                             np.array([kd0]), "piston", kd0)
+                             np.array([kd0]), kd0)
     assert refl[0] < 1e-3
-    with pytest.raises(ValueError, match="absorption_profile"):
-        profile_wavenumber("flap", G, D, 1.0)
-
-
-def test_linear_gain_tends_to_the_shallow_water_gain_for_long_waves():
-    shallow = math.sqrt(G / D)
-    assert absorption_gain("shallow", G, D, 1.0) == shallow
-    for period, tol in ((20.0, 2e-3), (200.0, 2e-5)):  # kd ~ 0.08, 0.008: error ~ (kd)^2 / 6
-        assert absorption_gain("linear", G, D, period) == pytest.approx(shallow, rel=tol)
-    assert absorption_gain("linear", G, D, None) == shallow  # no period known: its limit
-    with pytest.raises(ValueError, match="absorption"):
-        absorption_gain("deep", G, D, 1.0)
     with pytest.raises(ValueError, match="period"):
-        absorption_gain("linear", G, D, -1.0)
+        profile_wavenumber(G, D, -1.0)
+
+
+def test_piston_gain_tends_to_the_shallow_water_gain_for_long_waves():
+    shallow = math.sqrt(G / D)
+    for period, tol in ((20.0, 2e-3), (200.0, 2e-5)):  # kd ~ 0.08, 0.008: error ~ (kd)^2 / 6
+        assert _piston(period) == pytest.approx(shallow, rel=tol)
 
 
 def test_wavenumber_agrees_with_the_wave_client_dispersion():
@@ -127,29 +115,21 @@ def test_wavenumber_agrees_with_the_wave_client_dispersion():
 def _ideal(omega: float, delay: float) -> complex:
     """The ideal correction per unit mismatch: the piston gain G(omega), delayed by delay/c."""
     k = linear_wavenumber(omega, D, G)
-    return absorption_gain("linear", G, D, 2 * math.pi / omega) * np.exp(-1j * k * delay)
-
-
-def test_plain_gains_have_no_filter_terms():
-    for kind in ("shallow", "linear"):
-        d_gain, tau, c = absorption_filter(kind, G, D, 0.02, 1.0)
-        assert d_gain == absorption_gain(kind, G, D, 1.0) and not c.any() and (tau > 0).all()
+    return _piston(2 * math.pi / omega) * np.exp(-1j * k * delay)
 
 
 @pytest.mark.parametrize("period", [0.7, 1.0, 2.5, None])
 def test_filter_follows_the_linear_gain_per_frequency(period):
     """Exact (delayed) piston gain at the wave period; over kd 0.3-2 the gain error alone
-    reflects less than 5 % (a causal three-pole fit of the piston gain: 2.5-4.7 %; of the
-    falling flux gain omega/(k d): 5-9 %), where the plain gain of one period reflects more
-    than 10 % away from it."""
+    reflects less than 5 % (a causal three-pole fit of the piston gain: 2.5-4.7 %), where the
+    plain gain of one period (the retired "linear" absorption) reflects more than 10 % away
+    from it."""
     delay = 0.03
-    d_gain, tau, c = absorption_filter("filter", G, D, delay, period)
+    d_gain, tau, c = absorption_filter(G, D, delay, period)
     kd = np.linspace(0.3, 2.0, 40)
     refl = filter_reflection(d_gain, tau, c, G, D, delay, kd)
     assert refl.max() < 0.05
-    flux = absorption_filter("filter", G, D, delay, period, "flux")
-    assert filter_reflection(*flux, G, D, delay, kd, "flux").max() < 0.10
-    lin = absorption_gain("linear", G, D, period)
+    lin = _piston(period)
     assert filter_reflection(lin, tau, 0 * c, G, D, delay, kd).max() > 0.1
     if period is not None:
         kd0 = linear_wavenumber(2 * math.pi / period, D, G) * D
@@ -168,7 +148,7 @@ def test_jitted_filter_has_the_designed_frequency_response():
     e.on[:] = e.absorb[:] = e.imposed[:] = True
     e.swl[:] = D
     e.z_top[:] = 2 * D
-    e.sqgd[0], e.filt_tau[0], e.filt_c[0] = absorption_filter("filter", G, D, delay, period)
+    e.sqgd[0], e.filt_tau[0], e.filt_c[0] = absorption_filter(G, D, delay, period)
     t = np.arange(0.0, 30.0, dt)
     du = np.empty(t.size)
     for i, ti in enumerate(t):
@@ -184,7 +164,7 @@ def test_jitted_filter_has_the_designed_frequency_response():
 
 
 def test_checkpoint_keeps_the_filter_state():
-    ends = _ends("filter")
+    ends = _ends()
     assert ends.ends.filt_c.any()
     ends.ends.filt_x[:] = 0.25
     saved = ends.state()
@@ -193,30 +173,52 @@ def test_checkpoint_keeps_the_filter_state():
     assert (ends.ends.filt_x == 0.25).all()
 
 
-def _ends(absorption: str, period_field: float | None = None,
-          profile: str = "uniform") -> OpenBoundaries:
-    sides = [{"side": s, "elevation": e, "absorption": absorption,
-              "absorption_period": period_field, "absorption_profile": profile}
+def _ends(period_field: float | None = None, sources: bool = True) -> OpenBoundaries:
+    """A 0.6 m flume's open ends, both sides driven by a linear wave of period 1 s (or none)."""
+    sides = [{"side": s, "elevation": e, "absorption_period": period_field}
              for s, e in (("left", "imposed"), ("right", "extrapolated"))]
     scene = make_scene({
         "dp": 0.02, "t_end": 1.0, "still_water_level": D,
         "tank": {"x0": 0.0, "x1": 0.6, "z0": 0.0, "z1": D + 0.12},
         "water_blocks": [{"x0": 0.0, "x1": 0.6, "z0": 0.0, "z1": D}],
         "constants": {"c0": 10.0 * math.sqrt(G * D)}, "open_boundaries": sides})
+    if not sources:
+        return OpenBoundaries.from_scene(scene, None, 0.02)
     model = build_theory("linear", height=0.01, period=1.0, depth=D, ramp_time=1.0)
-    sources = {side: WaveModelBoundary(model, nd, D, nd.x_face)
-               for side, nd in flume_nodes(scene).items()}
-    return OpenBoundaries.from_scene(scene, sources, 0.02)
+    return OpenBoundaries.from_scene(scene, {side: WaveModelBoundary(model, nd, D, nd.x_face)
+                                             for side, nd in flume_nodes(scene).items()}, 0.02)
 
 
-def test_flume_takes_the_gain_of_its_scene_and_the_source_period():
-    """linear (default): omega/(k d) at the source theory's period, or at the scene's
-    absorption_period; shallow: sqrt(g/d) (seed 002)."""
-    lin = _ends("linear")
-    assert source_period(lin.sources["left"]) == 1.0
-    for b in (0, 1):
-        assert lin.ends.sqgd[b] == pytest.approx(absorption_gain("linear", G, D, 1.0))
-    assert _ends("linear", 2.5).ends.sqgd[0] == pytest.approx(
-        absorption_gain("linear", G, D, 2.5))
-    assert _ends("shallow").ends.sqgd[1] == pytest.approx(math.sqrt(G / D))
-    assert absorption_gain("linear", G, D, 1.0) < 0.85 * math.sqrt(G / D)  # kd 1.38: 20 % below
+def test_flume_takes_the_filter_of_the_source_period_or_its_scene():
+    """The filter is fitted at the source theory's period, or at the scene's absorption_period,
+    to the gain of the mode profile of that period, delayed by the gauge's offset."""
+    ends = _ends()
+    assert source_period(ends.sources["left"]) == 1.0
+    for period, e in ((1.0, ends), (2.5, _ends(2.5))):
+        q = profile_wavenumber(G, D, period)
+        for b, side in enumerate(("left", "right")):
+            nd = e.nodes[side]
+            d_gain, tau, c = absorption_filter(G, D, abs(nd.x_gauge - nd.x_face), period, q)
+            assert e.ends.sqgd[b] == d_gain
+            np.testing.assert_array_equal(e.ends.filt_c[b], c)
+            np.testing.assert_array_equal(e.ends.filt_tau[b], tau)
+
+
+@pytest.mark.parametrize("key, value", [("absorption", "shallow"), ("absorption", "linear"),
+                                        ("absorption_transfer", "flux"),
+                                        ("absorption_profile", "uniform"),
+                                        ("surface", "gauge")])
+def test_retired_absorption_options_name_their_decision_page(key, value):
+    """Each retired value is refused naming docs/decisions/<key>.md; the surviving default,
+    written explicitly, is still accepted (and is what the end does)."""
+    base = {"dp": 0.02, "t_end": 1.0, "still_water_level": D,
+            "tank": {"x0": 0.0, "x1": 0.6, "z0": 0.0, "z1": D + 0.12},
+            "water_blocks": [{"x0": 0.0, "x1": 0.6, "z0": 0.0, "z1": D}]}
+    end = {"side": "right", "elevation": "extrapolated"}
+    with pytest.raises(SceneError, match=rf"open_boundaries\.0\.{key}: '{value}' was measured "
+                                         rf"and retired \(see docs/decisions/{key}\.md\)"):
+        make_scene({**base, "open_boundaries": [{**end, key: value}]})
+    kept = {"absorption": "filter", "absorption_transfer": "piston", "absorption_profile": "mode",
+            "surface": "face"}[key]
+    explicit = make_scene({**base, "open_boundaries": [{**end, key: kept}]})
+    assert explicit == make_scene({**base, "open_boundaries": [end]})

@@ -71,8 +71,7 @@ def amplitude_profile(model: Any, *, ramp: float, height: float, period: float, 
                       dp: float, periods: float = 4.0, n_gauges: int = 12,
                       flume_wavelengths: float = 1.0, inlet_pressure: str | None = None,
                       settle_periods: float = 0.0, outlet_absorb: bool = True,
-                      gauge_wavelengths: float = 0.75, absorption: str = "filter",
-                      absorption_transfer: str = "piston", wait_reflection: bool = False,
+                      gauge_wavelengths: float = 0.75, wait_reflection: bool = False,
                       noise: bool = False, **constants: Any) -> AmplitudeProfile:
     """Run the flume driven by ``model`` (its start-up ramp lasting ``ramp`` s) and measure
     the amplitude ratio along it (``constants`` override the scene's, e.g. alpha). The flume is
@@ -80,8 +79,7 @@ def amplitude_profile(model: Any, *, ramp: float, height: float, period: float, 
     (3/4 by default: a one-wavelength flume). The window starts ``settle_periods`` periods
     after the front has passed the last gauge, or with ``wait_reflection`` after the front's
     reflection from the outlet has come back to the inlet (the separated fit assumes a steady
-    reflected wave). ``absorption``, ``absorption_transfer``: both ends' correction
-    (scene.OpenBoundary). ``noise``: sample the particle-noise energy along x every period / 5
+    reflected wave). ``noise``: sample the particle-noise energy along x every period / 5
     (wavesph.cases.particle_noise; about 1 s of numpy per sample at dp 0.02, outside ``wall_s``)."""
     length = float(model.length)
     if not 0.0 < gauge_wavelengths < flume_wavelengths:
@@ -97,9 +95,7 @@ def amplitude_profile(model: Any, *, ramp: float, height: float, period: float, 
                              t_end=t0 + periods * period, length=flume_wavelengths * length,
                              absorb=(True, outlet_absorb),
                              right_elevation="extrapolated", probe_every=period / 40,
-                             name="wave_decay", left_pressure=inlet_pressure,
-                             absorption=absorption, absorption_transfer=absorption_transfer,
-                             **constants)
+                             name="wave_decay", left_pressure=inlet_pressure, **constants)
     probes = [ElevationProbe(kind="elevation", name=f"g{i}", x=float(x)) for i, x in enumerate(xs)]
     scene = scene.model_copy(update={"probes": probes})
     edges = np.arange(0.0, scene.tank.x1 + 1e-9, NOISE_BIN_M)

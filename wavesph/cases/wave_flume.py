@@ -41,9 +41,7 @@ def wave_flume_scene(*, depth: float, wavelength: float, height: float, dp: floa
                      length: float | None = None, absorb: tuple[bool, bool] = (True, True),
                      right_elevation: str = "extrapolated", probe_every: float = 0.02,
                      c0: float | None = None, g: float = 9.81, name: str = "wave_flume",
-                     absorption: str = "filter", left_pressure: str | None = None,
-                     scheme: dict | None = None, absorption_transfer: str = "piston",
-                     right_surface: str = "face", absorption_profile: str | None = None,
+                     left_pressure: str | None = None, scheme: dict | None = None,
                      **constants: Any) -> Scene:
     """A flat-bed flume [0, length] x [0, top] (floor z = 0, still water at z = depth) with open
     ends and elevation gauges mid-flume and L/16 apart within L/4 of it.
@@ -51,8 +49,7 @@ def wave_flume_scene(*, depth: float, wavelength: float, height: float, dp: floa
     length defaults to one wavelength; the tank top leaves 2H + 4dp above still water. c0
     defaults to 10 sqrt(g d): the shallow-water celerity bounds the orbital speeds, and the
     hydrostatic density variation g d / c0^2 stays at 1 %. ``scheme``: the scene's [scheme]
-    table (default wcsph). ``absorption_profile``: the ends' correction profile (None: the
-    scene's default)."""
+    table (default wcsph)."""
     # whole number of particle spacings: the right buffer continues the fluid lattice
     length = dp * round((wavelength if length is None else length) / dp)
     top = depth + 2.0 * height + 4.0 * dp
@@ -60,7 +57,6 @@ def wave_flume_scene(*, depth: float, wavelength: float, height: float, dp: floa
     probes = [{"kind": "elevation", "name": nm, "x": mid + off * wavelength}
               for nm, off in GAUGE_OFFSETS.items() if 0.0 < mid + off * wavelength < length]
     cst = {"c0": c0 if c0 is not None else 10.0 * math.sqrt(g * depth), "g": g, **constants}
-    profile = {} if absorption_profile is None else {"absorption_profile": absorption_profile}
     return make_scene({
         "name": name, "dp": dp, "t_end": t_end, "still_water_level": depth,
         "tank": {"x0": 0.0, "x1": length, "z0": 0.0, "z1": top},
@@ -69,11 +65,8 @@ def wave_flume_scene(*, depth: float, wavelength: float, height: float, dp: floa
         "probes": probes, "scheme": scheme or {},
         "open_boundaries": [
             {"side": "left", "elevation": "imposed", "absorb": absorb[0],
-             "absorption": absorption, "absorption_transfer": absorption_transfer,
-             "pressure": left_pressure, **profile},
-            {"side": "right", "elevation": right_elevation, "absorb": absorb[1],
-             "absorption": absorption, "absorption_transfer": absorption_transfer,
-             "surface": right_surface, **profile}],
+             "pressure": left_pressure},
+            {"side": "right", "elevation": right_elevation, "absorb": absorb[1]}],
     })
 
 
@@ -139,9 +132,7 @@ def run_wave_flume(scene: Scene, model: Any, *, window: float, x_model_left: flo
 def flume_case(model: Any, *, height: float, period: float, depth: float, wavelength: float,
                dp: float, periods: float, ramp: float, standing: bool = False,
                absorb: tuple[bool, bool] = (True, True), window_per_period: int = 50,
-               regular: bool = True, name: str = "wave_flume", absorption: str = "filter",
-               absorption_transfer: str = "piston", right_surface: str = "face",
-               absorption_profile: str | None = None, steady: bool = False,
+               regular: bool = True, name: str = "wave_flume", steady: bool = False,
                **constants: Any) -> dict[str, Any]:
     """Run one wave case and score it: the figures of ``bench/flume_accuracy.py``.
 
@@ -180,9 +171,7 @@ def flume_case(model: Any, *, height: float, period: float, depth: float, wavele
     scene = wave_flume_scene(depth=depth, wavelength=wavelength, height=height, dp=dp,
                              t_end=t_end, length=length, absorb=absorb,
                              right_elevation="imposed" if standing else "extrapolated",
-                             probe_every=period / 40, name=name, absorption=absorption,
-                             absorption_transfer=absorption_transfer, right_surface=right_surface,
-                             absorption_profile=absorption_profile, **constants)
+                             probe_every=period / 40, name=name, **constants)
     x_left = -0.5 * scene.tank.x1 if standing else 0.0
     res = run_wave_flume(scene, model, window=period / window_per_period, x_model_left=x_left)
     sel = (res.t >= t_start - 1e-9) & (res.t <= t_start + periods * period + 1e-9)
@@ -220,10 +209,7 @@ def flume_case(model: Any, *, height: float, period: float, depth: float, wavele
             "rmse_over_H": rmse_over_height(res.eta["mid"][sel], res.theory["mid"][sel], height),
             "reflection": refl, "reflection_3g": refl_3g, "reflection_harmonics": refl_h,
             "reflection_steady": refl_steady,
-            "absorb": list(absorb), "absorption": absorption,
-            "absorption_transfer": absorption_transfer, "right_surface": right_surface,
-            "absorption_profile": scene.open_boundaries[0].absorption_profile,
-            "kd": round(kd, 4),
+            "absorb": list(absorb), "kd": round(kd, 4),
             "wall_s": round(res.wall_s, 2),
             "particles": res.particles, "steps": res.steps,
             "particle_steps_per_s": round(res.particles * res.steps / max(res.wall_s, 1e-9)),
