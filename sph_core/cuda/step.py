@@ -1,0 +1,201 @@
+"""The kdk step on the GPU for a built ``Simulation``: its state is copied to the device once,
+stepped there, and copied back on request.
+
+    stepper = CudaStepper(sim)            # raises RuntimeError (no GPU) / ValueError (scope)
+    stepper.advance_steps(100)            # or stepper.advance_to(t_end)
+    stepper.to_host()                     # particles, cells and clock back into ``sim``
+
+One step is 11 kernel launches, all queued without a host wait (``kernels.py``): kick + drift
++ binning, the cell count's prefix sum (3), scatter, per-cell ordering, permute into the twin,
+wall pass, fluid pass, kick with the guards and reductions, and a one-thread kernel that
+computes the next dt on the device. The host reads two small arrays (clock and guards) every
+``batch`` steps to learn whether the device stopped (t_stop, max_steps or a guard).
+
+Scope: closed tanks with the kdk integrator and the delta-SPH scheme (no open ends, bodies,
+shifting, Riemann SPH, kernel gradient correction or ISPH: ``unsupported`` names what a scene
+uses that this step lacks).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from ..particles import N_FIELDS
+from ..state import Cells, particles_view
+from ..wcsph import INTEGRATORS, KDK
+from . import kernels as K
+from . import simulated, unavailable_reason
+
+LAUNCHES_PER_STEP = 11
+
+
+def unsupported(sim: Any) -> list[str]:
+    """What the scene of ``sim`` uses that the GPU step does not do yet (empty: supported)."""
+    prm = sim.prm
+    out = []
+    if sim.isph:
+        out.append("ISPH")
+    if sim.integrator != KDK:
+        out.append(f"integrator {sim.scene.constants.integrator} (only kdk)")
+    if sim.open.active:
+        out.append("open ends")
+    if sim.bodies.active:
+        out.append("rigid bodies")
+    if prm.shift_a > 0.0:
+        out.append("particle shifting")
+    if prm.riemann:
+        out.append("Riemann SPH")
+    if prm.kgc != 0:
+        out.append("kernel gradient correction")
+    if np.any(sim.particles.kind[: sim.particles.n] < 0):
+        out.append("inactive (excluded) particles")
+    return out
+
+
+class CudaStepper:
+    """The GPU twin of ``step.run`` (kdk) for one Simulation; see the module docstring."""
+
+    def __init__(self, sim: Any, batch: int | None = None) -> None:
+        reason = unavailable_reason()
+        if reason is not None:
+            raise RuntimeError(f"device cuda: {reason}")
+        missing = unsupported(sim)
+        if missing:
+            raise ValueError("device cuda: not supported yet: " + ", ".join(missing))
+        assert INTEGRATORS["kdk"] == KDK
+        from numba import cuda
+
+        self._cuda = cuda
+        self.sim = sim
+        # steps queued between reads of the stop flag (the simulator runs queued no-op steps
+        # thread by thread: one at a time there)
+        self.batch = int(batch) if batch else (1 if simulated() else 64)
+        ps = sim.particles
+        self.n = int(ps.n)
+        grid = sim.grid
+        self.ncell = grid.ncx * grid.ncz
+        self.m = self.ncell + 2            # cells, the inactive bin, and the total
+        dev = self._to_device
+        # the simulator's kernels take numpy arrays (numba-compiled bodies cannot index its
+        # array wrappers); on a GPU these are device arrays
+        self.bufs = [particles_view(dev(ps.f), dev(ps.kind), dev(ps.ids), dev(ps.cell)),
+                     particles_view(dev(ps.f2), dev(ps.kind2), dev(ps.ids2), dev(ps.cell2))]
+        self.cur = 0                       # which buffer holds the state
+        c = sim.cells
+        self.start = dev(c.start)
+        self.cursor = dev(np.zeros(self.m, dtype=np.int64))
+        self.count = dev(np.zeros(self.m, dtype=np.int64))
+        self.order = dev(c.order)
+        self.nb = (self.m + K.SCAN_B - 1) // K.SCAN_B
+        self.bsum = dev(np.zeros(self.nb, dtype=np.int64))
+        self.cells = Cells(self.start, self.cursor, self.order, c.ncx, c.ncz, c.xmin, c.zmin,
+                           c.inv_cs, c.reach)
+        self.clk = dev(np.zeros(K.N_CLK))
+        self.ctl = dev(np.zeros(K.N_CTL, dtype=np.int64))
+        self.prm = sim.prm
+        self.t = float(sim.t)
+        self.dt = float(sim.dt)
+        self.steps = 0                     # steps taken on the device
+        self.v_max = float(sim.v_max)
+        self.launches = 0
+        self._grid_n = (self.n + K.TPB - 1) // K.TPB
+        self._grid_c = (self.ncell + 1 + K.TPB - 1) // K.TPB
+
+    def _to_device(self, a: np.ndarray):
+        return np.array(a, copy=True) if simulated() else self._cuda.to_device(np.ascontiguousarray(a))
+
+    def _to_host(self, a) -> np.ndarray:
+        return np.array(a, copy=True) if simulated() else a.copy_to_host()
+
+    def _put(self, dst, src: np.ndarray) -> None:
+        if simulated():
+            dst[:] = src
+        else:
+            dst.copy_to_device(src)
+
+    # ------------------------------------------------------------------ stepping
+    def _launch_step(self, parity: int) -> None:
+        ps, ps2 = self.bufs[parity], self.bufs[1 - parity]
+        n, prm, cells, clk, ctl = self.n, self.prm, self.cells, self.clk, self.ctl
+        gn, tpb = self._grid_n, K.TPB
+        K.k_kick_drift_bin[gn, tpb](ps, n, prm, cells, self.count, clk, ctl)
+        K.k_scan_blocks[self.nb, K.SCAN_B](self.count, self.start, self.bsum, self.m, ctl)
+        K.k_scan_sums[1, K.SCAN_B](self.bsum, self.nb, ctl)
+        K.k_scan_add[self.nb, K.SCAN_B](self.start, self.bsum, self.cursor, self.count, self.m, ctl)
+        K.k_scatter[gn, tpb](ps, n, self.cursor, self.order, ctl)
+        K.k_cell_order[self._grid_c, tpb](self.start, self.order, self.ncell + 1, ctl)
+        K.k_permute[gn, tpb](ps, ps2, self.order, n, ctl)
+        K.k_wall[gn, tpb](ps2, n, cells, prm, ctl)
+        K.k_fluid[gn, tpb](ps2, n, cells, prm, ctl)
+        K.k_kick[gn, tpb](ps2, n, prm, clk, ctl)
+        K.k_finish[1, 1](prm, clk, ctl)
+        self.launches += LAUNCHES_PER_STEP
+
+    def run(self, t_stop: float, max_steps: int) -> tuple[float, float, int, int, int, float]:
+        """Steps until t_stop or max_steps or a guard trips (as ``step.run``); returns
+        (t, dt_next, steps, status, n_flagged, v_max). The state stays on the device."""
+        clk = np.zeros(K.N_CLK)
+        clk[K.T], clk[K.DT], clk[K.T_STOP] = self.t, self.dt, t_stop
+        ctl = np.zeros(K.N_CTL, dtype=np.int64)
+        ctl[K.MAX_STEPS] = max_steps
+        self._put(self.clk, clk)
+        self._put(self.ctl, ctl)
+        K.k_begin[1, 1](self.clk, self.ctl)
+        launched = 0
+        while launched < max_steps:
+            k = min(self.batch, max_steps - launched)
+            for s in range(k):
+                self._launch_step((self.cur + launched + s) % 2)
+            launched += k
+            if self._to_host(self.ctl)[K.STOP] != 0:
+                break
+        clk = self._to_host(self.clk)
+        ctl = self._to_host(self.ctl)
+        done = int(ctl[K.STEPS])
+        self.cur = (self.cur + done) % 2
+        self.steps += done
+        self.t, self.dt = float(clk[K.T]), float(clk[K.DT])
+        if done:
+            self.v_max = math.sqrt(clk[K.V2LAST])
+        return self.t, self.dt, done, int(ctl[K.STATUS]), int(ctl[K.N_FLAG]), self.v_max
+
+    def advance_steps(self, n_steps: int) -> int:
+        """Take ``n_steps`` steps (fewer if a guard trips); returns the status."""
+        return self.run(math.inf, int(n_steps))[3]
+
+    def advance_to(self, t_end: float, max_steps: int = 2**62) -> int:
+        """Step until t = t_end (the last step shortened to land on it); returns the status."""
+        return self.run(float(t_end), max_steps)[3]
+
+    # ------------------------------------------------------------------ state
+    def synchronize(self) -> None:
+        if not simulated():
+            self._cuda.synchronize()
+
+    def to_host(self) -> None:
+        """Copy the device state into the Simulation: particles (live and twin), cell lists,
+        clock and step count."""
+        sim = self.sim
+        ps = sim.particles
+        live, twin = self.bufs[self.cur], self.bufs[1 - self.cur]
+        ps.f[:] = self._to_host(live.f)
+        ps.kind[:] = self._to_host(live.kind)
+        ps.ids[:] = self._to_host(live.ids)
+        ps.cell[:] = self._to_host(live.cell)
+        ps.f2[:] = self._to_host(twin.f)
+        ps.kind2[:] = self._to_host(twin.kind)
+        ps.ids2[:] = self._to_host(twin.ids)
+        ps.cell2[:] = self._to_host(twin.cell)
+        sim.cells.start[:] = self._to_host(self.start)
+        sim.cells.order[:] = self._to_host(self.order)
+        sim.t, sim.dt, sim.v_max = self.t, self.dt, self.v_max
+        sim.steps += self.steps
+        self.steps = 0
+
+    def device_bytes(self) -> int:
+        """Bytes of the particle buffers on the device."""
+        cap = self.sim.particles.capacity
+        return 2 * cap * (8 * N_FIELDS + 1 + 8 + 8)
