@@ -9,6 +9,11 @@ Device scalars (two small arrays, so dt and the guards never leave the GPU durin
     clk (float64): T, DT (next stable dt), DTS (this step's dt), T_STOP, V2, A2, RMAX (this
                    step's reductions), V2LAST (max |v|^2 of the last completed step)
     ctl (int64):   STOP, STATUS, N_FLAG, STEPS, MAX_STEPS, N_BAD, N_BAND, N_OUT, LAST
+
+A particle buffer reaches a kernel as the tuple ``buf = (f, kind, ids, cell)`` and the kernel
+builds the named views (``state.Particles``) from it: passing the 33-array NamedTuple itself
+would make ~260 kernel parameters (seven per array) per buffer, marshalled in Python at every
+launch.
 """
 
 from __future__ import annotations
@@ -16,6 +21,7 @@ from __future__ import annotations
 from numba import cuda, float64, int64, njit
 
 from ..particles import FLUID, N_SORTED_KDK, WALL
+from ..state import particles_view
 from ..wcsph import ST_DENSITY, ST_LEFT_DOMAIN, ST_NONFINITE, ST_REACHED_T, ST_STEP_LIMIT, stable_dt
 from . import simulated
 from .bodies import cell_of, fluid_particle, kick_drift_particle, kick_particle, wall_particle
@@ -49,9 +55,31 @@ def _schedule_py(clk, ctl):
     clk[DTS] = dts
 
 
-# a device function on the GPU; under the simulator clk/ctl are its array wrappers, which only
-# Python code can index
-_schedule = _schedule_py if simulated() else njit(inline="always")(_schedule_py)
+def _view_py(buf):
+    """The named row views (state.Particles) of the buffer tuple (f, kind, ids, cell)."""
+    return particles_view(buf[0], buf[1], buf[2], buf[3])
+
+
+def _stable_dt_py(v2max, a2max, rmax, prm):
+    return stable_dt(v2max, a2max, rmax, prm)
+
+
+# device functions on the GPU (inlined: numba-cuda compiles an inlined @njit callee for the
+# device; docs/developer/gpu.md). Under the simulator they stay Python: clk/ctl are its array
+# wrappers there, which compiled code cannot take.
+if simulated():
+    _schedule = _schedule_py
+    _view = _view_py
+    _stable_dt = _stable_dt_py
+else:
+    _schedule = njit(inline="always")(_schedule_py)
+    _particles_view = njit(inline="always")(particles_view)
+
+    @njit(inline="always")
+    def _view(buf):
+        return _particles_view(buf[0], buf[1], buf[2], buf[3])
+
+    _stable_dt = njit(inline="always")(stable_dt.py_func)
 
 
 @cuda.jit
@@ -73,7 +101,7 @@ def k_finish(prm, clk, ctl):
     ctl[STEPS] += 1
     v2 = clk[V2]
     clk[V2LAST] = v2
-    clk[DT] = stable_dt(v2, clk[A2], clk[RMAX], prm)
+    clk[DT] = _stable_dt(v2, clk[A2], clk[RMAX], prm)
     status = ST_REACHED_T
     flag = 0
     if ctl[N_BAD] > 0:
@@ -100,12 +128,13 @@ def k_finish(prm, clk, ctl):
 
 
 @cuda.jit
-def k_kick_drift_bin(ps, n, prm, cells, count, clk, ctl):
+def k_kick_drift_bin(buf, n, prm, cells, count, clk, ctl):
     """kdk first half-kick + drift (fluid), then the cell of every slot and its count."""
     if ctl[STOP] != 0:
         return
     i = cuda.grid(1)
     if i < n:
+        ps = _view(buf)
         if ps.kind[i] == FLUID:
             if kick_drift_particle(i, ps, clk[DTS], prm):
                 cuda.atomic.add(ctl, N_OUT, 1)
@@ -181,13 +210,13 @@ def k_scan_add(start, bsum, cursor, count, m, ctl):
 
 
 @cuda.jit
-def k_scatter(ps, n, cursor, order, ctl):
+def k_scatter(buf, n, cursor, order, ctl):
     """order[k] = slot that goes to position k (unordered within a cell)."""
     if ctl[STOP] != 0:
         return
     i = cuda.grid(1)
     if i < n:
-        k = cuda.atomic.add(cursor, ps.cell[i], 1)
+        k = cuda.atomic.add(cursor, buf[3][i], 1)
         order[k] = i
 
 
@@ -211,42 +240,44 @@ def k_cell_order(start, order, ncells, ctl):
 
 
 @cuda.jit
-def k_permute(ps, ps2, order, n, ctl):
+def k_permute(buf, buf2, order, n, ctl):
     """neighbours.permute: gather the carried rows, kind, ids and cell into the twin."""
     if ctl[STOP] != 0:
         return
     k = cuda.grid(1)
     if k < n:
         i = order[k]
+        f = buf[0]
+        f2 = buf2[0]
         for r in range(N_SORTED_KDK):
-            ps2.f[r, k] = ps.f[r, i]
-        ps2.kind[k] = ps.kind[i]
-        ps2.ids[k] = ps.ids[i]
-        ps2.cell[k] = ps.cell[i]
+            f2[r, k] = f[r, i]
+        buf2[1][k] = buf[1][i]
+        buf2[2][k] = buf[2][i]
+        buf2[3][k] = buf[3][i]
 
 
 @cuda.jit
-def k_wall(ps, n, cells, prm, ctl):
+def k_wall(buf, n, cells, prm, ctl):
     """wcsph.wall_pass (Adami walls)."""
     if ctl[STOP] != 0:
         return
     i = cuda.grid(1)
-    if i < n and ps.kind[i] == WALL:
-        wall_particle(i, ps, cells, prm)
+    if i < n and buf[1][i] == WALL:
+        wall_particle(i, _view(buf), cells, prm)
 
 
 @cuda.jit
-def k_fluid(ps, n, cells, prm, ctl):
+def k_fluid(buf, n, cells, prm, ctl):
     """wcsph.fluid_pass (delta-SPH form)."""
     if ctl[STOP] != 0:
         return
     i = cuda.grid(1)
-    if i < n and ps.kind[i] == FLUID:
-        fluid_particle(i, ps, cells, prm)
+    if i < n and buf[1][i] == FLUID:
+        fluid_particle(i, _view(buf), cells, prm)
 
 
 @cuda.jit
-def k_kick(ps, n, prm, clk, ctl):
+def k_kick(buf, n, prm, clk, ctl):
     """wcsph.kdk_kick: second half-kick, guard counts, block-reduced max |v|^2, |a|^2, rho."""
     if ctl[STOP] != 0:
         return
@@ -258,8 +289,8 @@ def k_kick(ps, n, prm, clk, ctl):
     v2 = 0.0
     a2 = 0.0
     r = 0.0
-    if i < n and ps.kind[i] == FLUID:
-        v2, a2, r, guard = kick_particle(i, ps, clk[DTS], prm)
+    if i < n and buf[1][i] == FLUID:
+        v2, a2, r, guard = kick_particle(i, _view(buf), clk[DTS], prm)
         if guard == 1:
             cuda.atomic.add(ctl, N_BAD, 1)
         elif guard == 2:

@@ -24,7 +24,7 @@ from typing import Any
 import numpy as np
 
 from ..particles import N_FIELDS
-from ..state import Cells, particles_view
+from ..state import Cells
 from ..wcsph import INTEGRATORS, KDK
 from . import kernels as K
 from . import simulated, unavailable_reason
@@ -81,8 +81,9 @@ class CudaStepper:
         dev = self._to_device
         # the simulator's kernels take numpy arrays (numba-compiled bodies cannot index its
         # array wrappers); on a GPU these are device arrays
-        self.bufs = [particles_view(dev(ps.f), dev(ps.kind), dev(ps.ids), dev(ps.cell)),
-                     particles_view(dev(ps.f2), dev(ps.kind2), dev(ps.ids2), dev(ps.cell2))]
+        # (f, kind, ids, cell) of each buffer: kernels.py says why not state.Particles
+        self.bufs = [(dev(ps.f), dev(ps.kind), dev(ps.ids), dev(ps.cell)),
+                     (dev(ps.f2), dev(ps.kind2), dev(ps.ids2), dev(ps.cell2))]
         self.cur = 0                       # which buffer holds the state
         c = sim.cells
         self.start = dev(c.start)
@@ -180,15 +181,9 @@ class CudaStepper:
         clock and step count."""
         sim = self.sim
         ps = sim.particles
-        live, twin = self.bufs[self.cur], self.bufs[1 - self.cur]
-        ps.f[:] = self._to_host(live.f)
-        ps.kind[:] = self._to_host(live.kind)
-        ps.ids[:] = self._to_host(live.ids)
-        ps.cell[:] = self._to_host(live.cell)
-        ps.f2[:] = self._to_host(twin.f)
-        ps.kind2[:] = self._to_host(twin.kind)
-        ps.ids2[:] = self._to_host(twin.ids)
-        ps.cell2[:] = self._to_host(twin.cell)
+        for host, dev in zip((ps.f, ps.kind, ps.ids, ps.cell, ps.f2, ps.kind2, ps.ids2, ps.cell2),
+                             self.bufs[self.cur] + self.bufs[1 - self.cur]):
+            host[:] = self._to_host(dev)
         sim.cells.start[:] = self._to_host(self.start)
         sim.cells.order[:] = self._to_host(self.order)
         sim.t, sim.dt, sim.v_max = self.t, self.dt, self.v_max

@@ -114,10 +114,10 @@ def test_kick_drift_and_cell_sort_match_cpu(sim_factory):
     assert start[st.ncell] == n_sorted
     np.testing.assert_array_equal(_host(st, st.order)[:n], cpu.cells.order[:n])
     np.testing.assert_array_equal(_host(st, st.count), 0)   # cleared for the next step
-    np.testing.assert_array_equal(_host(st, b.kind)[:n], ps.kind2[:n])
-    np.testing.assert_array_equal(_host(st, b.ids)[:n], ps.ids2[:n])
-    np.testing.assert_array_equal(_host(st, b.cell)[:n], ps.cell2[:n])
-    f2 = _host(st, b.f)
+    np.testing.assert_array_equal(_host(st, b[1])[:n], ps.kind2[:n])
+    np.testing.assert_array_equal(_host(st, b[2])[:n], ps.ids2[:n])
+    np.testing.assert_array_equal(_host(st, b[3])[:n], ps.cell2[:n])
+    f2 = _host(st, b[0])
     for r in range(N_SORTED_KDK):
         _close(f2[r, :n], ps.f2[r, :n], rel=1e-15)
 
@@ -137,7 +137,7 @@ def test_wall_and_fluid_pass_match_cpu(sim_factory):
     a = st.bufs[0]
     K.k_wall[st._grid_n, K.TPB](a, n, st.cells, st.prm, st.ctl)
     K.k_fluid[st._grid_n, K.TPB](a, n, st.cells, st.prm, st.ctl)
-    f = _host(st, a.f)
+    f = _host(st, a[0])
     wall = ps.kind[:n] == WALL
     fluid = ps.kind[:n] == FLUID
     assert np.abs(ps.f[P, :n][wall]).max() > 0.0   # the walls carry pressure
@@ -167,7 +167,7 @@ def test_kick_and_next_dt_match_cpu(sim_factory):
     assert (ctl[K.N_BAD], ctl[K.N_BAND]) == (n_bad, n_band) == (0, 0)
     assert v2 > 0.0
     np.testing.assert_allclose(clk[[K.V2, K.A2, K.RMAX]], [v2, a2, rmax], rtol=1e-14)
-    f = _host(st, a.f)
+    f = _host(st, a[0])
     for row in (VX, VZ, RHO):
         _close(f[row, :n], ps.f[row, :n], rel=1e-15)
     K.k_finish[1, 1](st.prm, st.clk, st.ctl)
