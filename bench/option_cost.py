@@ -34,9 +34,6 @@ VARIANTS = {
     "h/dp sqrt(2)": {"h_over_dp": 1.4142},
     "alpha_wall_factor 1": {"alpha_wall_factor": 1.0},
     "shifting fickian": {"shifting": "fickian"},
-    "kernel_correction all": {"kernel_correction": "all"},
-    "kernel_correction surface": {"kernel_correction": "surface"},
-    "kernel_correction weighted": {"kernel_correction": "weighted"},
     "shifting dplus": {"shifting": "dplus"},
 }
 

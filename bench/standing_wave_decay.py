@@ -3,9 +3,8 @@
     python bench/standing_wave_decay.py [--dp 0.02 0.01] [--h-over-dp 2] [--alpha 0.01]
         [--alpha-wall 1] [--slip no_slip|free_slip] [--delta 0.1] [--c0-factor 10] [--periods 6]
         [--cfl 0.25] [--nu 1e-6] [--shifting none|fickian|dplus]
-        [--kernel-correction off|all|surface|weighted] [--shift-a 2] [--shift-fs-div 1.8]
-        [--scheme wcsph|riemann|isph] [--reconstruction muscl|none] [--limiter minmod|vanleer]
-        [--low-dissipation | --no-low-dissipation]
+        [--shift-a 2] [--shift-fs-div 1.8]
+        [--scheme wcsph|riemann|isph] [--reconstruction muscl|none]
 
 The first sloshing mode of a tank half a wavelength long, the wave of bench/wave_decay.py
 (cases.standing_wave). Its amplitude decay rate in time over the group velocity is the decay
@@ -56,8 +55,6 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--shifting", choices=["none", "fickian", "dplus"])
     ap.add_argument("--shift-a", type=float)
     ap.add_argument("--shift-fs-div", type=float)
-    ap.add_argument("--kernel-correction", choices=["off", "all", "surface", "weighted"],
-                    help="kernel gradient correction of the pressure gradient")
     ap.add_argument("--shift-dplus-scale", type=float, help="dplus: multiplier on CFL Ma (2h)^2")
     ap.add_argument("--no-shift-carry", action="store_true",
                     help="do not Taylor-carry rho, v of a shifted particle")
@@ -69,8 +66,7 @@ def main(argv: list[str] | None = None) -> int:
                              "shift_a": a.shift_a, "shift_fs_div": a.shift_fs_div,
                              "alpha_wall_factor": a.alpha_wall,
                              "shift_dplus_scale": a.shift_dplus_scale,
-                             "shift_carry": False if a.no_shift_carry else None,
-                             "kernel_correction": a.kernel_correction}.items() if v is not None}
+                             "shift_carry": False if a.no_shift_carry else None}.items() if v is not None}
     scheme = scheme_from_args(a)
     decays = []
     for dp in a.dp:

@@ -4,12 +4,11 @@
         [--settle-periods 0] [--inlet-pressure hydrostatic|extrapolated] [--no-outlet-absorb]
         [--h-over-dp 2.0] [--alpha 0.01] [--slip no_slip|free_slip] [--c0-factor 10] [--delta 0.1]
         [--cfl 0.25] [--integrator kdk|symplectic_pc] [--nu 1e-6] [--alpha-wall 1.0]
-        [--shifting none|fickian|dplus] [--kernel-correction off|all|surface|weighted] [--shift-a 2.0]
+        [--shifting none|fickian|dplus] [--shift-a 2.0]
         [--shift-fs-div 1.8] [--shift-open-end full|tangential|none] [--flume-wavelengths 1]
         [--gauge-wavelengths 0.75] [--n-gauges 12]
         [--long] [--noise] [--absorption filter|linear|shallow] [--transfer piston|flux]
-        [--scheme wcsph|riemann|isph] [--reconstruction muscl|none] [--limiter minmod|vanleer]
-        [--low-dissipation | --no-low-dissipation]
+        [--scheme wcsph|riemann|isph] [--reconstruction muscl|none]
 
 --long: a flume 3 wavelengths long, 36 gauges over 2.25 wavelengths, the window after the
 outlet's reflection has come back to the inlet: resolves the decay to ~0.1 %/m (dp 0.02: fitted
@@ -104,8 +103,6 @@ def main(argv: list[str] | None = None) -> int:
                     help="outlet without the absorption correction (diagnostic: its reflection)")
     ap.add_argument("--inlet-pressure", choices=["hydrostatic", "extrapolated"],
                     help="inlet buffer pressure (scene default if unset)")
-    ap.add_argument("--kernel-correction", choices=["off", "all", "surface", "weighted"],
-                    help="kernel gradient correction of the pressure gradient")
     add_scheme_arguments(ap)
     a = ap.parse_args(argv)
     cst = {k: v for k, v in {"h_over_dp": a.h_over_dp, "alpha": a.alpha, "wall_slip": a.slip,
@@ -115,8 +112,7 @@ def main(argv: list[str] | None = None) -> int:
                              "alpha_wall_factor": a.alpha_wall,
                              "shift_dplus_scale": a.shift_dplus_scale,
                              "shift_carry": False if a.no_shift_carry else None,
-                             "shift_open_end": a.shift_open_end,
-                             "kernel_correction": a.kernel_correction}.items() if v is not None}
+                             "shift_open_end": a.shift_open_end}.items() if v is not None}
     scheme = scheme_from_args(a)
     if a.long:
         a.flume_wavelengths, a.gauge_wavelengths, a.n_gauges = 3.0, 2.25, 36

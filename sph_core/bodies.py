@@ -50,10 +50,10 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit, prange
 
-from .kernels import f_of_q
-from .neighbours import block_of
-from .particles import FLUID, WALL, ParticleSet
+from .pairs import fluid_only, gather
+from .particles import WALL, ParticleSet
 from .scene import Body, Scene
+from .terms import body_reaction, fluid_consts
 
 FIXED = 0
 PRESCRIBED = 1
@@ -265,89 +265,28 @@ def place_bodies(ps, n, bd):
 
 @njit(parallel=True, cache=True)
 def _particle_loads(ps, n, cells, prm, bd):
-    """Per body particle k: minus the pair forces it exerts on its fluid neighbours (the pair term
-    of wcsph.fluid_pass for a WALL neighbour, times the fluid particle's mass), and its moment
-    about the body's reference point."""
-    x = ps.x
-    z = ps.z
-    vx = ps.vx
-    vz = ps.vz
-    rho = ps.rho
-    p = ps.p
-    pw = ps.pw     # fluid: the p_i the walls felt in fluid_pass (p or max(p, 0))
-    m = ps.m
-    vwx = ps.vwx
-    vwz = ps.vwz
+    """Per body particle k: minus the pair forces it exerts on its fluid neighbours (the
+    fluid-wall pair of the fluid pass, terms.body_reaction), and its moment about the body's
+    reference point."""
     kind = ps.kind
     ids = ps.ids
-    cell = ps.cell
-    cell_start = cells.start
-    ncx = cells.ncx
-    h = prm.h
-    inv_h = 1.0 / h
-    s2 = 4.0 * h * h
-    eta2 = 0.01 * h * h
-    af = prm.alpha_f
-    # the wall artificial viscosity of fluid_pass (alpha_wall x alpha): the same pair term, or
-    # fluid + body momentum is not conserved when alpha_wall_factor != 1
-    av = prm.alpha_wall * prm.alpha * prm.c0 * h
-    nu4 = 4.0 * prm.nu
-    noslip = prm.noslip
-    id0 = bd.id0
-    npart = bd.npart
-    owner = bd.owner
-    q = bd.q
     fk_x = bd.fk_x
     fk_z = bd.fk_z
     fk_m = bd.fk_m
     for j in prange(n):
-        k = ids[j] - id0
-        if k >= 0 and k < npart and kind[j] == WALL:
-            xj = x[j]
-            zj = z[j]
-            rhoj = rho[j]
-            pj = p[j]
-            mj = m[j]
-            wx = vwx[j]
-            wz = vwz[j]
-            fx = 0.0
-            fz = 0.0
-            cxl, cxh, czl, czh = block_of(cell[j], cells)
-            for zz in range(czl, czh + 1):
-                row = zz * ncx
-                for i in range(cell_start[row + cxl], cell_start[row + cxh + 1]):
-                    if kind[i] == FLUID:
-                        dx = x[i] - xj
-                        dz = z[i] - zj
-                        r2 = dx * dx + dz * dz
-                        if r2 < s2:
-                            fij = f_of_q(math.sqrt(r2) * inv_h, af)
-                            rhoi = rho[i]
-                            # fluid_pass's fluid-wall pair, with the p_i the wall felt there
-                            # (no tension while i approaches the wall)
-                            pf = mj * (pw[i] + pj) / (rhoi * rhoj)
-                            pax = 0.0
-                            paz = 0.0
-                            if noslip:
-                                dvx = vx[i] - wx
-                                dvz = vz[i] - wz
-                                vr = dvx * dx + dvz * dz
-                                if vr < 0.0:
-                                    pf -= mj * av * vr / (0.5 * (rhoi + rhoj) * (r2 + eta2))
-                                lam = mj * nu4 * r2 / ((rhoi + rhoj) * (r2 + eta2))
-                                pax -= lam * fij * dvx
-                                paz -= lam * fij * dvz
-                            pax += pf * fij * dx
-                            paz += pf * fij * dz
-                            # fluid particle i receives m_i (pax, paz) from j; j the opposite
-                            fx -= m[i] * pax
-                            fz -= m[i] * paz
-            b = owner[k]
-            rx = xj - q[b, 0]
-            rz = zj - q[b, 1]
-            fk_x[k] = fx
-            fk_z[k] = fz
-            fk_m[k] = rx * fz - rz * fx
+        kb = ids[j] - bd.id0
+        if kb >= 0 and kb < bd.npart and kind[j] == WALL:
+            k = fluid_consts(prm)   # per particle: see wcsph.fluid_pass
+            xj = ps.x[j]
+            zj = ps.z[j]
+            fx, fz = gather(j, xj, zj, ps.cell[j], ps, cells, k.s2, fluid_only, body_reaction, k,
+                            (0.0, 0.0))
+            b = bd.owner[kb]
+            rx = xj - bd.q[b, 0]
+            rz = zj - bd.q[b, 1]
+            fk_x[kb] = fx
+            fk_z[kb] = fz
+            fk_m[kb] = rx * fz - rz * fx
 
 
 @njit(cache=True)

@@ -52,9 +52,10 @@ class LoadProbes:
             cols += [f"{p.name}_q", f"{p.name}_volume"]
         return cols
 
-    def values(self, ps: Any, cells: Any, h: float, alpha_w: float, alpha_f: float,
-               t: float, bodies: Any = None) -> dict[str, float | None]:
-        """Every column at the current state of particle set ``ps`` (cell lists ``cells``);
+    def values(self, ps: Any, cells: Any, prm: Any, t: float,
+               bodies: Any = None) -> dict[str, float | None]:
+        """Every column at the current state of particle set ``ps`` (cell lists ``cells``,
+        the run's Params ``prm``);
         ``bodies`` (a BodySet) places the pressure lines that follow a body."""
         out: dict[str, float | None] = {}
         for sl, name in self._follow:
@@ -66,10 +67,10 @@ class LoadProbes:
             sel = np.nonzero((kind[:n] == WALL) & (x >= p.x0) & (x <= p.x1)
                              & (z >= p.z0) & (z <= p.z1))[0]
             xm, zm = p.moment_about or (0.5 * (p.x0 + p.x1), p.z0)
-            fx, fz, my = wall_force(ps.view, cells, sel, xm, zm, h, alpha_f)
+            fx, fz, my = wall_force(ps.view, cells, sel, xm, zm, prm)
             out.update({f"{p.name}_fx": fx, f"{p.name}_fz": fz, f"{p.name}_my": my})
         if self.lines:
-            interpolate_points(ps.view, cells, self._lx, self._lz, h, alpha_w, self._lout)
+            interpolate_points(ps.view, cells, self._lx, self._lz, prm.h, prm.alpha_w, self._lout)
             k = 0
             for p in self.lines:
                 for j in range(len(p.points)):

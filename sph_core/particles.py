@@ -33,22 +33,19 @@ DRHO, VWX, VWZ = range(14, 17)
 # Riemann SPH with MUSCL (riemann.py): gradients of p, vx, vz of fluid and buffer particles,
 # recomputed before every force pass
 GPX, GPZ, GUX, GUZ, GWX, GWZ = range(17, 23)
-# kernel gradient correction (kernel_correction.py): the symmetric 2x2 matrix L of every fluid
-# and buffer particle (identity elsewhere), recomputed before every force pass
-LXX, LXZ, LZZ = range(23, 26)
 # no-penetration velocity correction of fluid particles at a wall face (wall_contact.py),
 # recomputed in every force pass and added by the kick / corrector
-DVNX, DVNZ = range(26, 28)
+DVNX, DVNZ = range(23, 25)
 # fluid: the pressure its wall neighbours feel from it, p or max(p, 0) (wcsph.fluid_pass), read
 # by the body loads so they are the reaction of what the fluid felt (not carried by a sort)
-PW = 28
-N_FIELDS = 29
+PW = 25
+N_FIELDS = 26
 N_SORTED_KDK = 9
 N_SORTED_PC = 14
 
 FIELD_NAMES = ("x", "z", "vx", "vz", "ax", "az", "rho", "p", "m",
                "xn", "zn", "vxn", "vzn", "rhon", "drho", "vwx", "vwz",
-               "gpx", "gpz", "gux", "guz", "gwx", "gwz", "lxx", "lxz", "lzz", "dvnx", "dvnz", "pw")
+               "gpx", "gpz", "gux", "guz", "gwx", "gwz", "dvnx", "dvnz", "pw")
 
 
 @dataclass

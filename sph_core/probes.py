@@ -19,39 +19,50 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from .kernels import f_of_q, w_of_q
-from .neighbours import block_of, cell_at
-from .particles import FLUID, INLET, OUTLET
+from .kernels import w_of_q
+from .neighbours import cell_at
+from .pairs import fluid_only, fluidlike, gather
+from .particles import FLUID
+from .terms import fluid_consts, kernel_f, pressure_factor
+
+
+@njit(cache=True, inline="always")
+def _point_pair(i, j, dx, dz, r2, ps, ctx, a):
+    """Shepard sums (sum V W, sum u V W, sum w V W, sum p V W) at a point; ctx = (h, alpha_w)."""
+    vw = ps.m[j] / ps.rho[j] * w_of_q(math.sqrt(r2) / ctx[0], ctx[1])
+    return a[0] + vw, a[1] + ps.vx[j] * vw, a[2] + ps.vz[j] * vw, a[3] + ps.p[j] * vw
+
+
+@njit(cache=True, inline="always")
+def _mass_pair(i, j, dx, dz, r2, ps, ctx, a):
+    """sum m W at a point (seed 004's kernel mass density); ctx = (h, alpha_w)."""
+    return a + ps.m[j] * w_of_q(math.sqrt(r2) / ctx[0], ctx[1])
+
+
+@njit(cache=True, inline="always")
+def _count_pair(i, j, dx, dz, r2, ps, ctx, a):
+    return a + 1
+
+
+@njit(cache=True, inline="always")
+def _wall_pressure_pair(i, j, dx, dz, r2, ps, k, a):
+    """Wall particle i and fluid neighbour j: the fluid-wall pair's pressure force on j,
+    m_j V_i (max(p_j, 0) + p_i) / rho_j F_ij r_ji, summed with the opposite sign (the wall's
+    reaction). a = (fx, fz)."""
+    rhoj = ps.rho[j]
+    pf = ps.m[j] * pressure_factor(ps.m[i] / ps.rho[i], max(ps.p[j], 0.0), ps.p[i], 1.0 / rhoj)
+    fij = kernel_f(r2, k)
+    # dx = x_i - x_j: the force on j is +pf F (x_j - x_i), the wall gets minus it
+    return a[0] + pf * fij * dx, a[1] + pf * fij * dz
 
 
 @njit(cache=True)
 def interpolate_points(ps, cells, xs, zs, h, alpha_w, out):
     """out[k] = (u, w, p, sum V W) at point k (Shepard-normalised; zeros where sum V W = 0)."""
-    x = ps.x
-    z = ps.z
-    kind = ps.kind
-    cell_start = cells.start
-    ncx = cells.ncx
     s2 = 4.0 * h * h
     for k in range(xs.size):
-        cxl, cxh, czl, czh = block_of(cell_at(xs[k], zs[k], cells), cells)
-        su = 0.0
-        sw_ = 0.0
-        sp = 0.0
-        sv = 0.0
-        for zz in range(czl, czh + 1):
-            row = zz * ncx
-            for j in range(cell_start[row + cxl], cell_start[row + cxh + 1]):
-                if kind[j] == FLUID:
-                    dx = xs[k] - x[j]
-                    dz = zs[k] - z[j]
-                    r2 = dx * dx + dz * dz
-                    if r2 < s2:
-                        vw = ps.m[j] / ps.rho[j] * w_of_q(math.sqrt(r2) / h, alpha_w)
-                        sv += vw
-                        su += ps.vx[j] * vw
-                        sw_ += ps.vz[j] * vw
-                        sp += ps.p[j] * vw
+        sv, su, sw_, sp = gather(-1, xs[k], zs[k], cell_at(xs[k], zs[k], cells), ps, cells, s2,
+                                 fluid_only, _point_pair, (h, alpha_w), (0.0, 0.0, 0.0, 0.0))
         if sv > 0.0:
             out[k, 0] = su / sv
             out[k, 1] = sw_ / sv
@@ -66,25 +77,10 @@ def interpolate_points(ps, cells, xs, zs, h, alpha_w, out):
 @njit(cache=True)
 def line_mass_density(ps, cells, xp, zs, h, alpha_w, out):
     """out[k] = sum_j m_j W at (xp, zs[k]) over fluid particles (seed 004, eq. 23)."""
-    x = ps.x
-    z = ps.z
-    kind = ps.kind
-    cell_start = cells.start
-    ncx = cells.ncx
     s2 = 4.0 * h * h
     for k in range(zs.size):
-        cxl, cxh, czl, czh = block_of(cell_at(xp, zs[k], cells), cells)
-        s = 0.0
-        for zz in range(czl, czh + 1):
-            row = zz * ncx
-            for j in range(cell_start[row + cxl], cell_start[row + cxh + 1]):
-                if kind[j] == FLUID:
-                    dx = xp - x[j]
-                    dz = zs[k] - z[j]
-                    r2 = dx * dx + dz * dz
-                    if r2 < s2:
-                        s += ps.m[j] * w_of_q(math.sqrt(r2) / h, alpha_w)
-        out[k] = s
+        out[k] = gather(-1, xp, zs[k], cell_at(xp, zs[k], cells), ps, cells, s2, fluid_only,
+                        _mass_pair, (h, alpha_w), 0.0)
 
 
 def surface_from_line(zs: np.ndarray, rho_f: np.ndarray, level: float) -> float | None:
@@ -102,68 +98,33 @@ def surface_from_line(zs: np.ndarray, rho_f: np.ndarray, level: float) -> float 
 @njit(parallel=True, cache=True)
 def fluid_neighbour_counts(ps, n, cells, h, counts):
     """counts[i] = number of fluid neighbours within 2h of fluid particle i (-1 for others)."""
-    x = ps.x
-    z = ps.z
     kind = ps.kind
-    cell = ps.cell
-    cell_start = cells.start
-    ncx = cells.ncx
     s2 = 4.0 * h * h
     for i in prange(n):
         if kind[i] != FLUID:
             counts[i] = -1
         else:
-            cxl, cxh, czl, czh = block_of(cell[i], cells)
-            k = 0
-            for zz in range(czl, czh + 1):
-                row = zz * ncx
-                for j in range(cell_start[row + cxl], cell_start[row + cxh + 1]):
-                    if j != i and kind[j] == FLUID:
-                        dx = x[i] - x[j]
-                        dz = z[i] - z[j]
-                        if dx * dx + dz * dz < s2:
-                            k += 1
-            counts[i] = k
+            counts[i] = gather(i, ps.x[i], ps.z[i], ps.cell[i], ps, cells, s2, fluid_only,
+                               _count_pair, 0, 0)
 
 
 @njit(cache=True)
-def wall_force(ps, cells, slots, xm, zm, h, alpha_f):
-    """(F_x, F_z, M_y) the fluid exerts on the wall particles ``slots``: minus the pressure pair
-    forces m_f m_s (max(p_f, 0) + p_s)/(rho_f rho_s) F_fs r_fs of wcsph.fluid_pass; M_y about (xm, zm).
-    No tension across a wall: fluid_pass drops it only while p_f approaches the wall (its pw row),
-    but a probe reads the state after the step's sort, where that row is not carried."""
-    x = ps.x
-    z = ps.z
-    kind = ps.kind
-    cell_start = cells.start
-    ncx = cells.ncx
-    s2 = 4.0 * h * h
+def wall_force(ps, cells, slots, xm, zm, prm):
+    """(F_x, F_z, M_y) the fluid exerts on the wall particles ``slots``: the reaction of the
+    pressure part of the fluid pass's fluid-wall pair (terms.wall_momentum) with max(p_f, 0),
+    on fluid and buffer neighbours; M_y about (xm, zm).
+    No tension across a wall: the fluid pass drops it only while p_f approaches the wall (its pw
+    row), but a probe reads the state after the step's sort, where that row is not carried."""
+    k = fluid_consts(prm)
     fx = 0.0
     fz = 0.0
     my = 0.0
-    for k in range(slots.size):
-        s = slots[k]
-        xs = x[s]
-        zs = z[s]
-        cxl, cxh, czl, czh = block_of(cell_at(xs, zs, cells), cells)
-        p_s = ps.p[s]
-        c_s = ps.m[s] / ps.rho[s]  # m_s / rho_s
-        sx = 0.0
-        sz = 0.0
-        for zz in range(czl, czh + 1):
-            row = zz * ncx
-            for j in range(cell_start[row + cxl], cell_start[row + cxh + 1]):
-                kj = kind[j]
-                if kj == FLUID or kj == INLET or kj == OUTLET:
-                    dx = x[j] - xs
-                    dz = z[j] - zs
-                    r2 = dx * dx + dz * dz
-                    if r2 < s2:
-                        pf = c_s * ps.m[j] * (max(ps.p[j], 0.0) + p_s) / ps.rho[j]
-                        fij = f_of_q(math.sqrt(r2) / h, alpha_f)
-                        # force on the fluid particle is +pf F r_fs; the wall gets the reaction
-                        sx -= pf * fij * dx
-                        sz -= pf * fij * dz
+    for q in range(slots.size):
+        s = slots[q]
+        xs = ps.x[s]
+        zs = ps.z[s]
+        sx, sz = gather(s, xs, zs, cell_at(xs, zs, cells), ps, cells, k.s2, fluidlike,
+                        _wall_pressure_pair, k, (0.0, 0.0))
         fx += sx
         fz += sz
         my += (zs - zm) * sx - (xs - xm) * sz

@@ -1,6 +1,5 @@
 """The renormalisation matrix and the first-order neighbour sums built with it: ONE neighbour
-walk (``moments``) that the kernel gradient correction (kernel_correction.py), both shifting
-laws (shifting.py), ISPH's corrected pressure gradient (isph.py) and Riemann SPH's MUSCL
+walk (``moments``, through pairs.gather) that both shifting laws (shifting.py), ISPH's corrected pressure gradient (isph.py) and Riemann SPH's MUSCL
 gradients (riemann.py) share.
 
 For particle i and its neighbours j (fluid, wall, active buffer; j != i), r_ji = r_j - r_i,
@@ -22,30 +21,29 @@ L_i = M_i^-1 makes L_i d_i[phi] exact for a linear phi wherever M_i is invertibl
 (~1 with a full support, where M ~ I; ~0.5 in the top row of a flat surface at h/dp 2; ~0 for
 a splash).
 
-Why one walk function and not one stored pass: no two callers evaluate M at the same state. The
-kernel correction (and Riemann SPH's MUSCL gradients) take it in the force pass, before the kick
+Why one walk function and not one stored pass: no two callers evaluate M at the same state.
+Riemann SPH's MUSCL gradients take it in the force pass, before the kick
 changes rho; the shifting after the kick (kdk) or after the corrector (symplectic_pc: other
 positions); ISPH at r^n with the solved pressure (its wall filter below), its shifting at r^{n+1}.
 A pass storing M for another caller would add a neighbour walk per use (shifting's one walk
 costs ~0.5x a step), so every caller inlines ``moments`` into its own pass, and what it does not
-read is compiled away (inline="always", then LLVM's dead-code elimination: the kernel
-correction, which reads M and the Shepard sum only, costs no more than before).
+read is compiled away (inline="always", then LLVM's dead-code elimination).
 
 Each caller keeps its own test of a near-singular M_i (they were tuned separately; unifying
-them would change results): the kernel correction and Riemann SPH det M > 0.0125 (tr M)^2, the
+them would change results): Riemann SPH det M > 0.0125 (tr M)^2, the
 shifting laws det M > 1e-6 (delta-plus also lambda > 0.2), ISPH det M > 0.01.
 """
 
 from __future__ import annotations
 
 import math
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 from numba import njit
 
 from .kernels import f_of_q, w_of_q
-from .neighbours import block_of
-from .particles import FLUID, OUTLET, WALL
+from .pairs import gather, interacting
+from .particles import WALL
 
 DPLUS_R = 0.2     # anti-clustering term 1 + R (W_ij / W(dp))^n of Sun et al. 2017
 DPLUS_N = 4       # (the exponent is written out as wr2 * wr2 in ``moments``)
@@ -73,79 +71,76 @@ class Moments(NamedTuple):
     mfzz: float
 
 
+class MomentsCtx(NamedTuple):
+    """What ``moments_pair`` reads besides the particles."""
+
+    inv_h: float
+    alpha_f: float
+    alpha_w: float
+    inv_wdp: float
+    phi: Any
+    u: Any
+    w: Any
+    phii: float
+    ui: float
+    wi: float
+    suction_walls: bool
+
+
+MOMENTS_ZERO = Moments(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0,
+                       0.0, 0.0)
+
+
+@njit(cache=True, inline="always")
+def moments_pair(i, j, dx, dz, r2, ps, ctx, a):
+    """One neighbour's share of the sums of ``moments``; ctx as built there."""
+    c = ctx
+    wall = ps.kind[j] == WALL
+    if wall and not c.suction_walls and ps.p[j] < 0.0:
+        return a
+    rx = -dx
+    rz = -dz
+    q = math.sqrt(r2) * c.inv_h
+    vol = ps.m[j] / ps.rho[j]
+    fv = vol * f_of_q(q, c.alpha_f)
+    fx = fv * rx                 # V_j grad_i W_ij
+    fz = fv * rz
+    wk = w_of_q(q, c.alpha_w)
+    wr = wk * c.inv_wdp
+    wr2 = wr * wr
+    wgt = 1.0 + DPLUS_R * wr2 * wr2
+    d = c.phi[j] - c.phii
+    mfxx = a.mfxx
+    mfxz = a.mfxz
+    mfzz = a.mfzz
+    ux = a.ux
+    uz = a.uz
+    wx = a.wx
+    wz = a.wz
+    if not wall:
+        mfxx += fx * rx
+        mfxz += fx * rz
+        mfzz += fz * rz
+        du = c.u[j] - c.ui
+        dw = c.w[j] - c.wi
+        ux += du * fx
+        uz += du * fz
+        wx += dw * fx
+        wz += dw * fz
+    return Moments(a.mxx + fx * rx, a.mxz + fx * rz, a.mzz + fz * rz, a.gx + fx, a.gz + fz,
+                   a.acx + wgt * fx, a.acz + wgt * fz, a.shepard + vol * wk, a.phix + d * fx,
+                   a.phiz + d * fz, ux, uz, wx, wz, mfxx, mfxz, mfzz)
+
+
 @njit(cache=True, inline="always")
 def moments(i, ps, cells, prm, phi, u, w, suction_walls):
     """The neighbour sums of particle i (module docstring), over fluid, wall and active buffer
     neighbours within 2h; ``suction_walls`` False leaves out a wall neighbour with p < 0 (ISPH:
     the air side of a wetted wall). ``phi``, ``u``, ``w`` are particle rows (any, when unused)."""
-    x = ps.x
-    z = ps.z
-    m = ps.m
-    rho = ps.rho
-    p = ps.p
-    kind = ps.kind
-    cell_start = cells.start
-    ncx = cells.ncx
-    inv_h = 1.0 / prm.h
-    s2 = 4.0 * prm.h * prm.h
-    af = prm.alpha_f
-    aw = prm.alpha_w
-    inv_wdp = prm.shift_inv_wdp
-    xi = x[i]
-    zi = z[i]
-    phii = phi[i]
-    ui = u[i]
-    wi = w[i]
-    mxx = mxz = mzz = 0.0
-    gx = gz = acx = acz = shep = 0.0
-    px = pz = ux = uz = wx = wz = 0.0
-    mfxx = mfxz = mfzz = 0.0
-    cxl, cxh, czl, czh = block_of(ps.cell[i], cells)
-    for zz in range(czl, czh + 1):
-        row = zz * ncx
-        for j in range(cell_start[row + cxl], cell_start[row + cxh + 1]):
-            kj = kind[j]
-            if j == i or kj < FLUID or kj > OUTLET:
-                continue
-            if kj == WALL and not suction_walls and p[j] < 0.0:
-                continue
-            rx = x[j] - xi
-            rz = z[j] - zi
-            r2 = rx * rx + rz * rz
-            if r2 >= s2:
-                continue
-            q = math.sqrt(r2) * inv_h
-            vol = m[j] / rho[j]
-            fv = vol * f_of_q(q, af)
-            fx = fv * rx                 # V_j grad_i W_ij
-            fz = fv * rz
-            mxx += fx * rx
-            mxz += fx * rz
-            mzz += fz * rz
-            gx += fx
-            gz += fz
-            wk = w_of_q(q, aw)
-            shep += vol * wk
-            wr = wk * inv_wdp
-            wr2 = wr * wr
-            wgt = 1.0 + DPLUS_R * wr2 * wr2
-            acx += wgt * fx
-            acz += wgt * fz
-            d = phi[j] - phii
-            px += d * fx
-            pz += d * fz
-            if kj != WALL:
-                mfxx += fx * rx
-                mfxz += fx * rz
-                mfzz += fz * rz
-                du = u[j] - ui
-                dw = w[j] - wi
-                ux += du * fx
-                uz += du * fz
-                wx += dw * fx
-                wz += dw * fz
-    return Moments(mxx, mxz, mzz, gx, gz, acx, acz, shep, px, pz, ux, uz, wx, wz, mfxx, mfxz,
-                   mfzz)
+    ctx = MomentsCtx(1.0 / prm.h, prm.alpha_f, prm.alpha_w, prm.shift_inv_wdp, phi, u, w, phi[i],
+                     u[i], w[i], suction_walls)
+    return gather(i, ps.x[i], ps.z[i], ps.cell[i], ps, cells, 4.0 * prm.h * prm.h, interacting,
+                  moments_pair, ctx, MOMENTS_ZERO)
 
 
 @njit(cache=True, inline="always")

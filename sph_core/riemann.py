@@ -46,37 +46,32 @@ from numba import njit, prange
 from .particles import FLUID, OUTLET
 from .renormalisation import moments, solve
 
-# scene [scheme] limiter -> Params.limiter (0: no reconstruction)
-LIMITERS = {"minmod": 1, "vanleer": 2}
+# Params.limiter: 0 no reconstruction, 1 MUSCL with van Leer's limiter (the minmod limiter and
+# Zhang et al.'s low-dissipation beta were measured and retired: docs/decisions/)
 NO_RECONSTRUCTION = 0
-MINMOD = 1
-VANLEER = 2
+VANLEER = 1
 _FASTMATH = {"nsz", "arcp", "contract", "afn", "reassoc"}
 
 
 @njit(cache=True, inline="always")
-def limited(a, d, limiter):
-    """Limited slope from the gradient's estimate ``a`` and the pair difference ``d``: minmod or
-    van Leer (capped at |d|); 0 when they disagree in sign; d when a == d."""
+def limited(a, d):
+    """Van Leer's limited slope from the gradient's estimate ``a`` and the pair difference
+    ``d``, capped at |d|; 0 when they disagree in sign; d when a == d."""
     if a * d <= 0.0:
         return 0.0
-    if limiter == MINMOD or abs(a) >= abs(d):
-        return a if abs(a) < abs(d) else d
+    if abs(a) >= abs(d):
+        return d
     # van Leer's harmonic mean, used only below |d|: beyond it the extrapolation passes the
     # mid-point (see the module docstring)
     return 2.0 * a * d / (a + d)
 
 
 @njit(cache=True, inline="always")
-def interface_state(ul, ur, pl, pr, zc, inv_c, eta, wall_factor):
-    """(U*, P*) of the linearised Riemann problem (module docstring); eta <= 0: beta = 1."""
+def interface_state(ul, ur, pl, pr, zc, wall_factor):
+    """(U*, P*) of the linearised Riemann problem (module docstring), beta = 1."""
     du = ul - ur
     ustar = 0.5 * (ul + ur) + 0.5 * (pl - pr) / zc
-    if eta > 0.0:
-        beta = min(eta * max(du, 0.0) * inv_c, 1.0)
-    else:
-        beta = 1.0
-    return ustar, 0.5 * (pl + pr) + 0.5 * beta * wall_factor * zc * du
+    return ustar, 0.5 * (pl + pr) + 0.5 * wall_factor * zc * du
 
 
 @njit(parallel=True, cache=True, fastmath=_FASTMATH)

@@ -21,8 +21,39 @@ class SceneError(ValueError):
     """A scene configuration is invalid; the message names each offending field."""
 
 
+# Options measured and retired (docs/decisions/KEY.md: what, the figure, why not): a scene that
+# still sets one gets a one-line error naming that page. (table model, key) -> the values still
+# accepted (the retired option's surviving default), if any.
+RETIRED: dict[tuple[str, str], tuple[Any, ...]] = {
+    ("Constants", "kernel_correction"): ("off",),
+    ("Scheme", "limiter"): ("vanleer",),
+    ("Scheme", "low_dissipation"): (False,),
+    ("Scheme", "low_dissipation_eta"): (),
+}
+
+
+def retired_page(key: str) -> str:
+    """The decision page of a retired option."""
+    return f"docs/decisions/{key}.md"
+
+
 class _Model(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True)
+
+    @model_validator(mode="before")
+    @classmethod
+    def _retired(cls, data: Any) -> Any:
+        if not isinstance(data, dict):
+            return data
+        kept = {}
+        for key, value in data.items():
+            accepted = RETIRED.get((cls.__name__, key))
+            if accepted is None:
+                kept[key] = value
+            elif value not in accepted:
+                raise ValueError(f"{key}: {value!r} was measured and retired "
+                                 f"(see {retired_page(key)})")
+        return kept
 
 
 class Rect(_Model):
@@ -182,15 +213,6 @@ class Constants(_Model):
     shift_fs_div: float = Field(1.8, gt=0, lt=2, description=(
         "position divergence below which a particle counts as near the free surface (2D: 2 "
         "inside the fluid) and shifts only tangentially"))
-    # experimental: none of the variants is stable enough for the default (still water loses
-    # particles through the bed with all / surface; weighted multiplies the particle noise;
-    # docs/wave_decay_study.md "Kernel gradient correction")
-    kernel_correction: Literal["off", "all", "surface", "weighted"] = Field("off", description=(
-        "kernel gradient correction of the momentum equation's pressure gradient (Bonet & Lok "
-        "1999, symmetric form; sph_core.kernel_correction), experimental: all = every fluid "
-        "particle, weighted = every fluid particle times its Shepard sum, surface = blended "
-        "in where the kernel is cut by the free surface (Schulze et al. 2025); wcsph scheme "
-        "without bodies only"))
     wall_slip: Literal["no_slip", "free_slip"] = "no_slip"
     density_band: tuple[float, float] = Field((0.7, 1.3), description="sane rho/rho0 band")
     # A drop thrown off the surface (splash, run-up on a staircase bed) keeps few neighbours: its
@@ -234,15 +256,8 @@ class Scheme(_Model):
     reconstruction: Literal["muscl", "none"] = Field("muscl", description=(
         "riemann: left/right states extrapolated to the pair's mid-point with limited "
         "gradients (muscl), or the particles' own values (none, first order)"))
-    # defaults measured (docs/schemes.md): van Leer + beta = 1 loses 2.5 %/wavelength in the
-    # closed tank at dp 0.02 (minmod 8.2 %); the low-dissipation limiter with MUSCL leaves the
-    # particle noise undamped (17 % of the wave's kinetic energy), without MUSCL (Zhang et al.
-    # as published) a particle left the tank
-    limiter: Literal["minmod", "vanleer"] = Field("vanleer", description="riemann: MUSCL slope limiter")
-    low_dissipation: bool = Field(False, description=(
-        "riemann: Zhang, Hu & Adams (2017) limiter on the pressure dissipation, "
-        "beta = min(eta max(U_L - U_R, 0)/c0, 1); false: beta = 1 (plain Godunov flux)"))
-    low_dissipation_eta: float = Field(3.0, gt=0, description="riemann: eta of that limiter")
+    # van Leer's limiter and beta = 1 were measured best (docs/schemes.md); the minmod limiter
+    # and the low-dissipation beta are retired (docs/decisions/limiter.md, low_dissipation.md)
     ppe_solver: Literal["explicit", "amg", "ilu", "direct", "bicgstab"] = Field("bicgstab", description=(
         "ISPH pressure Poisson solver: explicit = the seed's Jacobi iteration (Hosseini et al. "
         "2007); amg = BiCGSTAB preconditioned by smoothed-aggregation AMG (pyamg); ilu = "
@@ -514,15 +529,6 @@ class Scene(_Model):
                     raise ValueError(f"bodies.{i}.motion: isph supports fixed and prescribed "
                                      f"bodies only, got {b.motion!r} (use scheme kind "
                                      "\"wcsph\" for free or hinged bodies)")
-        if self.constants.kernel_correction != "off":
-            # the Riemann flux and ISPH have their own gradients; the body loads (bodies.py) and
-            # force probes take the uncorrected pair term
-            if self.scheme.kind != "wcsph":
-                raise ValueError("constants.kernel_correction: applies to [scheme] kind = "
-                                 "\"wcsph\" only")
-            if self.bodies:
-                raise ValueError("constants.kernel_correction: not with bodies (their loads "
-                                 "use the uncorrected pair term)")
         bnames = [b.name for b in self.bodies]
         if len(set(bnames)) != len(bnames):
             raise ValueError(f"bodies: duplicate names {bnames}")
@@ -562,7 +568,8 @@ def _format_errors(exc: ValidationError) -> str:
         msg = err["msg"].removeprefix("Value error, ")
         if ": " in msg and not msg.startswith(("Input", "Field")):
             head, tail = msg.split(": ", 1)
-            if head.split(".")[0] in {"x0", "x1", "z0", "z1", "points", "density_band"}:
+            if head.split(".")[0] in {"x0", "x1", "z0", "z1", "points", "density_band",
+                                      *(key for _, key in RETIRED)}:
                 loc.append(head)
                 msg = tail
             elif loc == [] or "." in head or head in {"probes", "output.snapshot_every"}:

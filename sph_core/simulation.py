@@ -28,7 +28,6 @@ import numba
 import numpy as np
 
 from . import riemann, step, wcsph
-from .kernel_correction import KERNEL_CORRECTIONS
 from .isph import IsphStepper
 from .bodies import BodyLog, BodySet
 from .boundary_data import BoundaryData, BoundaryDataError, BoundarySample
@@ -53,12 +52,11 @@ CELLS_PER_SUPPORT = 2
 
 
 def scheme_params(scheme: Scheme) -> dict[str, Any]:
-    """The Params fields of the scene's [scheme] (riemann, limiter, rs_eta)."""
+    """The Params fields of the scene's [scheme] (riemann, limiter)."""
     if scheme.kind != "riemann":
-        return {"riemann": False, "limiter": riemann.NO_RECONSTRUCTION, "rs_eta": 0.0}
-    lim = riemann.LIMITERS[scheme.limiter] if scheme.reconstruction == "muscl" else riemann.NO_RECONSTRUCTION
-    return {"riemann": True, "limiter": lim,
-            "rs_eta": scheme.low_dissipation_eta if scheme.low_dissipation else 0.0}
+        return {"riemann": False, "limiter": riemann.NO_RECONSTRUCTION}
+    lim = riemann.VANLEER if scheme.reconstruction == "muscl" else riemann.NO_RECONSTRUCTION
+    return {"riemann": True, "limiter": lim}
 
 
 class UnstableError(RuntimeError):
@@ -152,7 +150,6 @@ class Simulation:
                           shift_dplus=dplus, shift_carry=c.shift_carry and not self.isph,
                           shift_inv_wdp=1.0 / w_of_q(dp / h, aw),
                           shift_open=SHIFT_OPEN_END[c.shift_open_end],
-                          kgc=KERNEL_CORRECTIONS[c.kernel_correction],
                           # no penetration at wall faces (WCSPH and Riemann; ISPH has its own
                           # no-penetration pressure, isph_wall_stop)
                           **dict(zip(("wall_ga", "wall_g0", "wall_gb"),
@@ -297,8 +294,8 @@ class Simulation:
                 sel = counts >= p.min_neighbours
                 out[f"{p.name}_x"] = float(x[sel].max()) if sel.any() else None
         if self.loads:
-            out.update(self.loads.values(self.particles, self.cells, self.h, aw,
-                                         self.prm.alpha_f, self.t, self.bodies))
+            out.update(self.loads.values(self.particles, self.cells, self.prm, self.t,
+                                         self.bodies))
         return out
 
     # ---------------------------------------------------------------- outputs

@@ -19,7 +19,7 @@ from typing import NamedTuple
 import numpy as np
 
 from .absorption import N_FILTER
-from .particles import (AX, AZ, DRHO, DVNX, DVNZ, GPX, GPZ, GUX, GUZ, GWX, GWZ, LXX, LXZ, LZZ,
+from .particles import (AX, AZ, DRHO, DVNX, DVNZ, GPX, GPZ, GUX, GUZ, GWX, GWZ,
                         M, P, PW, RHO, RHON, VWX, VWZ, VX, VXN, VZ, VZN, XN, ZN, X, Z)
 
 
@@ -54,9 +54,6 @@ class Particles(NamedTuple):
     guz: np.ndarray
     gwx: np.ndarray
     gwz: np.ndarray
-    lxx: np.ndarray      # kernel gradient correction L (kernel_correction.py): symmetric 2x2
-    lxz: np.ndarray
-    lzz: np.ndarray
     dvnx: np.ndarray     # fluid: no-penetration velocity correction at a wall face (wall_contact.py)
     dvnz: np.ndarray
     pw: np.ndarray       # fluid: the pressure its walls feel from it, p or max(p, 0) (wcsph.fluid_pass)
@@ -69,7 +66,7 @@ def particles_view(f: np.ndarray, kind: np.ndarray, ids: np.ndarray, cell: np.nd
     """Named views of the storage ``f`` (no copy)."""
     return Particles(f, f[X], f[Z], f[VX], f[VZ], f[AX], f[AZ], f[RHO], f[P], f[M], f[XN], f[ZN],
                      f[VXN], f[VZN], f[RHON], f[DRHO], f[VWX], f[VWZ], f[GPX], f[GPZ], f[GUX], f[GUZ],
-                     f[GWX], f[GWZ], f[LXX], f[LXZ], f[LZZ], f[DVNX], f[DVNZ], f[PW],
+                     f[GWX], f[GWZ], f[DVNX], f[DVNZ], f[PW],
                      kind, ids, cell)
 
 
@@ -117,11 +114,7 @@ class Params(NamedTuple):
     shift_fs_div: float  # position divergence below which shifting is tangential only
     # scheme (scene [scheme]; riemann.py): Riemann SPH instead of delta-SPH + Monaghan AV
     riemann: bool = False
-    limiter: int = 0     # MUSCL slope limiter (riemann.LIMITERS): 0 = no reconstruction
-    rs_eta: float = 0.0  # Zhang et al. 2017 dissipation limiter eta (0: full dissipation)
-    # kernel gradient correction of the pressure gradient (scene constants.kernel_correction;
-    # kernel_correction.KERNEL_CORRECTIONS): 0 off, 1 all fluid particles, 2 near the surface
-    kgc: int = 0
+    limiter: int = 0     # MUSCL reconstruction (riemann.VANLEER) or none (0)
     # particle shifting law (shifting.py): Fickian (D = shift_a h |v_i| dt) or delta-plus
     # (D = shift_a h max|v| dt, anti-clustering weight 1 + R (W / W(dp))^4 with shift_inv_wdp
     # = 1 / W(dp), Marrone's surface detection); shift_carry: Taylor-carry rho, v over the shift

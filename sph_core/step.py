@@ -22,8 +22,7 @@ One step, as the two integrators order the same stages (wcsph.py has the equatio
     measure_boundaries              [G]      correct (guards)
                                              update_buffers                [D]
 
-[F] forces = ``wall_pass`` (Adami wall state) then, with a kernel gradient correction,
-``correction_matrices``, then, for Riemann SPH with MUSCL,
+[F] forces = ``wall_pass`` (Adami wall state) then, for Riemann SPH with MUSCL,
 ``riemann_gradients``, then ``fluid_pass`` (continuity, delta-SPH, pressure, viscosity, gravity;
 or the Riemann flux, riemann.py) then ``body_loads`` (fluid loads on the rigid bodies, their
 accelerations): ``_forces`` below. Bodies follow the fluid's stages: kdk half-kick + drift with
@@ -35,13 +34,12 @@ forces: boundary gauges) return at once when ``ends.active`` is False, so a clos
 same code. Buffer particles are not FLUID: the integrators never move them; update_buffers does,
 once per step, with the window's data at t + dt.
 
-Where a new physical term goes (one jitted function, one line here):
-- a pass that needs neighbours before the forces (as the kernel-gradient correction matrix
-  L_i of each fluid particle, kernel_correction.py, rows lxx..lzz): call it in ``_forces``
-  before ``fluid_pass``;
-- a change of the rates (a new force or density term): its own pass after ``fluid_pass`` in
-  ``_forces`` adding into ps.ax / ps.az / ps.drho (or a term inside fluid_pass's pair loop if it
-  must share the neighbour search);
+Where a new physical term goes (docs/developer/adding_a_term.md):
+- a new pair contribution to the rates (a force or density term between neighbours): its
+  physical function in terms.py, called from the pair term of the scheme it belongs to
+  (terms.wcsph_pair / riemann_pair): it shares fluid_pass's one neighbour walk (pairs.gather);
+- a pass that needs neighbours before the forces (as Riemann SPH's MUSCL gradients): a
+  pass over ``pairs.gather`` with its own term, called in ``_forces`` before ``fluid_pass``;
 - a position correction after the update (particle shifting): a pass after ``kdk_kick`` /
   ``pc_correct`` in ``_step_kdk`` / ``_step_pc``, on the sorted state (cells valid for kdk; for
   symplectic_pc the cells are those of x^n);
@@ -59,7 +57,6 @@ from numba import njit
 
 from .bodies import (bodies_correct, bodies_kick, bodies_kick_drift, bodies_predict,
                      bodies_v2max, body_loads, place_bodies)
-from .kernel_correction import correction_matrices
 from .neighbours import sort_by_cell
 from .open_boundary import extrapolate_buffers, measure_boundaries, update_buffers
 from .particles import N_SORTED_KDK, N_SORTED_PC
@@ -74,9 +71,6 @@ from .wcsph import (KDK, ST_CAPACITY, ST_DENSITY, ST_LEFT_DOMAIN, ST_NONFINITE, 
 def _forces(ps, n, cells, prm, bd):
     """Rates of every fluid particle (ax, az, drho) and body (acc) at the current, sorted state."""
     wall_pass(ps, n, cells, prm)
-    if prm.kgc != 0:
-        correction_matrices(ps, n, cells, prm)   # kernel gradient correction L_i (after the
-        # wall pass: the wall particles' volumes enter M_i)
     if prm.riemann and prm.limiter != NO_RECONSTRUCTION:
         riemann_gradients(ps, n, cells, prm)   # MUSCL: gradients of p and v (riemann.py)
     fluid_pass(ps, n, cells, prm)

@@ -1,6 +1,7 @@
-"""Weakly-compressible SPH: the physical terms of a step, each a jitted pass over the particles.
+"""Weakly-compressible SPH: the passes of a step over the particles, and the integrators.
 
-The step that calls them is ``step.run`` (one skeleton for every integrator and scene).
+The per-pair terms the passes fold over their neighbours (pairs.gather) are in terms.py; the
+step that calls the passes is ``step.run`` (one skeleton for every integrator and scene).
 
 Equations (i fluid, j neighbour, r_ij = r_i - r_j, grad_i W_ij = -F_ij r_ij, V_j = m_j / rho_j):
 
@@ -10,8 +11,6 @@ continuity + delta-SPH (Fourtakas et al. 2019 dynamic form, fluid-fluid and flui
     rho^H_ji = rho_H(z_j) - rho_H(z_i) = (rho_i g / c_i^2)(z_i - z_j),  c_i^2 = c0^2 (rho_i/rho0)^(gamma-1)
 momentum:
     dv_i/dt = sum_j m_j [(p_i + p_j)/(rho_i rho_j) + Pi_ij] F_ij r_ij                 (pressure, Monaghan AV)
-              (with a kernel gradient correction, kernel_correction.py, the pressure part's
-               F_ij r_ij is (L_i + L_j)/2 F_ij r_ij)
               - sum_j m_j 4 nu F_ij r^2 / ((rho_i + rho_j)(r^2 + 0.01 h^2)) v_ij + g   (Lo & Shao 2002)
     Pi_ij = -alpha c0 h (v_ij.r_ij) / (rho_bar (r^2 + 0.01 h^2)) if v_ij.r_ij < 0 else 0   (Monaghan 1992)
 walls (Adami, Hu & Adams 2012, eq. 22 of seed 004), from fluid neighbours f of wall particle s:
@@ -39,10 +38,10 @@ import numpy as np
 from numba import njit, prange
 
 from .eos import density, pressure
-from .kernels import f_of_q, w_of_q
-from .neighbours import block_of
-from .particles import FLUID, INLET, OUTLET, WALL
-from .riemann import NO_RECONSTRUCTION, interface_state, limited
+from .pairs import fluidlike, gather, interacting
+from .particles import FLUID, WALL
+from .terms import (FLUID_SUMS_ZERO, WALL_SUMS_ZERO, adami_pair, fluid_consts, fluid_i,
+                    riemann_pair, wcsph_pair)
 from .wall_contact import approach_speed, no_penetration
 
 # status codes returned by the time loop (step.run)
@@ -73,285 +72,84 @@ PASSES_PER_STEP = {"kdk": 1, "symplectic_pc": 2}
 @njit(parallel=True, cache=True, fastmath=FASTMATH)
 def wall_pass(ps, n, cells, prm):
     """Adami et al. (2012) pressure, density and no-slip velocity of every wall particle."""
-    x = ps.x
-    z = ps.z
-    vx = ps.vx
-    vz = ps.vz
-    ax = ps.ax
-    az = ps.az
-    rho = ps.rho
     p = ps.p
+    rho = ps.rho
     vwx = ps.vwx
     vwz = ps.vwz
     kind = ps.kind
-    cell = ps.cell
-    cell_start = cells.start
-    ncx = cells.ncx
     h = prm.h
     inv_h = 1.0 / h
     s2 = 4.0 * h * h
-    aw = prm.alpha_w
-    gx = prm.gx
-    gz = prm.gz
-    rho0 = prm.rho0
-    b = prm.b
-    gam = prm.gamma
     for i in prange(n):
         if kind[i] == WALL:
-            xi = x[i]
-            zi = z[i]
-            bx = gx - ax[i]
-            bz = gz - az[i]
-            sw = 0.0
-            sp = 0.0
-            svx = 0.0
-            svz = 0.0
-            cxl, cxh, czl, czh = block_of(cell[i], cells)
-            for zz in range(czl, czh + 1):
-                row = zz * ncx
-                for j in range(cell_start[row + cxl], cell_start[row + cxh + 1]):
-                    # fluid and active open-boundary buffer particles (kinds 0, 2, 3)
-                    if kind[j] == FLUID or kind[j] == INLET or kind[j] == OUTLET:
-                        dx = xi - x[j]
-                        dz = zi - z[j]
-                        r2 = dx * dx + dz * dz
-                        if r2 < s2:
-                            w = w_of_q(math.sqrt(r2) * inv_h, aw)
-                            sw += w
-                            sp += (p[j] + rho[j] * (bx * dx + bz * dz)) * w
-                            svx += vx[j] * w
-                            svz += vz[j] * w
-            if sw > 0.0:
+            ctx = (inv_h, prm.alpha_w, prm.gx - ps.ax[i], prm.gz - ps.az[i])
+            s = gather(i, ps.x[i], ps.z[i], ps.cell[i], ps, cells, s2, fluidlike, adami_pair, ctx,
+                       WALL_SUMS_ZERO)
+            if s.sw > 0.0:
                 # no suction: a negative extrapolated pressure (free surface near the wall)
                 # would pull fluid into the wall
-                pi = max(sp / sw, 0.0)
+                pi = max(s.sp / s.sw, 0.0)
                 p[i] = pi
-                rho[i] = density(pi, rho0, b, gam)
-                vwx[i] = 2.0 * vx[i] - svx / sw
-                vwz[i] = 2.0 * vz[i] - svz / sw
+                rho[i] = density(pi, prm.rho0, prm.b, prm.gamma)
+                vwx[i] = 2.0 * ps.vx[i] - s.svx / s.sw
+                vwz[i] = 2.0 * ps.vz[i] - s.svz / s.sw
             else:
                 p[i] = 0.0
-                rho[i] = rho0
-                vwx[i] = vx[i]
-                vwz[i] = vz[i]
+                rho[i] = prm.rho0
+                vwx[i] = ps.vx[i]
+                vwz[i] = ps.vz[i]
 
 
 @njit(parallel=True, cache=True, fastmath=FASTMATH)
 def fluid_pass(ps, n, cells, prm):
-    """The fused gather over fluid particles: continuity, delta-SPH, pressure, viscosity, gravity.
-
-    With ``prm.riemann`` the pair's continuity, delta-SPH, pressure and artificial viscosity are
-    the Riemann SPH flux instead (riemann.py; MUSCL gradients from riemann_gradients).
-    Writes ax, az, drho and the no-penetration velocity change dvnx, dvnz (wall_contact.py) of
-    each fluid particle; returns nothing (reductions are in the kicks)."""
-    x = ps.x
-    z = ps.z
-    vx = ps.vx
-    vz = ps.vz
+    """The gather over fluid particles: continuity, delta-SPH, pressure, viscosity, gravity
+    (terms.wcsph_pair), or with ``prm.riemann`` the Riemann SPH flux (terms.riemann_pair; MUSCL
+    gradients from riemann_gradients). Writes ax, az, drho, pw and the no-penetration velocity
+    change dvnx, dvnz (wall_contact.py) of each fluid particle; returns nothing (reductions are
+    in the kicks)."""
+    # only the rows written need locals (numba drops prange stores made through ps.row[i])
     ax = ps.ax
     az = ps.az
-    rho = ps.rho
-    p = ps.p
-    m = ps.m
     drho = ps.drho
-    vwx = ps.vwx
-    vwz = ps.vwz
-    kind = ps.kind
-    cell = ps.cell
-    cell_start = cells.start
-    ncx = cells.ncx
-    h = prm.h
-    inv_h = 1.0 / h
-    s2 = 4.0 * h * h
-    eta2 = 0.01 * h * h
-    af = prm.alpha_f
-    rho0 = prm.rho0
-    c0 = prm.c0
-    gam = prm.gamma
-    gx = prm.gx
-    gz = prm.gz
-    g = math.sqrt(gx * gx + gz * gz)
-    gdir_z = gz / g if g > 0 else 0.0
-    gdir_x = gx / g if g > 0 else 0.0
-    av = prm.alpha * c0 * h
-    # artificial viscosity against walls (DualSPHysics' ViscoBoundFactor): the bed's boundary
-    # layer is far thinner than dp, and alpha c0 h over a shear across dp dissipates the same
-    # wave energy at every dp (docs/wave_decay_study.md)
-    av_wall = prm.alpha_wall * av
-    nu4 = 4.0 * prm.nu
-    ddiff = 2.0 * prm.delta * h * c0
-    noslip = prm.noslip
-    rs = prm.riemann
-    lim = prm.limiter
-    muscl = lim != NO_RECONSTRUCTION
-    eta = prm.rs_eta
-    inv_c0 = 1.0 / c0
-    wall_rs = prm.alpha_wall
-    gpx = ps.gpx
-    gpz = ps.gpz
-    gux = ps.gux
-    guz = ps.guz
-    gwx = ps.gwx
-    gwz = ps.gwz
-    # kernel gradient correction (kernel_correction.py): the pressure term's grad_i W_ij becomes
-    # (L_i + L_j)/2 grad_i W_ij (L_i for a wall neighbour): antisymmetric, so momentum is kept
-    kgc = prm.kgc != 0
-    lxx = ps.lxx
-    lxz = ps.lxz
-    lzz = ps.lzz
-    # no penetration at wall faces (wall_contact.py): g0 = 0 turns it off
-    ga = prm.wall_ga
-    g0 = prm.wall_g0
-    gb = prm.wall_gb
-    nopen = g0 > 0.0
-    aw = prm.alpha_w
-    inv_rho0 = 1.0 / rho0
     dvnx = ps.dvnx
     dvnz = ps.dvnz
     pw = ps.pw
+    kind = ps.kind
+    rs = prm.riemann
+    # no penetration at wall faces (wall_contact.py): g0 = 0 turns it off
+    nopen = prm.wall_g0 > 0.0
     for i in prange(n):
         if kind[i] == FLUID:
-            xi = x[i]
-            zi = z[i]
-            lxxi = lxx[i]
-            lxzi = lxz[i]
-            lzzi = lzz[i]
-            vxi = vx[i]
-            vzi = vz[i]
-            rhoi = rho[i]
-            pi = p[i]
-            inv_rhoi = 1.0 / rhoi
-            # hydrostatic density gradient factor rho_i g / c_i^2 (Fourtakas et al. 2019)
-            khyd = rhoi * g / (c0 * c0 * (rhoi / rho0) ** (gam - 1.0))
-            fx = 0.0
-            fz = 0.0
-            cont = 0.0
-            diff = 0.0
-            gw = 0.0     # wall share, normal and velocity sums (wall_contact.py)
-            gnx = 0.0
-            gnz = 0.0
-            gvx = 0.0
-            gvz = 0.0
-            tx = 0.0     # the walls' push that a particle in tension (p_i < 0) would not feel
-            tz = 0.0
-            cxl, cxh, czl, czh = block_of(cell[i], cells)
-            for zz in range(czl, czh + 1):
-                row = zz * ncx
-                for j in range(cell_start[row + cxl], cell_start[row + cxh + 1]):
-                    kj = kind[j]
-                    # INACTIVE (-1) and idle buffer slots (> OUTLET) do not interact; active
-                    # buffer particles (INLET, OUTLET) act as fluid with imposed velocity
-                    if j == i or kj < FLUID or kj > OUTLET:
-                        continue
-                    dx = xi - x[j]
-                    dz = zi - z[j]
-                    r2 = dx * dx + dz * dz
-                    if r2 >= s2:
-                        continue
-                    fij = f_of_q(math.sqrt(r2) * inv_h, af)
-                    rhoj = rho[j]
-                    mj = m[j]
-                    vol = mj / rhoj
-                    # continuity uses the particle's own (for walls: prescribed) velocity
-                    dvx = vxi - vx[j]
-                    dvz = vzi - vz[j]
-                    visc = kj != WALL or noslip
-                    if rs:
-                        # Riemann problem along e = r_ji / |r_ji| (riemann.py), r_ji = -(dx, dz)
-                        r = max(math.sqrt(r2), 1e-9 * h)   # coincident particles: no NaN
-                        ex = -dx / r
-                        ez = -dz / r
-                        ul = vxi * ex + vzi * ez
-                        ur = vx[j] * ex + vz[j] * ez
-                        ui = ul
-                        pl = pi
-                        pr = p[j]
-                        if muscl:
-                            dpj = pr - pl
-                            si = -(gpx[i] * dx + gpz[i] * dz)
-                            sj = si if kj == WALL else -(gpx[j] * dx + gpz[j] * dz)
-                            pl += 0.5 * limited(si, dpj, lim)
-                            pr -= 0.5 * limited(sj, dpj, lim)
-                            if kj != WALL:
-                                duj = ur - ul
-                                si = -((gux[i] * dx + guz[i] * dz) * ex
-                                       + (gwx[i] * dx + gwz[i] * dz) * ez)
-                                sj = -((gux[j] * dx + guz[j] * dz) * ex
-                                       + (gwx[j] * dx + gwz[j] * dz) * ez)
-                                ul += 0.5 * limited(si, duj, lim)
-                                ur -= 0.5 * limited(sj, duj, lim)
-                        ustar, pstar = interface_state(ul, ur, pl, pr, 0.5 * (rhoi + rhoj) * c0,
-                                                       inv_c0, eta,
-                                                       wall_rs if kj == WALL else 1.0)
-                        cont += 2.0 * vol * fij * r * (ui - ustar)
-                        pf = 2.0 * vol * pstar * inv_rhoi
-                    else:
-                        cont -= vol * fij * (dvx * dx + dvz * dz)
-                        # m_j (p_i + p_j) / (rho_i rho_j), with the divisions shared per pair
-                        pf = vol * (pi + p[j]) * inv_rhoi
-                        # height of i above j along gravity (z_i - z_j for g = (0, -g)); wall
-                        # densities come from the Adami extrapolation, so they carry the
-                        # hydrostatic part as the fluid's do and take part in the diffusion
-                        up = -(gdir_x * dx + gdir_z * dz)
-                        diff += (rhoj - rhoi - khyd * up) * fij * vol
-                    if kj == WALL:
-                        dvx = vxi - vwx[j]
-                        dvz = vzi - vwz[j]
-                        vg = mj * inv_rho0
-                        wg = vg * w_of_q(math.sqrt(r2) * inv_h, aw)
-                        gw += wg
-                        gnx += vg * fij * dx
-                        gnz += vg * fij * dz
-                        gvx += wg * vx[j]
-                        gvz += wg * vz[j]
-                        if pi < 0.0 and not rs:
-                            pt = -vol * pi * inv_rhoi
-                            if kgc:
-                                tx += pt * fij * (lxxi * dx + lxzi * dz)
-                                tz += pt * fij * (lxzi * dx + lzzi * dz)
-                            else:
-                                tx += pt * fij * dx
-                                tz += pt * fij * dz
-                    if kgc:
-                        # the pressure part alone goes through L; viscosity keeps grad W
-                        if kj == WALL:
-                            cxx = lxxi
-                            cxz = lxzi
-                            czz = lzzi
-                        else:
-                            cxx = 0.5 * (lxxi + lxx[j])
-                            cxz = 0.5 * (lxzi + lxz[j])
-                            czz = 0.5 * (lzzi + lzz[j])
-                        fx += pf * fij * (cxx * dx + cxz * dz)
-                        fz += pf * fij * (cxz * dx + czz * dz)
-                        pf = 0.0
-                    if visc:
-                        vr = dvx * dx + dvz * dz
-                        mden = mj / ((rhoi + rhoj) * (r2 + eta2))
-                        if vr < 0.0 and not rs:
-                            pf -= 2.0 * (av_wall if kj == WALL else av) * vr * mden
-                        lam = nu4 * r2 * mden
-                        fx -= lam * fij * dvx
-                        fz -= lam * fij * dvz
-                    fx += pf * fij * dx
-                    fz += pf * fij * dz
+            # (built per particle: a NamedTuple live into a prange loop fails numba's parfor
+            # lowering, and it costs a few flops against ~30 pairs)
+            k = fluid_consts(prm)
+            fi = fluid_i(i, ps, k)
+            if rs:
+                a = gather(i, fi.x, fi.z, ps.cell[i], ps, cells, k.s2, interacting, riemann_pair,
+                           (k, fi), FLUID_SUMS_ZERO)
+            else:
+                a = gather(i, fi.x, fi.z, ps.cell[i], ps, cells, k.s2, interacting, wcsph_pair,
+                           (k, fi), FLUID_SUMS_ZERO)
+            fx = a.fx
+            fz = a.fz
             # no tension across a wall while the particle approaches it (p_i -> max(p_i, 0)): a
             # particle in tension is otherwise pulled into the wall (a dry-bed front sinks
             # through the bed); one that moves away keeps the pull, so a thin swash film stays
-            # on its beach (docs/wall_pressure.md, session 7)
-            # (the Riemann flux has no such pair term: tx = 0, and its bodies keep max(p_i, 0))
-            pwi = pi
-            if pi < 0.0 and (rs or approach_speed(gw, gnx, gnz, gvx, gvz, vxi, vzi) < 0.0):
-                fx += tx
-                fz += tz
+            # on its beach (docs/wall_pressure.md). The Riemann flux has no such pair term
+            # (tx = 0): its walls always feel max(p_i, 0)
+            pwi = fi.p
+            if fi.p < 0.0 and (rs or approach_speed(a.gw, a.gnx, a.gnz, a.gvx, a.gvz, fi.vx,
+                                                    fi.vz) < 0.0):
+                fx += a.tx
+                fz += a.tz
                 pwi = 0.0
             pw[i] = pwi
-            ax[i] = fx + gx
-            az[i] = fz + gz
-            drho[i] = rhoi * cont + ddiff * diff
+            ax[i] = fx + prm.gx
+            az[i] = fz + prm.gz
+            drho[i] = fi.rho * a.cont + k.ddiff * a.diff
             if nopen:
-                dvnx[i], dvnz[i] = no_penetration(gw, gnx, gnz, gvx, gvz, vxi, vzi, ga, g0, gb)
-
+                dvnx[i], dvnz[i] = no_penetration(a.gw, a.gnx, a.gnz, a.gvx, a.gvz, fi.vx, fi.vz,
+                                                  prm.wall_ga, prm.wall_g0, prm.wall_gb)
 
 @njit(parallel=True, cache=True)
 def kdk_kick_drift(ps, n, dt, prm):

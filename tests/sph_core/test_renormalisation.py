@@ -1,14 +1,12 @@
 """The shared renormalisation walk (sph_core.renormalisation.moments) against a brute-force numpy
 reference on a jittered block with a free surface, walls (one at suction pressure), an inlet
-buffer column and a splash particle; its lambda and M^-1 against numpy's linear algebra; and the
-kernel correction's L_i built from it."""
+buffer column and a splash particle; its lambda and M^-1 against numpy's linear algebra."""
 
 import numpy as np
 import pytest
 from cell_sorted import sort_into_cells
 from numba import njit
 
-from sph_core.kernel_correction import KGC_ALL, KGC_WEIGHTED, correction_matrices
 from sph_core.kernels import f_of_q, w_of_q, wendland_alpha
 from sph_core.particles import FLUID, INLET, M, N_FIELDS, OUTLET, P, RHO, VX, VZ, WALL, X, Z
 from sph_core.renormalisation import DPLUS_R, moments, smallest_eigenvalue, solve
@@ -159,29 +157,3 @@ def test_moments_match_a_brute_force_reference(suction_walls):
         np.testing.assert_allclose(out[18:20, i], np.linalg.solve(mi, [1.0, 0.0]), rtol=1e-10)
     if not suction_walls:   # the filter took the suction wall out of its neighbours' sums
         assert not np.allclose(ref["mzz"], _reference(ps, n, prm, True)["mzz"])
-
-
-@pytest.mark.parametrize("kgc", [KGC_ALL, KGC_WEIGHTED])
-def test_kernel_correction_is_the_inverse_of_the_shared_matrix(kgc):
-    """L_i (weighted: gamma_i L_i, gamma the Shepard sum with the self term, capped at 1) of
-    every fluid and buffer particle with a well-conditioned M_i, from the reference sums."""
-    ps, n, cells, prm = _particles()
-    prm = prm._replace(kgc=kgc)
-    correction_matrices(ps, n, cells, prm)
-    ref = _reference(ps, n, prm, True)
-    kind = ps.kind[:n]
-    w0 = w_of_q(0.0, prm.alpha_w)
-    gam = 1.0
-    if kgc == KGC_WEIGHTED:
-        gam = np.minimum(ps.m[:n] / ps.rho[:n] * w0 + ref["shepard"], 1.0)
-    det = ref["mxx"] * ref["mzz"] - ref["mxz"] ** 2
-    tr = ref["mxx"] + ref["mzz"]
-    ok = ((kind == FLUID) | (kind == INLET)) & (det > 0.0125 * tr * tr)
-    assert ok.sum() > 0.9 * np.count_nonzero(kind != WALL)
-    lxx = gam * ref["mzz"] / det
-    lxz = -gam * ref["mxz"] / det
-    lzz = gam * ref["mxx"] / det
-    for got, want in ((ps.lxx, lxx), (ps.lxz, lxz), (ps.lzz, lzz)):
-        np.testing.assert_allclose(got[:n][ok], want[ok], rtol=1e-11, atol=1e-11)
-    rest = ~ok
-    assert np.all(ps.lxx[:n][rest] == 1.0) and np.all(ps.lxz[:n][rest] == 0.0)
