@@ -2,8 +2,8 @@
 
 Scope today: a closed tank (no open ends, no bodies, no shifting), the kdk integrator, delta-SPH
 + Monaghan AV + Lo & Shao viscosity, Adami walls, the no-penetration correction and the
-approach-gated wall tension (``wcsph.wall_pass`` / ``fluid_pass`` without Riemann SPH or the
-kernel gradient correction). ``step.CudaStepper`` runs it; the per-particle bodies
+approach-gated wall tension (``wcsph.wall_pass`` / ``fluid_pass`` without Riemann SPH), from
+the same pair terms as the CPU step (``pairs.gather`` + ``terms.py``). ``step.CudaStepper`` runs it; the per-particle bodies
 (``bodies.py``) are plain ``@njit(inline="always")`` functions, which numba-cuda compiles for
 the GPU as device functions and the CUDA simulator (``NUMBA_ENABLE_CUDASIM=1``) calls as CPU code.
 """

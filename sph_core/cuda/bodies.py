@@ -1,13 +1,11 @@
 """Per-particle bodies of the CUDA step's kernels, one ``@njit(inline="always")`` function per pass.
 
 Each is the loop body of its CPU twin in ``sph_core/wcsph.py`` / ``neighbours.py`` for one
-particle slot ``i`` (the same equations, line for line; Riemann SPH and the kernel gradient
-correction are not carried: the GPU step refuses scenes that use them). numba compiles them
-for whichever target calls them: as device functions inside the CUDA kernels of ``kernels.py``
-and as ordinary CPU code under the CUDA simulator, where they run at compiled speed.
-
-The pair loops are here, one function per pass (``wall_particle``, ``fluid_particle``), so
-they can be replaced as a whole by the solver's shared per-pair terms (``sph_core/pairs.py``).
+particle slot ``i``; the passes' pairs are the CPU's own: ``pairs.gather`` folding the pair
+terms of ``terms.py`` (``adami_pair``, ``wcsph_pair``), so a term changed there changes on
+both devices. Riemann SPH is not carried yet (the GPU step refuses such scenes). numba
+compiles these for whichever target calls them: as device functions inside the CUDA kernels
+of ``kernels.py`` and as ordinary CPU code under the CUDA simulator (compiled speed).
 """
 
 from __future__ import annotations
@@ -17,9 +15,10 @@ import math
 from numba import njit
 
 from ..eos import density, pressure
-from ..kernels import f_of_q, w_of_q
-from ..neighbours import block_of, cell_at
-from ..particles import FLUID, INLET, OUTLET, WALL
+from ..neighbours import cell_at
+from ..pairs import fluidlike, gather, interacting
+from ..terms import (FLUID_SUMS_ZERO, WALL_SUMS_ZERO, adami_pair, fluid_consts, fluid_i,
+                     wcsph_pair)
 from ..wall_contact import approach_speed, no_penetration
 
 
@@ -34,171 +33,55 @@ def cell_of(i, ps, cells):
 
 @njit(cache=True, inline="always")
 def wall_particle(i, ps, cells, prm):
-    """``wcsph.wall_pass`` for wall slot i: Adami pressure, density and no-slip velocity."""
-    x = ps.x
-    z = ps.z
-    vx = ps.vx
-    vz = ps.vz
-    rho = ps.rho
-    p = ps.p
-    kind = ps.kind
-    cell_start = cells.start
-    ncx = cells.ncx
-    inv_h = 1.0 / prm.h
-    s2 = 4.0 * prm.h * prm.h
-    aw = prm.alpha_w
-    xi = x[i]
-    zi = z[i]
-    bx = prm.gx - ps.ax[i]
-    bz = prm.gz - ps.az[i]
-    sw = 0.0
-    sp = 0.0
-    svx = 0.0
-    svz = 0.0
-    cxl, cxh, czl, czh = block_of(ps.cell[i], cells)
-    for zz in range(czl, czh + 1):
-        row = zz * ncx
-        for j in range(cell_start[row + cxl], cell_start[row + cxh + 1]):
-            if kind[j] == FLUID or kind[j] == INLET or kind[j] == OUTLET:
-                dx = xi - x[j]
-                dz = zi - z[j]
-                r2 = dx * dx + dz * dz
-                if r2 < s2:
-                    w = w_of_q(math.sqrt(r2) * inv_h, aw)
-                    sw += w
-                    sp += (p[j] + rho[j] * (bx * dx + bz * dz)) * w
-                    svx += vx[j] * w
-                    svz += vz[j] * w
-    if sw > 0.0:
-        pi = max(sp / sw, 0.0)   # no suction (wcsph.wall_pass)
-        p[i] = pi
-        rho[i] = density(pi, prm.rho0, prm.b, prm.gamma)
-        ps.vwx[i] = 2.0 * vx[i] - svx / sw
-        ps.vwz[i] = 2.0 * vz[i] - svz / sw
+    """``wcsph.wall_pass`` for wall slot i: Adami pressure, density and no-slip velocity, from
+    the shared pair term ``terms.adami_pair``."""
+    h = prm.h
+    ctx = (1.0 / h, prm.alpha_w, prm.gx - ps.ax[i], prm.gz - ps.az[i])
+    s = gather(i, ps.x[i], ps.z[i], ps.cell[i], ps, cells, 4.0 * h * h, fluidlike, adami_pair,
+               ctx, WALL_SUMS_ZERO)
+    if s.sw > 0.0:
+        pi = max(s.sp / s.sw, 0.0)   # no suction (wcsph.wall_pass)
+        ps.p[i] = pi
+        ps.rho[i] = density(pi, prm.rho0, prm.b, prm.gamma)
+        ps.vwx[i] = 2.0 * ps.vx[i] - s.svx / s.sw
+        ps.vwz[i] = 2.0 * ps.vz[i] - s.svz / s.sw
     else:
-        p[i] = 0.0
-        rho[i] = prm.rho0
-        ps.vwx[i] = vx[i]
-        ps.vwz[i] = vz[i]
+        ps.p[i] = 0.0
+        ps.rho[i] = prm.rho0
+        ps.vwx[i] = ps.vx[i]
+        ps.vwz[i] = ps.vz[i]
+
+
+# terms.fluid_consts / fluid_i are plain (not inlined) @njit functions: their same source,
+# inlined, so every device callee is inlined (the form compile_ptx verifies without a GPU)
+_fluid_consts = njit(inline="always")(fluid_consts.py_func)
+_fluid_i = njit(inline="always")(fluid_i.py_func)
 
 
 @njit(cache=True, inline="always")
 def fluid_particle(i, ps, cells, prm):
-    """``wcsph.fluid_pass`` for fluid slot i (delta-SPH, no kernel correction): writes ax, az,
-    drho, pw and, with the no-penetration correction on, dvnx, dvnz."""
-    x = ps.x
-    z = ps.z
-    vx = ps.vx
-    vz = ps.vz
-    rho = ps.rho
-    p = ps.p
-    m = ps.m
-    vwx = ps.vwx
-    vwz = ps.vwz
-    kind = ps.kind
-    cell_start = cells.start
-    ncx = cells.ncx
-    h = prm.h
-    inv_h = 1.0 / h
-    s2 = 4.0 * h * h
-    eta2 = 0.01 * h * h
-    af = prm.alpha_f
-    rho0 = prm.rho0
-    c0 = prm.c0
-    gam = prm.gamma
-    gx = prm.gx
-    gz = prm.gz
-    g = math.sqrt(gx * gx + gz * gz)
-    gdir_z = gz / g if g > 0 else 0.0
-    gdir_x = gx / g if g > 0 else 0.0
-    av = prm.alpha * c0 * h
-    av_wall = prm.alpha_wall * av
-    nu4 = 4.0 * prm.nu
-    ddiff = 2.0 * prm.delta * h * c0
-    noslip = prm.noslip
-    ga = prm.wall_ga
-    g0 = prm.wall_g0
-    gb = prm.wall_gb
-    aw = prm.alpha_w
-    inv_rho0 = 1.0 / rho0
-    xi = x[i]
-    zi = z[i]
-    vxi = vx[i]
-    vzi = vz[i]
-    rhoi = rho[i]
-    pi = p[i]
-    inv_rhoi = 1.0 / rhoi
-    khyd = rhoi * g / (c0 * c0 * (rhoi / rho0) ** (gam - 1.0))
-    fx = 0.0
-    fz = 0.0
-    cont = 0.0
-    diff = 0.0
-    gw = 0.0
-    gnx = 0.0
-    gnz = 0.0
-    gvx = 0.0
-    gvz = 0.0
-    tx = 0.0
-    tz = 0.0
-    cxl, cxh, czl, czh = block_of(ps.cell[i], cells)
-    for zz in range(czl, czh + 1):
-        row = zz * ncx
-        for j in range(cell_start[row + cxl], cell_start[row + cxh + 1]):
-            kj = kind[j]
-            if j == i or kj < FLUID or kj > OUTLET:
-                continue
-            dx = xi - x[j]
-            dz = zi - z[j]
-            r2 = dx * dx + dz * dz
-            if r2 >= s2:
-                continue
-            fij = f_of_q(math.sqrt(r2) * inv_h, af)
-            rhoj = rho[j]
-            mj = m[j]
-            vol = mj / rhoj
-            dvx = vxi - vx[j]
-            dvz = vzi - vz[j]
-            visc = kj != WALL or noslip
-            cont -= vol * fij * (dvx * dx + dvz * dz)
-            pf = vol * (pi + p[j]) * inv_rhoi
-            up = -(gdir_x * dx + gdir_z * dz)
-            diff += (rhoj - rhoi - khyd * up) * fij * vol
-            if kj == WALL:
-                dvx = vxi - vwx[j]
-                dvz = vzi - vwz[j]
-                vg = mj * inv_rho0
-                wg = vg * w_of_q(math.sqrt(r2) * inv_h, aw)
-                gw += wg
-                gnx += vg * fij * dx
-                gnz += vg * fij * dz
-                gvx += wg * vx[j]
-                gvz += wg * vz[j]
-                if pi < 0.0:
-                    pt = -vol * pi * inv_rhoi
-                    tx += pt * fij * dx
-                    tz += pt * fij * dz
-            if visc:
-                vr = dvx * dx + dvz * dz
-                mden = mj / ((rhoi + rhoj) * (r2 + eta2))
-                if vr < 0.0:
-                    pf -= 2.0 * (av_wall if kj == WALL else av) * vr * mden
-                lam = nu4 * r2 * mden
-                fx -= lam * fij * dvx
-                fz -= lam * fij * dvz
-            fx += pf * fij * dx
-            fz += pf * fij * dz
+    """``wcsph.fluid_pass`` for fluid slot i in its delta-SPH form (the shared pair term
+    ``terms.wcsph_pair``): writes ax, az, drho, pw and, with the no-penetration correction on,
+    dvnx, dvnz."""
+    k = _fluid_consts(prm)
+    fi = _fluid_i(i, ps, k)
+    a = gather(i, fi.x, fi.z, ps.cell[i], ps, cells, k.s2, interacting, wcsph_pair, (k, fi),
+               FLUID_SUMS_ZERO)
+    fx = a.fx
+    fz = a.fz
     # the approach-gated wall tension (wcsph.fluid_pass)
-    pwi = pi
-    if pi < 0.0 and approach_speed(gw, gnx, gnz, gvx, gvz, vxi, vzi) < 0.0:
-        fx += tx
-        fz += tz
+    pwi = fi.p
+    if fi.p < 0.0 and approach_speed(a.gw, a.gnx, a.gnz, a.gvx, a.gvz, fi.vx, fi.vz) < 0.0:
+        fx += a.tx
+        fz += a.tz
         pwi = 0.0
     ps.pw[i] = pwi
-    ps.ax[i] = fx + gx
-    ps.az[i] = fz + gz
-    ps.drho[i] = rhoi * cont + ddiff * diff
-    if g0 > 0.0:
-        ps.dvnx[i], ps.dvnz[i] = no_penetration(gw, gnx, gnz, gvx, gvz, vxi, vzi, ga, g0, gb)
+    ps.ax[i] = fx + prm.gx
+    ps.az[i] = fz + prm.gz
+    ps.drho[i] = fi.rho * a.cont + k.ddiff * a.diff
+    if prm.wall_g0 > 0.0:
+        ps.dvnx[i], ps.dvnz[i] = no_penetration(a.gw, a.gnx, a.gnz, a.gvx, a.gvz, fi.vx, fi.vz,
+                                                prm.wall_ga, prm.wall_g0, prm.wall_gb)
 
 
 @njit(cache=True, inline="always")

@@ -12,7 +12,7 @@ computes the next dt on the device. The host reads two small arrays (clock and g
 ``batch`` steps to learn whether the device stopped (t_stop, max_steps or a guard).
 
 Scope: closed tanks with the kdk integrator and the delta-SPH scheme (no open ends, bodies,
-shifting, Riemann SPH, kernel gradient correction or ISPH: ``unsupported`` names what a scene
+shifting, Riemann SPH or ISPH: ``unsupported`` names what a scene
 uses that this step lacks).
 """
 
@@ -48,8 +48,6 @@ def unsupported(sim: Any) -> list[str]:
         out.append("particle shifting")
     if prm.riemann:
         out.append("Riemann SPH")
-    if prm.kgc != 0:
-        out.append("kernel gradient correction")
     if np.any(sim.particles.kind[: sim.particles.n] < 0):
         out.append("inactive (excluded) particles")
     return out
