@@ -102,6 +102,8 @@ class CudaStepper:
         self.launches = 0
         self._grid_n = (self.n + K.TPB - 1) // K.TPB
         self._grid_c = (self.ncell + 1 + K.TPB - 1) // K.TPB
+        # the launches of an even and an odd step, configured once (their arguments never change)
+        self._plan = [self._launches(0), self._launches(1)]
 
     def _to_device(self, a: np.ndarray):
         return np.array(a, copy=True) if simulated() else self._cuda.to_device(np.ascontiguousarray(a))
@@ -116,33 +118,58 @@ class CudaStepper:
             dst.copy_to_device(src)
 
     # ------------------------------------------------------------------ stepping
-    def _launch_step(self, parity: int) -> None:
+    def _launches(self, parity: int) -> list:
+        """The step's kernel launches in order, as (name, configured kernel, args)."""
         ps, ps2 = self.bufs[parity], self.bufs[1 - parity]
         n, prm, cells, clk, ctl = self.n, self.prm, self.cells, self.clk, self.ctl
-        gn, tpb = self._grid_n, K.TPB
-        K.k_kick_drift_bin[gn, tpb](ps, n, prm, cells, self.count, clk, ctl)
-        K.k_scan_blocks[self.nb, K.SCAN_B](self.count, self.start, self.bsum, self.m, ctl)
-        K.k_scan_sums[1, K.SCAN_B](self.bsum, self.nb, ctl)
-        K.k_scan_add[self.nb, K.SCAN_B](self.start, self.bsum, self.cursor, self.count, self.m, ctl)
-        K.k_scatter[gn, tpb](ps, n, self.cursor, self.order, ctl)
-        K.k_cell_order[self._grid_c, tpb](self.start, self.order, self.ncell + 1, ctl)
-        K.k_permute[gn, tpb](ps, ps2, self.order, n, ctl)
-        K.k_wall[gn, tpb](ps2, n, cells, prm, ctl)
-        K.k_fluid[gn, tpb](ps2, n, cells, prm, ctl)
-        K.k_kick[gn, tpb](ps2, n, prm, clk, ctl)
-        K.k_finish[1, 1](prm, clk, ctl)
+        gn, tpb, nb, sb = self._grid_n, K.TPB, self.nb, K.SCAN_B
+        return [
+            ("kick_drift_bin", K.k_kick_drift_bin[gn, tpb], (ps, n, prm, cells, self.count, clk, ctl)),
+            ("scan_blocks", K.k_scan_blocks[nb, sb], (self.count, self.start, self.bsum, self.m, ctl)),
+            ("scan_sums", K.k_scan_sums[1, sb], (self.bsum, nb, ctl)),
+            ("scan_add", K.k_scan_add[nb, sb], (self.start, self.bsum, self.cursor, self.count, self.m, ctl)),
+            ("scatter", K.k_scatter[gn, tpb], (ps, n, self.cursor, self.order, ctl)),
+            ("cell_order", K.k_cell_order[self._grid_c, tpb], (self.start, self.order, self.ncell + 1, ctl)),
+            ("permute", K.k_permute[gn, tpb], (ps, ps2, self.order, n, ctl)),
+            ("wall", K.k_wall[gn, tpb], (ps2, n, cells, prm, ctl)),
+            ("fluid", K.k_fluid[gn, tpb], (ps2, n, cells, prm, ctl)),
+            ("kick", K.k_kick[gn, tpb], (ps2, n, prm, clk, ctl)),
+            ("finish", K.k_finish[1, 1], (prm, clk, ctl)),
+        ]
+
+    def _launch_step(self, parity: int) -> None:
+        for _, kernel, args in self._plan[parity]:
+            kernel(*args)
         self.launches += LAUNCHES_PER_STEP
+
+    def kernel_times(self, steps: int = 5) -> dict[str, float]:
+        """Milliseconds per kernel (CUDA events around each launch), mean over ``steps`` real
+        steps taken from the current state; a profile, not a throughput figure."""
+        cuda = self._cuda
+        # the simulator's events take no timing flag (and time nothing of the device)
+        event = cuda.event if simulated() else (lambda: cuda.event(timing=True))
+        self._begin(math.inf, steps)
+        total: dict[str, float] = {}
+        for s in range(steps):
+            marks = [event()]
+            marks[0].record()
+            names = []
+            for name, kernel, args in self._plan[(self.cur + s) % 2]:
+                kernel(*args)
+                e = event()
+                e.record()
+                marks.append(e)
+                names.append(name)
+            marks[-1].synchronize()
+            for k, name in enumerate(names):
+                total[name] = total.get(name, 0.0) + marks[k].elapsed_time(marks[k + 1])
+        self._end()
+        return {k: round(v / steps, 4) for k, v in total.items()}
 
     def run(self, t_stop: float, max_steps: int) -> tuple[float, float, int, int, int, float]:
         """Steps until t_stop or max_steps or a guard trips (as ``step.run``); returns
         (t, dt_next, steps, status, n_flagged, v_max). The state stays on the device."""
-        clk = np.zeros(K.N_CLK)
-        clk[K.T], clk[K.DT], clk[K.T_STOP] = self.t, self.dt, t_stop
-        ctl = np.zeros(K.N_CTL, dtype=np.int64)
-        ctl[K.MAX_STEPS] = max_steps
-        self._put(self.clk, clk)
-        self._put(self.ctl, ctl)
-        K.k_begin[1, 1](self.clk, self.ctl)
+        self._begin(t_stop, max_steps)
         launched = 0
         while launched < max_steps:
             k = min(self.batch, max_steps - launched)
@@ -151,6 +178,19 @@ class CudaStepper:
             launched += k
             if self._to_host(self.ctl)[K.STOP] != 0:
                 break
+        return self._end()
+
+    def _begin(self, t_stop: float, max_steps: int) -> None:
+        clk = np.zeros(K.N_CLK)
+        clk[K.T], clk[K.DT], clk[K.T_STOP] = self.t, self.dt, t_stop
+        ctl = np.zeros(K.N_CTL, dtype=np.int64)
+        ctl[K.MAX_STEPS] = max_steps
+        self._put(self.clk, clk)
+        self._put(self.ctl, ctl)
+        K.k_begin[1, 1](self.clk, self.ctl)
+
+    def _end(self) -> tuple[float, float, int, int, int, float]:
+        """Read the device's clock and guards after a run call; the host follows its steps."""
         clk = self._to_host(self.clk)
         ctl = self._to_host(self.ctl)
         done = int(ctl[K.STEPS])
