@@ -49,14 +49,14 @@ print("cuda:", sc.unavailable_reason() or "available")
 PYEOF
 
 say "pytest -m cuda (real GPU unless NUMBA_ENABLE_CUDASIM=1)"
-NUMBA_NUM_THREADS=$HT timeout "$(left 170)" $PY -m pytest -m cuda tests/sph_core/test_cuda_*.py -q -p no:cacheprovider \
+NUMBA_NUM_THREADS=$HT timeout "$(left 170)" $PY -m pytest -m cuda tests/sph_core/test_cuda_*.py -q -rP -p no:cacheprovider \
     2>&1 | tee -a "$LOG"
 say "pytest exit ${PIPESTATUS[0]}"
 
 if [ -n "$GPU_DPS" ]; then
     say "GPU throughput, dp = $GPU_DPS"
     NUMBA_NUM_THREADS=$HT timeout "$(left 150)" $PY bench/gpu_throughput.py --device cuda \
-        --dps $GPU_DPS --budget 5 --out "$JSONL" 2>&1 | tee -a "$LOG"
+        --dps $GPU_DPS --budget 4 --out "$JSONL" 2>&1 | tee -a "$LOG"
     say "GPU bench exit ${PIPESTATUS[0]}"
 fi
 

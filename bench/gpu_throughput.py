@@ -37,7 +37,8 @@ def _steps_for(n: int, budget: float, guess: float) -> int:
     return int(min(5000, max(20, budget * guess / n)))
 
 
-def run_cuda(dp: float, budget: float) -> dict:
+def run_cuda(dp: float, budget: float, modes: list[bool]) -> list[dict]:
+    """One Simulation and CudaStepper per size, timed with plain launches and/or graphs."""
     import numba
 
     from sph_core.cuda.step import LAUNCHES_PER_STEP, CudaStepper
@@ -52,28 +53,40 @@ def run_cuda(dp: float, budget: float) -> dict:
     st.synchronize()
     t_warm = time.perf_counter() - t0
     n = sim.n_particles
-    # a short timed run, then one sized to the budget from its rate
-    t0 = time.perf_counter()
-    st.advance_steps(20)
-    st.synchronize()
-    rate = n * 20 / (time.perf_counter() - t0)
-    steps = _steps_for(n, budget, rate)
-    ts, s0 = st.t, st.steps
-    t0 = time.perf_counter()
-    st.advance_steps(steps)
-    st.synchronize()
-    wall = time.perf_counter() - t0
-    done = st.steps - s0
     kt = st.kernel_times(5)
-    return {"bench": "gpu_throughput", "case": "dambreak_2d_1x2m_tank4m", "device": _gpu_name(),
-            "dp": dp, "particles": n, "fluid_particles": sim.n_fluid, "steps": done,
-            "wall_s": round(wall, 4), "particle_steps_per_s": round(n * done / wall),
+    out = []
+    for graphs in modes:
+        if graphs and not st.enable_graphs():
+            out.append({"bench": "gpu_throughput", "dp": dp, "graphs": True,
+                        "error": st.graph_error})
+            continue
+        # a short timed run, then one sized to the budget from its rate
+        t0 = time.perf_counter()
+        st.advance_steps(20)
+        st.synchronize()
+        rate = n * 20 / (time.perf_counter() - t0)
+        steps = _steps_for(n, budget, rate)
+        ts, s0 = st.t, st.steps
+        t0 = time.perf_counter()
+        st.advance_steps(steps)
+        st.synchronize()
+        wall = time.perf_counter() - t0
+        done = st.steps - s0
+        out.append({
+            "bench": "gpu_throughput", "case": "dambreak_2d_1x2m_tank4m", "device": _gpu_name(),
+            "graphs": graphs, "batch": st.batch, "dp": dp, "particles": n,
+            "fluid_particles": sim.n_fluid, "steps": done, "wall_s": round(wall, 4),
+            "particle_steps_per_s": round(n * done / wall),
             "wall_s_per_sim_s": round(wall / (st.t - ts), 3) if st.t > ts else None,
-            "ms_per_step": round(1e3 * wall / done, 4), "launches_per_step": LAUNCHES_PER_STEP,
+            "ms_per_step": round(1e3 * wall / done, 4),
+            # host calls per step: the kernels' launches, or one graph replay per two steps
+            "launches_per_step": 0.5 if graphs else LAUNCHES_PER_STEP,
+            "kernels_per_step": LAUNCHES_PER_STEP,
             "kernel_ms": kt, "kernel_ms_sum": round(sum(kt.values()), 4),
             "build_s": round(t_build, 2), "compile_and_warm_s": round(t_warm, 2),
             "simulated_t_s": round(st.t, 5), "dt_s": st.dt, "numba": numba.__version__,
-            "host_threads": numba.get_num_threads()}
+            "host_threads": numba.get_num_threads()})
+    return out
 
 
 def run_cpu(dp: float, budget: float) -> dict:
@@ -119,16 +132,20 @@ def main() -> None:
     ap.add_argument("--device", choices=["cuda", "cpu"], default="cuda")
     ap.add_argument("--dps", type=float, nargs="+", default=[0.01, 0.0025, 0.00125])
     ap.add_argument("--budget", type=float, default=8.0, help="seconds of timed stepping per size")
+    ap.add_argument("--graphs", choices=["off", "on", "both"], default="both",
+                    help="cuda: replay two-step CUDA graphs (on), plain launches (off) or both")
     ap.add_argument("--out", type=Path, default=None, help="append the JSON lines here too")
     args = ap.parse_args()
+    modes = {"off": [False], "on": [True], "both": [False, True]}[args.graphs]
     for dp in args.dps:
         print(f"# {args.device} dp={dp} ...", file=sys.stderr, flush=True)
-        res = run_cuda(dp, args.budget) if args.device == "cuda" else run_cpu(dp, args.budget)
-        line = json.dumps(res)
-        print(line, flush=True)
-        if args.out:
-            with open(args.out, "a") as fh:
-                fh.write(line + "\n")
+        for res in (run_cuda(dp, args.budget, modes) if args.device == "cuda"
+                    else [run_cpu(dp, args.budget)]):
+            line = json.dumps(res)
+            print(line, flush=True)
+            if args.out:
+                with open(args.out, "a") as fh:
+                    fh.write(line + "\n")
 
 
 if __name__ == "__main__":

@@ -10,6 +10,8 @@ One step is 11 kernel launches, all queued without a host wait (``kernels.py``):
 wall pass, fluid pass, kick with the guards and reductions, and a one-thread kernel that
 computes the next dt on the device. The host reads two small arrays (clock and guards) every
 ``batch`` steps to learn whether the device stopped (t_stop, max_steps or a guard).
+``enable_graphs()`` captures two steps into a CUDA graph, replayed with one host call per pair
+of steps (the kernels' launch cost in Python is what bounds small cases).
 
 Scope: closed tanks with the kdk integrator and the delta-SPH scheme (no open ends, bodies,
 shifting, Riemann SPH or ISPH: ``unsupported`` names what a scene
@@ -104,6 +106,8 @@ class CudaStepper:
         self._grid_c = (self.ncell + 1 + K.TPB - 1) // K.TPB
         # the launches of an even and an odd step, configured once (their arguments never change)
         self._plan = [self._launches(0), self._launches(1)]
+        self._graph = None                 # (enable_graphs) two-step CUDA graphs, if captured
+        self.graph_error: str | None = None
 
     def _to_device(self, a: np.ndarray):
         return np.array(a, copy=True) if simulated() else self._cuda.to_device(np.ascontiguousarray(a))
@@ -118,24 +122,74 @@ class CudaStepper:
             dst.copy_to_device(src)
 
     # ------------------------------------------------------------------ stepping
-    def _launches(self, parity: int) -> list:
+    def _launches(self, parity: int, stream: Any = 0) -> list:
         """The step's kernel launches in order, as (name, configured kernel, args)."""
         ps, ps2 = self.bufs[parity], self.bufs[1 - parity]
         n, prm, cells, clk, ctl = self.n, self.prm, self.cells, self.clk, self.ctl
-        gn, tpb, nb, sb = self._grid_n, K.TPB, self.nb, K.SCAN_B
+        gn, tpb, nb, sb, gc = self._grid_n, K.TPB, self.nb, K.SCAN_B, self._grid_c
         return [
-            ("kick_drift_bin", K.k_kick_drift_bin[gn, tpb], (ps, n, prm, cells, self.count, clk, ctl)),
-            ("scan_blocks", K.k_scan_blocks[nb, sb], (self.count, self.start, self.bsum, self.m, ctl)),
-            ("scan_sums", K.k_scan_sums[1, sb], (self.bsum, nb, ctl)),
-            ("scan_add", K.k_scan_add[nb, sb], (self.start, self.bsum, self.cursor, self.count, self.m, ctl)),
-            ("scatter", K.k_scatter[gn, tpb], (ps, n, self.cursor, self.order, ctl)),
-            ("cell_order", K.k_cell_order[self._grid_c, tpb], (self.start, self.order, self.ncell + 1, ctl)),
-            ("permute", K.k_permute[gn, tpb], (ps, ps2, self.order, n, ctl)),
-            ("wall", K.k_wall[gn, tpb], (ps2, n, cells, prm, ctl)),
-            ("fluid", K.k_fluid[gn, tpb], (ps2, n, cells, prm, ctl)),
-            ("kick", K.k_kick[gn, tpb], (ps2, n, prm, clk, ctl)),
-            ("finish", K.k_finish[1, 1], (prm, clk, ctl)),
+            ("kick_drift_bin", K.k_kick_drift_bin[gn, tpb, stream], (ps, n, prm, cells, self.count, clk, ctl)),
+            ("scan_blocks", K.k_scan_blocks[nb, sb, stream], (self.count, self.start, self.bsum, self.m, ctl)),
+            ("scan_sums", K.k_scan_sums[1, sb, stream], (self.bsum, nb, ctl)),
+            ("scan_add", K.k_scan_add[nb, sb, stream], (self.start, self.bsum, self.cursor, self.count, self.m, ctl)),
+            ("scatter", K.k_scatter[gn, tpb, stream], (ps, n, self.cursor, self.order, ctl)),
+            ("cell_order", K.k_cell_order[gc, tpb, stream], (self.start, self.order, self.ncell + 1, ctl)),
+            ("permute", K.k_permute[gn, tpb, stream], (ps, ps2, self.order, n, ctl)),
+            ("wall", K.k_wall[gn, tpb, stream], (ps2, n, cells, prm, ctl)),
+            ("fluid", K.k_fluid[gn, tpb, stream], (ps2, n, cells, prm, ctl)),
+            ("kick", K.k_kick[gn, tpb, stream], (ps2, n, prm, clk, ctl)),
+            ("finish", K.k_finish[1, 1, stream], (prm, clk, ctl)),
         ]
+
+    def enable_graphs(self) -> bool:
+        """Capture two steps (even + odd buffer parity, 22 launches) into a CUDA graph per
+        starting parity, so ``run`` replays a pair of steps with one host call instead of 22
+        launches. Call after the kernels have been compiled (a step taken). Returns False, with
+        the reason in ``graph_error``, where it fails (and under the simulator); the plain
+        launches then stay in use."""
+        if simulated():
+            self.graph_error = "the simulator has no CUDA graphs"
+            return False
+        try:
+            from cuda.bindings import driver as cu
+        except ImportError as exc:
+            self.graph_error = f"cuda.bindings: {exc}"
+            return False
+
+        def check(res):
+            res = res if isinstance(res, tuple) else (res,)
+            if res[0] != cu.CUresult.CUDA_SUCCESS:
+                raise RuntimeError(f"CUDA graph call failed: {res[0]}")
+            return res[1] if len(res) > 1 else None
+
+        stream = self._cuda.stream()
+        h = int(stream.handle)
+        execs = []
+        try:
+            for p in (0, 1):
+                plan = self._launches(p, stream) + self._launches(1 - p, stream)
+                check(cu.cuStreamBeginCapture(
+                    h, cu.CUstreamCaptureMode.CU_STREAM_CAPTURE_MODE_RELAXED))
+                try:
+                    for _, kernel, args in plan:
+                        kernel(*args)
+                finally:
+                    graph = check(cu.cuStreamEndCapture(h))
+                execs.append(check(cu.cuGraphInstantiate(graph, 0)))
+        except Exception as exc:   # a driver or binding that cannot: keep the plain launches
+            self.graph_error = repr(exc)
+            return False
+        self._graph = (cu, stream, h, execs, check)
+        self.graph_error = None
+        return True
+
+    def _launch_pairs(self, parity: int, pairs: int) -> None:
+        """Replay the two-step graph starting at ``parity`` ``pairs`` times."""
+        cu, stream, h, execs, check = self._graph
+        g = execs[parity]
+        for _ in range(pairs):
+            check(cu.cuGraphLaunch(g, h))
+        self.launches += 2 * pairs
 
     def _launch_step(self, parity: int) -> None:
         for _, kernel, args in self._plan[parity]:
@@ -173,7 +227,11 @@ class CudaStepper:
         launched = 0
         while launched < max_steps:
             k = min(self.batch, max_steps - launched)
-            for s in range(k):
+            s = 0
+            if self._graph is not None and k >= 2:
+                self._launch_pairs((self.cur + launched) % 2, k // 2)
+                s = 2 * (k // 2)
+            for s in range(s, k):
                 self._launch_step((self.cur + launched + s) % 2)
             launched += k
             if self._to_host(self.ctl)[K.STOP] != 0:
@@ -213,6 +271,8 @@ class CudaStepper:
     def synchronize(self) -> None:
         if not simulated():
             self._cuda.synchronize()
+            if self._graph is not None:
+                self._graph[1].synchronize()
 
     def to_host(self) -> None:
         """Copy the device state into the Simulation: particles (live and twin), cell lists,
