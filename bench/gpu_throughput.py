@@ -41,7 +41,7 @@ def run_cuda(dp: float, budget: float, modes: list[bool]) -> list[dict]:
     """One Simulation and CudaStepper per size, timed with plain launches and/or graphs."""
     import numba
 
-    from sph_core.cuda.step import LAUNCHES_PER_STEP, CudaStepper
+    from sph_core.cuda.stepper import LAUNCHES_PER_STEP, CudaStepper
     from sph_core.simulation import Simulation
 
     t0 = time.perf_counter()
@@ -109,7 +109,7 @@ def run_cpu(dp: float, budget: float) -> dict:
     wall = time.perf_counter() - t0
     done = sim.steps - s0
     return {"bench": "gpu_throughput", "case": "dambreak_2d_1x2m_tank4m",
-            "device": f"cpu {platform.processor() or platform.machine()} x{numba.get_num_threads()}",
+            "device": f"cpu {platform.machine()} x{numba.get_num_threads()}",
             "threads": numba.get_num_threads(), "threading_layer": numba.threading_layer(),
             "dp": dp, "particles": n, "fluid_particles": sim.n_fluid, "steps": done,
             "wall_s": round(wall, 4), "particle_steps_per_s": round(n * done / wall),

@@ -3,9 +3,10 @@
 Scope today: a closed tank (no open ends, no bodies, no shifting), the kdk integrator, delta-SPH
 + Monaghan AV + Lo & Shao viscosity, Adami walls, the no-penetration correction and the
 approach-gated wall tension (``wcsph.wall_pass`` / ``fluid_pass`` without Riemann SPH), from
-the same pair terms as the CPU step (``pairs.gather`` + ``terms.py``). ``step.CudaStepper`` runs it; the per-particle bodies
-(``bodies.py``) are plain ``@njit(inline="always")`` functions, which numba-cuda compiles for
-the GPU as device functions and the CUDA simulator (``NUMBA_ENABLE_CUDASIM=1``) calls as CPU code.
+the same pair terms as the CPU step (``pairs.gather`` + ``terms.py``). ``stepper.CudaStepper``
+runs it; the per-particle bodies (``per_particle.py``) are plain ``@njit(inline="always")``
+functions, which numba-cuda compiles for the GPU as device functions and the CUDA simulator
+(``NUMBA_ENABLE_CUDASIM=1``) calls as CPU code.
 """
 
 from __future__ import annotations

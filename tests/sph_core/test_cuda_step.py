@@ -62,12 +62,12 @@ def sim_factory():
 
 
 def _stepper(sim):
-    from sph_core.cuda.step import CudaStepper
+    from sph_core.cuda.stepper import CudaStepper
     return CudaStepper(sim)
 
 
 def _set_clock(st, dts=0.0):
-    from sph_core.cuda import kernels as K
+    from sph_core.cuda import gpu_kernels as K
     clk = np.zeros(K.N_CLK)
     clk[K.DTS] = dts
     clk[K.T_STOP] = np.inf
@@ -88,7 +88,7 @@ def _close(gpu, cpu, rel=1e-12):
 
 def test_kick_drift_and_cell_sort_match_cpu(sim_factory):
     from sph_core import wcsph
-    from sph_core.cuda import kernels as K
+    from sph_core.cuda import gpu_kernels as K
     from sph_core.neighbours import sort_by_cell
     from sph_core.particles import N_SORTED_KDK
 
@@ -126,7 +126,7 @@ def test_kick_drift_and_cell_sort_match_cpu(sim_factory):
 
 def test_wall_and_fluid_pass_match_cpu(sim_factory):
     from sph_core import wcsph
-    from sph_core.cuda import kernels as K
+    from sph_core.cuda import gpu_kernels as K
     from sph_core.particles import AX, AZ, DRHO, DVNX, DVNZ, FLUID, P, PW, RHO, VWX, VWZ, WALL
 
     cpu = sim_factory()
@@ -151,7 +151,7 @@ def test_wall_and_fluid_pass_match_cpu(sim_factory):
 
 def test_kick_and_next_dt_match_cpu(sim_factory):
     from sph_core import wcsph
-    from sph_core.cuda import kernels as K
+    from sph_core.cuda import gpu_kernels as K
     from sph_core.particles import RHO, VX, VZ
 
     cpu = sim_factory()
@@ -242,7 +242,7 @@ def test_unsupported_scene_is_refused():
     from sph_core.cuda import unavailable_reason
     if unavailable_reason():
         pytest.skip(unavailable_reason())
-    from sph_core.cuda.step import CudaStepper
+    from sph_core.cuda.stepper import CudaStepper
     from sph_core.simulation import Simulation
 
     sim = Simulation(_dambreak(integrator="symplectic_pc"))

@@ -24,7 +24,7 @@ from ..particles import FLUID, N_SORTED_KDK, WALL
 from ..state import particles_view
 from ..wcsph import ST_DENSITY, ST_LEFT_DOMAIN, ST_NONFINITE, ST_REACHED_T, ST_STEP_LIMIT, stable_dt
 from . import simulated
-from .bodies import cell_of, fluid_particle, kick_drift_particle, kick_particle, wall_particle
+from .per_particle import cell_of, fluid_particle, kick_drift_particle, kick_particle, wall_particle
 
 T, DT, DTS, T_STOP, V2, A2, RMAX, V2LAST = range(8)
 N_CLK = 8

@@ -5,7 +5,7 @@ particle slot ``i``; the passes' pairs are the CPU's own: ``pairs.gather`` foldi
 terms of ``terms.py`` (``adami_pair``, ``wcsph_pair``), so a term changed there changes on
 both devices. Riemann SPH is not carried yet (the GPU step refuses such scenes). numba
 compiles these for whichever target calls them: as device functions inside the CUDA kernels
-of ``kernels.py`` and as ordinary CPU code under the CUDA simulator (compiled speed).
+of ``gpu_kernels.py`` and as ordinary CPU code under the CUDA simulator (compiled speed).
 """
 
 from __future__ import annotations

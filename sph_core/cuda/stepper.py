@@ -5,7 +5,7 @@ stepped there, and copied back on request.
     stepper.advance_steps(100)            # or stepper.advance_to(t_end)
     stepper.to_host()                     # particles, cells and clock back into ``sim``
 
-One step is 11 kernel launches, all queued without a host wait (``kernels.py``): kick + drift
+One step is 11 kernel launches, all queued without a host wait (``gpu_kernels.py``): kick + drift
 + binning, the cell count's prefix sum (3), scatter, per-cell ordering, permute into the twin,
 wall pass, fluid pass, kick with the guards and reductions, and a one-thread kernel that
 computes the next dt on the device. The host reads two small arrays (clock and guards) every
@@ -28,7 +28,7 @@ import numpy as np
 from ..particles import N_FIELDS
 from ..state import Cells
 from ..wcsph import INTEGRATORS, KDK
-from . import kernels as K
+from . import gpu_kernels as K
 from . import simulated, unavailable_reason
 
 LAUNCHES_PER_STEP = 11
@@ -81,7 +81,7 @@ class CudaStepper:
         dev = self._to_device
         # the simulator's kernels take numpy arrays (numba-compiled bodies cannot index its
         # array wrappers); on a GPU these are device arrays
-        # (f, kind, ids, cell) of each buffer: kernels.py says why not state.Particles
+        # (f, kind, ids, cell) of each buffer: gpu_kernels.py says why not state.Particles
         self.bufs = [(dev(ps.f), dev(ps.kind), dev(ps.ids), dev(ps.cell)),
                      (dev(ps.f2), dev(ps.kind2), dev(ps.ids2), dev(ps.cell2))]
         self.cur = 0                       # which buffer holds the state
@@ -110,7 +110,9 @@ class CudaStepper:
         self.graph_error: str | None = None
 
     def _to_device(self, a: np.ndarray):
-        return np.array(a, copy=True) if simulated() else self._cuda.to_device(np.ascontiguousarray(a))
+        if simulated():
+            return np.array(a, copy=True)
+        return self._cuda.to_device(np.ascontiguousarray(a))
 
     def _to_host(self, a) -> np.ndarray:
         return np.array(a, copy=True) if simulated() else a.copy_to_host()
@@ -127,14 +129,17 @@ class CudaStepper:
         ps, ps2 = self.bufs[parity], self.bufs[1 - parity]
         n, prm, cells, clk, ctl = self.n, self.prm, self.cells, self.clk, self.ctl
         gn, tpb, nb, sb, gc = self._grid_n, K.TPB, self.nb, K.SCAN_B, self._grid_c
+        count, start, bsum = self.count, self.start, self.bsum
+        cursor, order = self.cursor, self.order
         return [
-            ("kick_drift_bin", K.k_kick_drift_bin[gn, tpb, stream], (ps, n, prm, cells, self.count, clk, ctl)),
-            ("scan_blocks", K.k_scan_blocks[nb, sb, stream], (self.count, self.start, self.bsum, self.m, ctl)),
-            ("scan_sums", K.k_scan_sums[1, sb, stream], (self.bsum, nb, ctl)),
-            ("scan_add", K.k_scan_add[nb, sb, stream], (self.start, self.bsum, self.cursor, self.count, self.m, ctl)),
-            ("scatter", K.k_scatter[gn, tpb, stream], (ps, n, self.cursor, self.order, ctl)),
-            ("cell_order", K.k_cell_order[gc, tpb, stream], (self.start, self.order, self.ncell + 1, ctl)),
-            ("permute", K.k_permute[gn, tpb, stream], (ps, ps2, self.order, n, ctl)),
+            ("kick_drift_bin", K.k_kick_drift_bin[gn, tpb, stream],
+             (ps, n, prm, cells, count, clk, ctl)),
+            ("scan_blocks", K.k_scan_blocks[nb, sb, stream], (count, start, bsum, self.m, ctl)),
+            ("scan_sums", K.k_scan_sums[1, sb, stream], (bsum, nb, ctl)),
+            ("scan_add", K.k_scan_add[nb, sb, stream], (start, bsum, cursor, count, self.m, ctl)),
+            ("scatter", K.k_scatter[gn, tpb, stream], (ps, n, cursor, order, ctl)),
+            ("cell_order", K.k_cell_order[gc, tpb, stream], (start, order, self.ncell + 1, ctl)),
+            ("permute", K.k_permute[gn, tpb, stream], (ps, ps2, order, n, ctl)),
             ("wall", K.k_wall[gn, tpb, stream], (ps2, n, cells, prm, ctl)),
             ("fluid", K.k_fluid[gn, tpb, stream], (ps2, n, cells, prm, ctl)),
             ("kick", K.k_kick[gn, tpb, stream], (ps2, n, prm, clk, ctl)),
