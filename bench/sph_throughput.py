@@ -67,7 +67,7 @@ def time_components(sim, repeats: int) -> dict:
     # the twin receives the copy and the live state stays as it is
     t_sort = clock(lambda: sort_by_cell(ps.view, ps.view2, N_SORTED_KDK, ps.n, cells))
     t_wall = clock(lambda: wcsph.wall_pass(ps.view, ps.n, cells, prm))
-    t_fluid = clock(lambda: wcsph.fluid_pass(ps.view, ps.n, cells, prm))
+    t_fluid = clock(lambda: wcsph.fluid_pass(ps.view, ps.n, cells, prm, None))
     t_kick = clock(lambda: wcsph.kdk_kick(ps.view, ps.n, 0.0, prm))
     return {"sort": t_sort, "wall": t_wall, "fluid": t_fluid, "kick": t_kick}
 

@@ -204,8 +204,8 @@ def zero_gravity(sim) -> None:
     fl = ps.mask(FLUID)
     ps.field(RHO)[fl] = sim.prm.rho0
     ps.field(P)[fl] = 0.0
-    dt, n = step.initialise(ps.view, ps.view2, sim.cells, sim.prm, sim.open.ends,
-                            sim.bodies.state, ps.n)
+    ends, bd, _, riemann, _ = sim._step_parts()
+    dt, n = step.initialise(ps.view, ps.view2, sim.cells, sim.prm, ends, bd, riemann, ps.n)
     ps.swap()
     ps.n = int(n)
     sim.dt = float(dt)

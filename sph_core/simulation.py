@@ -156,7 +156,6 @@ class Simulation:
                                      (0.0, 0.0, 0.0) if self.isph
                                      else face_shares(h, dp, layout.n_layers, aw))),
                           **scheme_params(scene.scheme))
-        self.integrator = wcsph.INTEGRATORS[c.integrator]
         self.passes_per_step = wcsph.PASSES_PER_STEP[c.integrator]
         self._counts = np.zeros(ps.capacity, dtype=np.int64)
         self.stepper: IsphStepper | None = None
@@ -172,8 +171,9 @@ class Simulation:
             dt, n_new = self.stepper.initialise(ps.view, ps.view2, self.cells, ps.n,
                                                 self.open.ends, self.bodies.state)
         else:
-            dt, n_new = step.initialise(ps.view, ps.view2, self.cells, self.prm, self.open.ends,
-                                       self.bodies.state, ps.n)
+            ends, bd, _, riemann, _ = self._step_parts()
+            dt, n_new = step.initialise(ps.view, ps.view2, self.cells, self.prm, ends, bd,
+                                        riemann, ps.n)
         self.dt = float(dt)
         ps.swap()
         ps.n = int(n_new)
@@ -437,8 +437,8 @@ class Simulation:
                 t_stop, max_steps)
         else:
             t, dt, steps, status, swapped, n_flag, vmax, n = step.run(
-                ps.view, ps.view2, self.cells, self.prm, ends, self.bodies.state, self.integrator,
-                ps.n, self.t, self.dt, t_stop, max_steps)
+                ps.view, ps.view2, self.cells, self.prm, *self._step_parts(), ps.n, self.t,
+                self.dt, t_stop, max_steps)
         self.wall_time += time.perf_counter() - tic
         if swapped:
             ps.swap()
@@ -456,6 +456,11 @@ class Simulation:
             raise UnstableError(self.steps, self.t, cause)
         if status not in (wcsph.ST_REACHED_T, wcsph.ST_STEP_LIMIT):
             self._stopped(status, n_flag)
+
+    def _step_parts(self) -> tuple:
+        """The optional parts of the jitted step, None where this scene has none (step.py)."""
+        return step.step_parts(self.open.ends, self.bodies.state, self.scene.constants.integrator,
+                               self.scene.scheme.kind == "riemann", self.prm.shift_a > 0.0)
 
     # ---------------------------------------------------------------- open ends
     def boundary_gauges(self) -> dict[str, float | None]:

@@ -59,9 +59,6 @@ STATUS_TEXT = {
     ST_CAPACITY: "particle capacity exhausted by open-boundary inflow",
 }
 
-INTEGRATORS = {"kdk": 0, "symplectic_pc": 1}
-KDK = 0
-SYMPLECTIC_PC = 1
 
 # fast-math for the interaction passes, without the no-NaN/no-inf assumptions: the stability
 # guard must still see a NaN produced there
@@ -101,10 +98,11 @@ def wall_pass(ps, n, cells, prm):
 
 
 @njit(parallel=True, cache=True, fastmath=FASTMATH)
-def fluid_pass(ps, n, cells, prm):
+def fluid_pass(ps, n, cells, prm, riemann):
     """The gather over fluid particles: continuity, delta-SPH, pressure, viscosity, gravity
-    (terms.wcsph_pair), or with ``prm.riemann`` the Riemann SPH flux (terms.riemann_pair; MUSCL
-    gradients from riemann_gradients). Writes ax, az, drho, pw and the no-penetration velocity
+    (terms.wcsph_pair), or with ``riemann`` True (not None) the Riemann SPH flux
+    (terms.riemann_pair; MUSCL gradients from riemann_gradients). A None ``riemann`` compiles
+    the WCSPH pair alone (step.py). Writes ax, az, drho, pw and the no-penetration velocity
     change dvnx, dvnz (wall_contact.py) of each fluid particle; returns nothing (reductions are
     in the kicks)."""
     # only the rows written need locals (numba drops prange stores made through ps.row[i])
@@ -115,7 +113,6 @@ def fluid_pass(ps, n, cells, prm):
     dvnz = ps.dvnz
     pw = ps.pw
     kind = ps.kind
-    rs = prm.riemann
     # no penetration at wall faces (wall_contact.py): g0 = 0 turns it off
     nopen = prm.wall_g0 > 0.0
     for i in prange(n):
@@ -124,11 +121,11 @@ def fluid_pass(ps, n, cells, prm):
             # lowering, and it costs a few flops against ~30 pairs)
             k = fluid_consts(prm)
             fi = fluid_i(i, ps, k)
-            if rs:
-                a = gather(i, fi.x, fi.z, ps.cell[i], ps, cells, k.s2, interacting, riemann_pair,
+            if riemann is None:
+                a = gather(i, fi.x, fi.z, ps.cell[i], ps, cells, k.s2, interacting, wcsph_pair,
                            (k, fi), FLUID_SUMS_ZERO)
             else:
-                a = gather(i, fi.x, fi.z, ps.cell[i], ps, cells, k.s2, interacting, wcsph_pair,
+                a = gather(i, fi.x, fi.z, ps.cell[i], ps, cells, k.s2, interacting, riemann_pair,
                            (k, fi), FLUID_SUMS_ZERO)
             fx = a.fx
             fz = a.fz
@@ -138,8 +135,9 @@ def fluid_pass(ps, n, cells, prm):
             # on its beach (docs/wall_pressure.md). The Riemann flux has no such pair term
             # (tx = 0): its walls always feel max(p_i, 0)
             pwi = fi.p
-            if fi.p < 0.0 and (rs or approach_speed(a.gw, a.gnx, a.gnz, a.gvx, a.gvz, fi.vx,
-                                                    fi.vz) < 0.0):
+            if fi.p < 0.0 and (riemann is not None
+                               or approach_speed(a.gw, a.gnx, a.gnz, a.gvx, a.gvz, fi.vx,
+                                                 fi.vz) < 0.0):
                 fx += a.tx
                 fz += a.tz
                 pwi = 0.0
@@ -151,6 +149,25 @@ def fluid_pass(ps, n, cells, prm):
                 dvnx[i], dvnz[i] = no_penetration(a.gw, a.gnx, a.gnz, a.gvx, a.gvz, fi.vx, fi.vz,
                                                   prm.wall_ga, prm.wall_g0, prm.wall_gb)
 
+# The integrator passes read rows through ``ps.row[i]`` and write through locals: numba drops
+# prange stores made through ``ps.row[i] = ...``.
+
+@njit(cache=True, inline="always")
+def _outside(xi, zi, prm):
+    """1 if (xi, zi) is outside the box a fluid particle must stay in, else 0."""
+    return 0 if (xi >= prm.fx0 and xi <= prm.fx1 and zi >= prm.fz0 and zi <= prm.fz1) else 1
+
+
+@njit(cache=True, inline="always")
+def _guard(u, w, r, axi, azi, lo, hi):
+    """(non-finite, outside the density band, |v|^2, |a|^2) of a particle after its update."""
+    v2 = u * u + w * w
+    a2 = axi * axi + azi * azi
+    if not (np.isfinite(v2) and np.isfinite(r) and np.isfinite(a2)):
+        return 1, 0, v2, a2
+    return 0, 1 if (r < lo or r > hi) else 0, v2, a2
+
+
 @njit(parallel=True, cache=True)
 def kdk_kick_drift(ps, n, dt, prm):
     """First half-kick and drift of the leapfrog; returns the number of fluid particles outside the tank."""
@@ -158,34 +175,23 @@ def kdk_kick_drift(ps, n, dt, prm):
     z = ps.z
     vx = ps.vx
     vz = ps.vz
-    ax = ps.ax
-    az = ps.az
     rho = ps.rho
     p = ps.p
-    drho = ps.drho
     kind = ps.kind
-    rho0 = prm.rho0
-    b = prm.b
-    gam = prm.gamma
-    fx0 = prm.fx0
-    fx1 = prm.fx1
-    fz0 = prm.fz0
-    fz1 = prm.fz1
     hdt = 0.5 * dt
     n_out = 0
     for i in prange(n):
         if kind[i] == FLUID:
-            vx[i] += hdt * ax[i]
-            vz[i] += hdt * az[i]
-            r = rho[i] + hdt * drho[i]
+            vx[i] += hdt * ps.ax[i]
+            vz[i] += hdt * ps.az[i]
+            r = rho[i] + hdt * ps.drho[i]
             rho[i] = r
-            p[i] = pressure(r + hdt * drho[i], rho0, b, gam)
+            p[i] = pressure(r + hdt * ps.drho[i], prm.rho0, prm.b, prm.gamma)
             xi = x[i] + dt * vx[i]
             zi = z[i] + dt * vz[i]
             x[i] = xi
             z[i] = zi
-            if not (xi >= fx0 and xi <= fx1 and zi >= fz0 and zi <= fz1):
-                n_out += 1
+            n_out += _outside(xi, zi, prm)
     return n_out
 
 
@@ -194,37 +200,28 @@ def kdk_kick(ps, n, dt, prm):
     """Second half-kick; returns (#non-finite, #outside density band, max |v|^2, max |a|^2, max rho)."""
     vx = ps.vx
     vz = ps.vz
-    ax = ps.ax
-    az = ps.az
     rho = ps.rho
-    drho = ps.drho
     kind = ps.kind
-    rho0 = prm.rho0
-    lo = prm.rho_lo * rho0
-    hi = prm.rho_hi * rho0
+    lo = prm.rho_lo * prm.rho0
+    hi = prm.rho_hi * prm.rho0
     hdt = 0.5 * dt
     n_bad = 0
     n_band = 0
     v2max = 0.0
     a2max = 0.0
     rmax = 0.0
-    dvnx = ps.dvnx
-    dvnz = ps.dvnz
     for i in prange(n):
         if kind[i] == FLUID:
             # dvn: the no-penetration correction of the force pass (wall_contact.py)
-            u = vx[i] + hdt * ax[i] + dvnx[i]
-            w = vz[i] + hdt * az[i] + dvnz[i]
-            r = rho[i] + hdt * drho[i]
+            u = vx[i] + hdt * ps.ax[i] + ps.dvnx[i]
+            w = vz[i] + hdt * ps.az[i] + ps.dvnz[i]
+            r = rho[i] + hdt * ps.drho[i]
             vx[i] = u
             vz[i] = w
             rho[i] = r
-            v2 = u * u + w * w
-            a2 = ax[i] * ax[i] + az[i] * az[i]
-            if not (np.isfinite(v2) and np.isfinite(r) and np.isfinite(a2)):
-                n_bad += 1
-            elif r < lo or r > hi:
-                n_band += 1
+            bad, band, v2, a2 = _guard(u, w, r, ps.ax[i], ps.az[i], lo, hi)
+            n_bad += bad
+            n_band += band
             v2max = max(v2max, v2)
             a2max = max(a2max, a2)
             rmax = max(rmax, r)
@@ -238,11 +235,8 @@ def pc_predict(ps, n, dt, prm):
     z = ps.z
     vx = ps.vx
     vz = ps.vz
-    ax = ps.ax
-    az = ps.az
     rho = ps.rho
     p = ps.p
-    drho = ps.drho
     xn = ps.xn
     zn = ps.zn
     vxn = ps.vxn
@@ -250,9 +244,6 @@ def pc_predict(ps, n, dt, prm):
     rhon = ps.rhon
     kind = ps.kind
     hdt = 0.5 * dt
-    rho0 = prm.rho0
-    b = prm.b
-    gam = prm.gamma
     for i in prange(n):
         if kind[i] == FLUID:
             xn[i] = x[i]
@@ -262,11 +253,11 @@ def pc_predict(ps, n, dt, prm):
             rhon[i] = rho[i]
             x[i] += hdt * vx[i]
             z[i] += hdt * vz[i]
-            vx[i] += hdt * ax[i]
-            vz[i] += hdt * az[i]
-            r = rho[i] + hdt * drho[i]
+            vx[i] += hdt * ps.ax[i]
+            vz[i] += hdt * ps.az[i]
+            r = rho[i] + hdt * ps.drho[i]
             rho[i] = r
-            p[i] = pressure(r, rho0, b, gam)
+            p[i] = pressure(r, prm.rho0, prm.b, prm.gamma)
 
 
 @njit(parallel=True, cache=True)
@@ -277,26 +268,11 @@ def pc_correct(ps, n, dt, prm):
     z = ps.z
     vx = ps.vx
     vz = ps.vz
-    ax = ps.ax
-    az = ps.az
     rho = ps.rho
     p = ps.p
-    drho = ps.drho
-    xn = ps.xn
-    zn = ps.zn
-    vxn = ps.vxn
-    vzn = ps.vzn
-    rhon = ps.rhon
     kind = ps.kind
-    rho0 = prm.rho0
-    b = prm.b
-    gam = prm.gamma
-    lo = prm.rho_lo * rho0
-    hi = prm.rho_hi * rho0
-    fx0 = prm.fx0
-    fx1 = prm.fx1
-    fz0 = prm.fz0
-    fz1 = prm.fz1
+    lo = prm.rho_lo * prm.rho0
+    hi = prm.rho_hi * prm.rho0
     n_bad = 0
     n_band = 0
     n_out = 0
@@ -305,29 +281,25 @@ def pc_correct(ps, n, dt, prm):
     rmax = 0.0
     for i in prange(n):
         if kind[i] == FLUID:
-            eps = -drho[i] / rho[i] * dt
-            r = rhon[i] * (2.0 - eps) / (2.0 + eps)
-            u0 = vxn[i]
-            w0 = vzn[i]
+            eps = -ps.drho[i] / rho[i] * dt
+            r = ps.rhon[i] * (2.0 - eps) / (2.0 + eps)
+            u0 = ps.vxn[i]
+            w0 = ps.vzn[i]
             # dvn: the no-penetration correction of the half-step force pass (wall_contact.py)
-            u = u0 + dt * ax[i] + ps.dvnx[i]
-            w = w0 + dt * az[i] + ps.dvnz[i]
-            xi = xn[i] + 0.5 * dt * (u + u0)
-            zi = zn[i] + 0.5 * dt * (w + w0)
+            u = u0 + dt * ps.ax[i] + ps.dvnx[i]
+            w = w0 + dt * ps.az[i] + ps.dvnz[i]
+            xi = ps.xn[i] + 0.5 * dt * (u + u0)
+            zi = ps.zn[i] + 0.5 * dt * (w + w0)
             vx[i] = u
             vz[i] = w
             rho[i] = r
-            p[i] = pressure(r, rho0, b, gam)
+            p[i] = pressure(r, prm.rho0, prm.b, prm.gamma)
             x[i] = xi
             z[i] = zi
-            v2 = u * u + w * w
-            a2 = ax[i] * ax[i] + az[i] * az[i]
-            if not (np.isfinite(v2) and np.isfinite(r) and np.isfinite(a2)):
-                n_bad += 1
-            elif r < lo or r > hi:
-                n_band += 1
-            if not (xi >= fx0 and xi <= fx1 and zi >= fz0 and zi <= fz1):
-                n_out += 1
+            bad, band, v2, a2 = _guard(u, w, r, ps.ax[i], ps.az[i], lo, hi)
+            n_bad += bad
+            n_band += band
+            n_out += _outside(xi, zi, prm)
             v2max = max(v2max, v2)
             a2max = max(a2max, a2)
             rmax = max(rmax, r)
@@ -337,15 +309,11 @@ def pc_correct(ps, n, dt, prm):
 @njit(parallel=True, cache=True)
 def update_pressure(ps, n, prm):
     """p = EOS(rho) for every fluid particle."""
-    rho = ps.rho
     p = ps.p
     kind = ps.kind
-    rho0 = prm.rho0
-    b = prm.b
-    gam = prm.gamma
     for i in prange(n):
         if kind[i] == FLUID:
-            p[i] = pressure(rho[i], rho0, b, gam)
+            p[i] = pressure(ps.rho[i], prm.rho0, prm.b, prm.gamma)
 
 
 @njit(cache=True)

@@ -81,7 +81,7 @@ def _disordered_block(linear_v: bool, limiter: int, seed: int = 3):
     ps = particles_view(f, kind, np.arange(n, dtype=np.int64), cell)
     if limiter != NO_RECONSTRUCTION:
         riemann_gradients(ps, n, cells, prm)
-    fluid_pass(ps, n, cells, prm)
+    fluid_pass(ps, n, cells, prm, True)
     fl = kind == FLUID
     return ps, fl, grad_p, grad_u
 

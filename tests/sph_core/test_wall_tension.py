@@ -48,7 +48,7 @@ def _one_particle_over_a_bed(vz: float, p: float):
                  fz0=-1.0, fz1=1.0, alpha_wall=0.0, shift_a=0.0, shift_fs_div=1.8,
                  wall_ga=ga, wall_g0=g0, wall_gb=gb)
     ps = particles_view(f, kind, np.arange(n, dtype=np.int64), cell)
-    fluid_pass(ps, n, cells, prm)
+    fluid_pass(ps, n, cells, prm, None)
     i = int(np.flatnonzero(order == n - 1)[0])
     return ps.az[i], ps.pw[i]
 
