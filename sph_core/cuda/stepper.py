@@ -27,7 +27,6 @@ import numpy as np
 
 from ..particles import N_FIELDS
 from ..state import Cells
-from ..wcsph import INTEGRATORS, KDK
 from . import gpu_kernels as K
 from . import simulated, unavailable_reason
 
@@ -40,7 +39,7 @@ def unsupported(sim: Any) -> list[str]:
     out = []
     if sim.isph:
         out.append("ISPH")
-    if sim.integrator != KDK:
+    if sim.scene.constants.integrator != "kdk":
         out.append(f"integrator {sim.scene.constants.integrator} (only kdk)")
     if sim.open.active:
         out.append("open ends")
@@ -65,7 +64,6 @@ class CudaStepper:
         missing = unsupported(sim)
         if missing:
             raise ValueError("device cuda: not supported yet: " + ", ".join(missing))
-        assert INTEGRATORS["kdk"] == KDK
         from numba import cuda
 
         self._cuda = cuda

@@ -134,7 +134,7 @@ def test_wall_and_fluid_pass_match_cpu(sim_factory):
     ps, n = cpu.particles, cpu.particles.n
     assert cpu.prm.wall_g0 > 0.0   # the no-penetration correction is exercised
     wcsph.wall_pass(ps.view, n, cpu.cells, cpu.prm)
-    wcsph.fluid_pass(ps.view, n, cpu.cells, cpu.prm)
+    wcsph.fluid_pass(ps.view, n, cpu.cells, cpu.prm, None)   # None: the delta-SPH form
     _set_clock(st)
     a = st.bufs[0]
     K.k_wall[st._grid_n, K.TPB](a, n, st.cells, st.prm, st.ctl)
