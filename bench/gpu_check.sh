@@ -7,8 +7,9 @@
 #   5. the CPU step at ~91k particles (dp 0.005) on 1, 2, 4, 8, 16 threads
 # JSON lines go to stdout and $OUT/gpu.jsonl, the whole log to $OUT/gpu_check.log.
 # Every phase runs under `timeout`, capped by what is left of TOTAL_S, so the script ends in time.
-# Overrides (for a dry run here): GPU_DPS, CPU_DP, THREADS, HOST_THREADS (16: pytest and the GPU
-# runs' host side), TOTAL_S, PYTHON, SKIP_WHEELS, NUMBA_ENABLE_CUDASIM.
+# Overrides (a rerun, or a dry run here): GPU_DPS, CPU_DP, THREADS (empty: no CPU runs),
+# HOST_THREADS (16: pytest and the GPU runs' host side), TOTAL_S, PYTHON, SKIP_WHEELS, SKIP_TESTS,
+# NUMBA_ENABLE_CUDASIM.
 set -u
 cd "$(dirname "$0")/.."
 OUT=${OUT:-/tmp/gpu_check_out}
@@ -20,7 +21,7 @@ T0=$(date +%s)
 TOTAL_S=${TOTAL_S:-350}
 GPU_DPS=${GPU_DPS-0.01 0.0025 0.00125}
 CPU_DP=${CPU_DP:-0.005}
-THREADS=${THREADS:-1 2 4 8 16}
+THREADS=${THREADS-1 2 4 8 16}
 PY=${PYTHON:-python3}
 HT=${HOST_THREADS:-16}
 say() { echo "[gpu_check +$(( $(date +%s) - T0 ))s] $*" | tee -a "$LOG" >&2; }
@@ -48,10 +49,12 @@ print("python", sys.version.split()[0], "numpy", numpy.__version__, "numba", num
 print("cuda:", sc.unavailable_reason() or "available")
 PYEOF
 
-say "pytest -m cuda (real GPU unless NUMBA_ENABLE_CUDASIM=1)"
-NUMBA_NUM_THREADS=$HT timeout "$(left 170)" $PY -m pytest -m cuda tests/sph_core/test_cuda_*.py -q -rP -p no:cacheprovider \
-    2>&1 | tee -a "$LOG"
-say "pytest exit ${PIPESTATUS[0]}"
+if [ -z "${SKIP_TESTS:-}" ]; then
+    say "pytest -m cuda (real GPU unless NUMBA_ENABLE_CUDASIM=1)"
+    NUMBA_NUM_THREADS=$HT timeout "$(left 170)" $PY -m pytest -m cuda tests/sph_core/test_cuda_*.py \
+        -q -rP -p no:cacheprovider 2>&1 | tee -a "$LOG"
+    say "pytest exit ${PIPESTATUS[0]}"
+fi
 
 if [ -n "$GPU_DPS" ]; then
     say "GPU throughput, dp = $GPU_DPS"
