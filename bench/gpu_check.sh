@@ -1,0 +1,71 @@
+#!/usr/bin/env bash
+# The GPU check for a lent NVIDIA machine (H100/H200, 16 cores), in one run of at most ~6 min:
+#   1. installs what the machine lacks from the carried wheels in .whl/ (bench/gpu_wheels.sh)
+#   2. prints the versions and the GPU
+#   3. runs the CUDA tests on the real GPU (pytest -m cuda)
+#   4. GPU throughput of the 2D dam break at ~25.6k, ~340k, ~1.4M particles (dp 0.01/0.0025/0.00125)
+#   5. the CPU step at ~91k particles (dp 0.005) on 1, 2, 4, 8, 16 threads
+# JSON lines go to stdout and $OUT/gpu.jsonl, the whole log to $OUT/gpu_check.log.
+# Every phase runs under `timeout`, capped by what is left of TOTAL_S, so the script ends in time.
+# Overrides (a rerun, or a dry run here): GPU_DPS, CPU_DP, THREADS (empty: no CPU runs),
+# HOST_THREADS (16: pytest and the GPU runs' host side), TOTAL_S, PYTHON, SKIP_WHEELS, SKIP_TESTS,
+# NUMBA_ENABLE_CUDASIM.
+set -u
+cd "$(dirname "$0")/.."
+OUT=${OUT:-/tmp/gpu_check_out}
+mkdir -p "$OUT"
+LOG=$OUT/gpu_check.log
+JSONL=$OUT/gpu.jsonl
+: > "$JSONL"
+T0=$(date +%s)
+TOTAL_S=${TOTAL_S:-350}
+GPU_DPS=${GPU_DPS-0.01 0.0025 0.00125}
+CPU_DP=${CPU_DP:-0.005}
+THREADS=${THREADS-1 2 4 8 16}
+PY=${PYTHON:-python3}
+HT=${HOST_THREADS:-16}
+say() { echo "[gpu_check +$(( $(date +%s) - T0 ))s] $*" | tee -a "$LOG" >&2; }
+left() { local l=$(( TOTAL_S - ($(date +%s) - T0) )); (( l > $1 )) && l=$1; echo $(( l > 5 ? l : 5 )); }
+
+if [ -z "${SKIP_WHEELS:-}" ] && compgen -G ".whl/*.whl" > /dev/null; then
+    say "installing $(ls .whl/*.whl | wc -l) carried wheels into /tmp/site"
+    $PY -m pip install -q --no-index --no-deps --no-compile --no-cache-dir --upgrade \
+        --target /tmp/site .whl/*.whl 2>&1 | tee -a "$LOG" || say "wheel install FAILED"
+    export PYTHONPATH=/tmp/site
+fi
+export PYTHONPATH=$PWD${PYTHONPATH:+:$PYTHONPATH}
+export CUDA_HOME=${CUDA_HOME:-/usr/local/cuda}
+export NUMBA_ENABLE_CUDASIM=${NUMBA_ENABLE_CUDASIM:-0}
+export NUMBA_CUDA_LOW_OCCUPANCY_WARNINGS=0 PYTHONUNBUFFERED=1 PYTHONDONTWRITEBYTECODE=1
+
+say "versions"
+(nvidia-smi --query-gpu=name,memory.total,driver_version --format=csv,noheader || true) 2>&1 | tee -a "$LOG"
+NUMBA_NUM_THREADS=$HT timeout 60 $PY - <<'PYEOF' 2>&1 | tee -a "$LOG"
+import sys, numpy, numba
+import sph_core.cuda as sc   # sets np.row_stack before numba.cuda is imported
+from importlib.metadata import version
+print("python", sys.version.split()[0], "numpy", numpy.__version__, "numba", numba.__version__,
+      "numba-cuda", version("numba-cuda"), "simulated", sc.simulated())
+print("cuda:", sc.unavailable_reason() or "available")
+PYEOF
+
+if [ -z "${SKIP_TESTS:-}" ]; then
+    say "pytest -m cuda (real GPU unless NUMBA_ENABLE_CUDASIM=1)"
+    NUMBA_NUM_THREADS=$HT timeout "$(left 170)" $PY -m pytest -m cuda tests/test_sph_core/test_cuda_*.py \
+        -q -rP -p no:cacheprovider 2>&1 | tee -a "$LOG"
+    say "pytest exit ${PIPESTATUS[0]}"
+fi
+
+if [ -n "$GPU_DPS" ]; then
+    say "GPU throughput, dp = $GPU_DPS"
+    NUMBA_NUM_THREADS=$HT timeout "$(left 150)" $PY bench/gpu_throughput.py --device cuda \
+        --dps $GPU_DPS --budget 4 --out "$JSONL" 2>&1 | tee -a "$LOG"
+    say "GPU bench exit ${PIPESTATUS[0]}"
+fi
+
+for t in $THREADS; do
+    say "CPU throughput, dp = $CPU_DP, $t thread(s)"
+    NUMBA_NUM_THREADS=$t timeout "$(left 45)" $PY bench/gpu_throughput.py --device cpu \
+        --dps "$CPU_DP" --budget 3 --out "$JSONL" 2>&1 | tee -a "$LOG"
+done
+say "done: $(wc -l < "$JSONL") JSON lines in $JSONL"

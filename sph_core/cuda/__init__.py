@@ -1,0 +1,41 @@
+"""The WCSPH step on an NVIDIA GPU (numba-cuda): see docs/developer/gpu.md.
+
+Scope today: a closed tank (no open ends, no bodies, no shifting), the kdk integrator, delta-SPH
++ Monaghan AV + Lo & Shao viscosity, Adami walls, the no-penetration correction and the
+approach-gated wall tension (``wcsph.wall_pass`` / ``fluid_pass`` without Riemann SPH), from
+the same pair terms as the CPU step (``pairs.gather`` + ``terms.py``). ``stepper.CudaStepper``
+runs it; the per-particle bodies (``per_particle.py``) are plain ``@njit(inline="always")``
+functions, which numba-cuda compiles for the GPU as device functions and the CUDA simulator
+(``NUMBA_ENABLE_CUDASIM=1``) calls as CPU code.
+"""
+
+from __future__ import annotations
+
+import os
+
+import numpy as np
+
+# numba-cuda <= 0.30 names np.row_stack, which numpy 2.5 removed (an alias of vstack)
+if not hasattr(np, "row_stack"):
+    np.row_stack = np.vstack
+
+
+def simulated() -> bool:
+    """True when numba-cuda runs its CPU simulator (NUMBA_ENABLE_CUDASIM=1)."""
+    return os.environ.get("NUMBA_ENABLE_CUDASIM", "0") not in ("", "0")
+
+
+def unavailable_reason() -> str | None:
+    """None if CUDA kernels can run here (a GPU, or the simulator), else a one-line reason."""
+    try:
+        from numba import cuda
+    except ImportError as exc:  # numba-cuda not installed
+        return f"numba-cuda is not installed ({exc}); pip install 'numba-cuda[cu13]'"
+    if simulated():
+        return None
+    try:
+        if not cuda.is_available():
+            return "no CUDA GPU or driver found (set NUMBA_ENABLE_CUDASIM=1 for the simulator)"
+    except Exception as exc:  # a broken driver or toolkit
+        return f"CUDA unusable: {exc}"
+    return None

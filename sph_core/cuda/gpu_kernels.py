@@ -1,0 +1,313 @@
+"""CUDA kernels of the GPU step: thin shells around the per-particle bodies of ``bodies.py``.
+
+One thread per particle slot (or per cell, or per scan element). Every kernel first reads the
+device's stop flag ``ctl[STOP]`` and returns at once when it is set, so the host can queue many
+steps without waiting: a step whose guard trips (or that reaches t_stop) stops all the kernels
+queued after it, and the host learns of it at its next read of ``ctl``.
+
+Device scalars (two small arrays, so dt and the guards never leave the GPU during a run):
+    clk (float64): T, DT (next stable dt), DTS (this step's dt), T_STOP, V2, A2, RMAX (this
+                   step's reductions), V2LAST (max |v|^2 of the last completed step)
+    ctl (int64):   STOP, STATUS, N_FLAG, STEPS, MAX_STEPS, N_BAD, N_BAND, N_OUT, LAST
+
+A particle buffer reaches a kernel as the tuple ``buf = (f, kind, ids, cell)`` and the kernel
+builds the named views (``state.Particles``) from it: passing the 33-array NamedTuple itself
+would make ~260 kernel parameters (seven per array) per buffer, marshalled in Python at every
+launch.
+"""
+
+from __future__ import annotations
+
+from numba import cuda, float64, int64, njit
+
+from ..particles import FLUID, N_SORTED_KDK, WALL
+from ..state import particles_view
+from ..wcsph import ST_DENSITY, ST_LEFT_DOMAIN, ST_NONFINITE, ST_REACHED_T, ST_STEP_LIMIT, stable_dt
+from . import simulated
+from .per_particle import cell_of, fluid_particle, kick_drift_particle, kick_particle, wall_particle
+
+T, DT, DTS, T_STOP, V2, A2, RMAX, V2LAST = range(8)
+N_CLK = 8
+STOP, STATUS, N_FLAG, STEPS, MAX_STEPS, N_BAD, N_BAND, N_OUT, LAST = range(9)
+N_CTL = 9
+
+# threads per block; the simulator runs each thread as a Python thread, so it gets small blocks
+TPB = 32 if simulated() else 256
+SCAN_B = 64 if simulated() else 1024   # elements per block of the cell-count prefix sum
+
+
+def _schedule_py(clk, ctl):
+    """Stop at t_stop or max_steps, else set this step's dt (clamped to land on t_stop)."""
+    t = clk[T]
+    if t >= clk[T_STOP]:
+        ctl[STOP] = 1
+        ctl[STATUS] = ST_REACHED_T
+        return
+    if ctl[STEPS] >= ctl[MAX_STEPS]:
+        ctl[STOP] = 1
+        ctl[STATUS] = ST_STEP_LIMIT
+        return
+    dts = clk[DT]
+    ctl[LAST] = 0
+    if t + dts >= clk[T_STOP]:
+        dts = clk[T_STOP] - t
+        ctl[LAST] = 1
+    clk[DTS] = dts
+
+
+def _view_py(buf):
+    """The named row views (state.Particles) of the buffer tuple (f, kind, ids, cell)."""
+    return particles_view(buf[0], buf[1], buf[2], buf[3])
+
+
+def _stable_dt_py(v2max, a2max, rmax, prm):
+    return stable_dt(v2max, a2max, rmax, prm)
+
+
+# device functions on the GPU (inlined: numba-cuda compiles an inlined @njit callee for the
+# device; docs/developer/gpu.md). Under the simulator they stay Python: clk/ctl are its array
+# wrappers there, which compiled code cannot take.
+if simulated():
+    _schedule = _schedule_py
+    _view = _view_py
+    _stable_dt = _stable_dt_py
+else:
+    _schedule = njit(inline="always")(_schedule_py)
+    _particles_view = njit(inline="always")(particles_view)
+
+    @njit(inline="always")
+    def _view(buf):
+        return _particles_view(buf[0], buf[1], buf[2], buf[3])
+
+    _stable_dt = njit(inline="always")(stable_dt.py_func)
+
+
+@cuda.jit
+def k_begin(clk, ctl):
+    """Start a run call: clear the stop flag and schedule the first step."""
+    if cuda.grid(1) == 0:
+        ctl[STOP] = 0
+        ctl[STATUS] = ST_REACHED_T
+        _schedule(clk, ctl)
+
+
+@cuda.jit
+def k_finish(prm, clk, ctl):
+    """End of a step (one thread): the clock, the verdict (step._verdict), the next dt
+    (wcsph.stable_dt), the reductions cleared, the next step scheduled."""
+    if cuda.grid(1) != 0 or ctl[STOP] != 0:
+        return
+    clk[T] = clk[T_STOP] if ctl[LAST] != 0 else clk[T] + clk[DTS]
+    ctl[STEPS] += 1
+    v2 = clk[V2]
+    clk[V2LAST] = v2
+    clk[DT] = _stable_dt(v2, clk[A2], clk[RMAX], prm)
+    status = ST_REACHED_T
+    flag = 0
+    if ctl[N_BAD] > 0:
+        status = ST_NONFINITE
+        flag = ctl[N_BAD]
+    elif ctl[N_OUT] > 0:
+        status = ST_LEFT_DOMAIN
+        flag = ctl[N_OUT]
+    elif ctl[N_BAND] > 0:
+        status = ST_DENSITY
+        flag = ctl[N_BAND]
+    ctl[N_BAD] = 0
+    ctl[N_BAND] = 0
+    ctl[N_OUT] = 0
+    clk[V2] = 0.0
+    clk[A2] = 0.0
+    clk[RMAX] = 0.0
+    if status != ST_REACHED_T:
+        ctl[STOP] = 1
+        ctl[STATUS] = status
+        ctl[N_FLAG] = flag
+        return
+    _schedule(clk, ctl)
+
+
+@cuda.jit
+def k_kick_drift_bin(buf, n, prm, cells, count, clk, ctl):
+    """kdk first half-kick + drift (fluid), then the cell of every slot and its count."""
+    if ctl[STOP] != 0:
+        return
+    i = cuda.grid(1)
+    if i < n:
+        ps = _view(buf)
+        if ps.kind[i] == FLUID:
+            if kick_drift_particle(i, ps, clk[DTS], prm):
+                cuda.atomic.add(ctl, N_OUT, 1)
+        c = cell_of(i, ps, cells)
+        ps.cell[i] = c
+        cuda.atomic.add(count, c, 1)
+
+
+@cuda.jit
+def k_scan_blocks(count, start, bsum, m, ctl):
+    """Exclusive prefix sum of count[0:m] within blocks of SCAN_B (Hillis-Steele in shared
+    memory); each block's total goes to bsum."""
+    if ctl[STOP] != 0:
+        return
+    s = cuda.shared.array(SCAN_B, int64)
+    t = cuda.threadIdx.x
+    g = cuda.blockIdx.x * SCAN_B + t
+    v = count[g] if g < m else 0
+    s[t] = v
+    cuda.syncthreads()
+    off = 1
+    while off < SCAN_B:
+        a = s[t - off] if t >= off else 0
+        cuda.syncthreads()
+        s[t] += a
+        cuda.syncthreads()
+        off *= 2
+    if g < m:
+        start[g] = s[t] - v
+    if t == SCAN_B - 1:
+        bsum[cuda.blockIdx.x] = s[t]
+
+
+@cuda.jit
+def k_scan_sums(bsum, nb, ctl):
+    """Exclusive prefix sum of the block totals bsum[0:nb] (one block, chunks of SCAN_B)."""
+    if ctl[STOP] != 0:
+        return
+    s = cuda.shared.array(SCAN_B, int64)
+    t = cuda.threadIdx.x
+    carry = 0
+    base = 0
+    while base < nb:
+        g = base + t
+        v = bsum[g] if g < nb else 0
+        s[t] = v
+        cuda.syncthreads()
+        off = 1
+        while off < SCAN_B:
+            a = s[t - off] if t >= off else 0
+            cuda.syncthreads()
+            s[t] += a
+            cuda.syncthreads()
+            off *= 2
+        if g < nb:
+            bsum[g] = carry + s[t] - v
+        carry += s[SCAN_B - 1]
+        cuda.syncthreads()
+        base += SCAN_B
+
+
+@cuda.jit
+def k_scan_add(start, bsum, cursor, count, m, ctl):
+    """Add the block offsets: start = first slot of each cell; cursor = start; counts cleared."""
+    if ctl[STOP] != 0:
+        return
+    g = cuda.grid(1)
+    if g < m:
+        v = start[g] + bsum[g // SCAN_B]
+        start[g] = v
+        cursor[g] = v
+        count[g] = 0
+
+
+@cuda.jit
+def k_scatter(buf, n, cursor, order, ctl):
+    """order[k] = slot that goes to position k (unordered within a cell)."""
+    if ctl[STOP] != 0:
+        return
+    i = cuda.grid(1)
+    if i < n:
+        k = cuda.atomic.add(cursor, buf[3][i], 1)
+        order[k] = i
+
+
+@cuda.jit
+def k_cell_order(start, order, ncells, ctl):
+    """Sort each cell's slots by index (insertion sort, a few per cell), so the order is the
+    stable counting sort's of neighbours.counting_sort, whatever order the atomics gave."""
+    if ctl[STOP] != 0:
+        return
+    c = cuda.grid(1)
+    if c < ncells:
+        a = start[c]
+        b = start[c + 1]
+        for k in range(a + 1, b):
+            v = order[k]
+            q = k - 1
+            while q >= a and order[q] > v:
+                order[q + 1] = order[q]
+                q -= 1
+            order[q + 1] = v
+
+
+@cuda.jit
+def k_permute(buf, buf2, order, n, ctl):
+    """neighbours.permute: gather the carried rows, kind, ids and cell into the twin."""
+    if ctl[STOP] != 0:
+        return
+    k = cuda.grid(1)
+    if k < n:
+        i = order[k]
+        f = buf[0]
+        f2 = buf2[0]
+        for r in range(N_SORTED_KDK):
+            f2[r, k] = f[r, i]
+        buf2[1][k] = buf[1][i]
+        buf2[2][k] = buf[2][i]
+        buf2[3][k] = buf[3][i]
+
+
+@cuda.jit
+def k_wall(buf, n, cells, prm, ctl):
+    """wcsph.wall_pass (Adami walls)."""
+    if ctl[STOP] != 0:
+        return
+    i = cuda.grid(1)
+    if i < n and buf[1][i] == WALL:
+        wall_particle(i, _view(buf), cells, prm)
+
+
+@cuda.jit
+def k_fluid(buf, n, cells, prm, ctl):
+    """wcsph.fluid_pass (delta-SPH form)."""
+    if ctl[STOP] != 0:
+        return
+    i = cuda.grid(1)
+    if i < n and buf[1][i] == FLUID:
+        fluid_particle(i, _view(buf), cells, prm)
+
+
+@cuda.jit
+def k_kick(buf, n, prm, clk, ctl):
+    """wcsph.kdk_kick: second half-kick, guard counts, block-reduced max |v|^2, |a|^2, rho."""
+    if ctl[STOP] != 0:
+        return
+    sv = cuda.shared.array(TPB, float64)
+    sa = cuda.shared.array(TPB, float64)
+    sr = cuda.shared.array(TPB, float64)
+    t = cuda.threadIdx.x
+    i = cuda.grid(1)
+    v2 = 0.0
+    a2 = 0.0
+    r = 0.0
+    if i < n and buf[1][i] == FLUID:
+        v2, a2, r, guard = kick_particle(i, _view(buf), clk[DTS], prm)
+        if guard == 1:
+            cuda.atomic.add(ctl, N_BAD, 1)
+        elif guard == 2:
+            cuda.atomic.add(ctl, N_BAND, 1)
+    sv[t] = v2
+    sa[t] = a2
+    sr[t] = r
+    cuda.syncthreads()
+    half = TPB // 2
+    while half > 0:
+        if t < half:
+            sv[t] = max(sv[t], sv[t + half])
+            sa[t] = max(sa[t], sa[t + half])
+            sr[t] = max(sr[t], sr[t + half])
+        cuda.syncthreads()
+        half //= 2
+    if t == 0:
+        cuda.atomic.max(clk, V2, sv[0])
+        cuda.atomic.max(clk, A2, sa[0])
+        cuda.atomic.max(clk, RMAX, sr[0])
