@@ -8,7 +8,10 @@ from pathlib import Path
 
 import httpx
 
+from protocol import Nodes, Welcome
 from wavesph.local_server import InProcessServer
+
+from coupling_client import TcpClient, handshake
 
 
 def scene(**overrides) -> dict:
@@ -50,6 +53,14 @@ class LiveServer(InProcessServer):
         r = self.http.post("/runs", json={"scene": scene(**scene_overrides), "mode": mode})
         assert r.status_code == 201, r.text
         return r.json()
+
+    def couple(self, run_id: str, timeout: float = 10.0, **handshake_kw) -> tuple[TcpClient, Welcome, Nodes]:
+        """A TCP client of the run once it waits for one, past HELLO and GETNODES (``timeout``:
+        the client's reads; a longer one waits longer for the run too, e.g. an SPH flume's build)."""
+        self.wait_state(run_id, "waiting_for_client", timeout=max(30.0, timeout))
+        client = TcpClient(self.tcp_port, timeout=timeout)
+        welcome, nodes = handshake(client, run_id, **handshake_kw)
+        return client, welcome, nodes
 
     def wait_state(self, run_id: str, *states: str, timeout: float = 30.0) -> dict:
         deadline = time.monotonic() + timeout

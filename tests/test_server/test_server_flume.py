@@ -17,7 +17,7 @@ from server.main import create_app  # noqa: F401  (default engine factory: the f
 from server.schemas import RunRequest
 
 from server_harness import live_server
-from coupling_client import TcpClient, bye, handshake
+from coupling_client import bye
 
 G, DEPTH, H, T, WINDOW = 9.81, 0.3, 0.02, 1.0, 0.05
 FLUME = {"name": "flume", "dp": 0.04, "t_end": 1.0, "still_water_level": DEPTH,
@@ -46,9 +46,7 @@ def test_flume_over_tcp_equals_the_flume_in_process(tmp_path):
         r = srv.http.post("/runs", json=body)
         assert r.status_code == 201, r.text
         run = r.json()
-        srv.wait_state(run["id"], "waiting_for_client", timeout=120)
-        c = TcpClient(srv.tcp_port, timeout=120)
-        welcome, nodes = handshake(c, run["id"], scene_hash=bytes.fromhex(run["scene_hash"]))
+        c, welcome, nodes = srv.couple(run["id"], timeout=120, scene_hash=bytes.fromhex(run["scene_hash"]))
         assert welcome.depth == pytest.approx(DEPTH) and welcome.z_ref == pytest.approx(-DEPTH / 2)
         assert sorted(set(nodes.side.tolist())) == [0, 1] and nodes.gauge_x.size == 3
         assert nodes.x[nodes.side == 0].max() == 0.0 and nodes.x[nodes.side == 1].min() == 1.2
@@ -80,9 +78,7 @@ def test_flume_refuses_boundary_data_outside_the_tank(tmp_path):
     body = {"scene": FLUME, "mode": "coupled", "coupling": {"window_max": WINDOW}}
     with live_server(tmp_path) as srv:
         run = srv.http.post("/runs", json=body).json()
-        srv.wait_state(run["id"], "waiting_for_client", timeout=120)
-        c = TcpClient(srv.tcp_port, timeout=120)
-        welcome, nodes = handshake(c, run["id"])
+        c, welcome, nodes = srv.couple(run["id"], timeout=120)
         n = welcome.n_nodes
         c.request(Set(0.0, WINDOW, np.zeros(n), np.zeros(n), np.full(n, 5.0)), Solve())
         from protocol import ErrorCode, RemoteError
@@ -100,9 +96,7 @@ def test_resumed_flume_continues_exactly(tmp_path):
     with live_server(tmp_path) as srv:
         run = srv.http.post("/runs", json=body).json()
         for session in range(2):
-            srv.wait_state(run["id"], "waiting_for_client", timeout=120)
-            c = TcpClient(srv.tcp_port, timeout=120)
-            welcome, nodes = handshake(c, run["id"])
+            c, welcome, nodes = srv.couple(run["id"], timeout=120)
             t = welcome.t_start
             for _ in range(2):
                 got.append(c.request(Set(t, t + WINDOW, *airy(nodes.x, nodes.z, t + WINDOW)), Solve(),
