@@ -34,7 +34,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from wavesph.cases.standing_wave import standing_wave_decay  # noqa: E402
 from wavesph.cases.schemes import (add_constant_arguments, add_scheme_arguments,  # noqa: E402
                                    constants_from_args, scheme_from_args)
-from wavesph.cases.wave_decay import convergence_orders  # noqa: E402
+from wavesph.cases.wave_decay import convergence_record  # noqa: E402
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -70,8 +70,7 @@ def main(argv: list[str] | None = None) -> int:
             "particle_steps_per_s": round(r.particles * r.steps / max(r.wall_s, 1e-9))}),
             flush=True)
     if len(a.dp) > 1:
-        print(json.dumps({"dp": a.dp, "equiv_decay_per_m": [round(k, 4) for k in decays],
-                          "convergence_order": convergence_orders(a.dp, decays)}), flush=True)
+        print(json.dumps(convergence_record(a.dp, decays, "equiv_decay_per_m")), flush=True)
     return 0
 
 

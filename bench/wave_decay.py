@@ -52,7 +52,7 @@ from pathlib import Path
 os.environ.setdefault("OMP_WAIT_POLICY", "passive")  # before numba: shared, loaded cores
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from wavesph.cases.wave_decay import amplitude_profile, convergence_orders, separated_decay  # noqa: E402
+from wavesph.cases.wave_decay import amplitude_profile, convergence_record, separated_decay  # noqa: E402
 from wavesph.cases.schemes import (add_constant_arguments, add_scheme_arguments,  # noqa: E402
                                    constants_from_args, scheme_from_args)
 from sph_core.absorption import ABSORPTION_KINDS, ABSORPTION_TRANSFERS  # noqa: E402
@@ -143,8 +143,7 @@ def main(argv: list[str] | None = None) -> int:
                           "particle_steps_per_s": round(prof.particles * prof.steps
                                                         / max(prof.wall_s, 1e-9))}), flush=True)
     if len(a.dp) > 1:
-        print(json.dumps({"dp": a.dp, "decay_per_m": [round(k, 4) for k in decays],
-                          "convergence_order": convergence_orders(a.dp, decays)}), flush=True)
+        print(json.dumps(convergence_record(a.dp, decays, "decay_per_m")), flush=True)
     return 0
 
 
