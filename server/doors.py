@@ -47,7 +47,7 @@ def error_frame(code: ErrorCode, text: str, seq: int = 0) -> bytes:
 
 
 async def admit(manager: RunManager, transport: DoorTransport,
-                run_id_of: Callable[[Hello], str]) -> tuple[Run, list] | None:
+                run_id_of: Callable[[Hello], str]) -> tuple[Run, list[tuple[int, Message]]] | None:
     """The first frame, HELLO, within ``hello_timeout``: the run it names (``run_id_of`` gives
     the id, or raises ProtocolError where the door refuses it) claimed, with the frames read so
     far. None if the client left first (the transport is left to the caller) or was refused
