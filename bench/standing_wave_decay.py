@@ -32,8 +32,9 @@ os.environ.setdefault("OMP_WAIT_POLICY", "passive")
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from wavesph.cases.standing_wave import standing_wave_decay  # noqa: E402
-from wavesph.cases.schemes import add_scheme_arguments, scheme_from_args  # noqa: E402
-from wavesph.cases.wave_decay import convergence_orders  # noqa: E402
+from wavesph.cases.schemes import (add_constant_arguments, add_scheme_arguments,  # noqa: E402
+                                   constants_from_args, scheme_from_args)
+from wavesph.cases.wave_decay import convergence_record  # noqa: E402
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -44,29 +45,10 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--a", type=float, default=0.02, help="standing-wave amplitude [m]")
     ap.add_argument("--periods", type=float, default=6.0)
     ap.add_argument("--c0-factor", type=float, default=10.0, help="c0 = factor * sqrt(g d)")
-    ap.add_argument("--h-over-dp", type=float)
-    ap.add_argument("--alpha", type=float)
-    ap.add_argument("--alpha-wall", type=float)
-    ap.add_argument("--slip", choices=["no_slip", "free_slip"])
-    ap.add_argument("--delta", type=float)
-    ap.add_argument("--cfl", type=float)
-    ap.add_argument("--integrator", choices=["kdk", "symplectic_pc"])
-    ap.add_argument("--nu", type=float)
-    ap.add_argument("--shifting", choices=["none", "fickian", "dplus"])
-    ap.add_argument("--shift-a", type=float)
-    ap.add_argument("--shift-fs-div", type=float)
-    ap.add_argument("--shift-dplus-scale", type=float, help="dplus: multiplier on CFL Ma (2h)^2")
-    ap.add_argument("--no-shift-carry", action="store_true",
-                    help="do not Taylor-carry rho, v of a shifted particle")
+    add_constant_arguments(ap)
     add_scheme_arguments(ap)
     a = ap.parse_args(argv)
-    cst = {k: v for k, v in {"h_over_dp": a.h_over_dp, "alpha": a.alpha, "wall_slip": a.slip,
-                             "delta": a.delta, "cfl": a.cfl, "nu": a.nu,
-                             "integrator": a.integrator, "shifting": a.shifting,
-                             "shift_a": a.shift_a, "shift_fs_div": a.shift_fs_div,
-                             "alpha_wall_factor": a.alpha_wall,
-                             "shift_dplus_scale": a.shift_dplus_scale,
-                             "shift_carry": False if a.no_shift_carry else None}.items() if v is not None}
+    cst = constants_from_args(a)
     scheme = scheme_from_args(a)
     decays = []
     for dp in a.dp:
@@ -88,8 +70,7 @@ def main(argv: list[str] | None = None) -> int:
             "particle_steps_per_s": round(r.particles * r.steps / max(r.wall_s, 1e-9))}),
             flush=True)
     if len(a.dp) > 1:
-        print(json.dumps({"dp": a.dp, "equiv_decay_per_m": [round(k, 4) for k in decays],
-                          "convergence_order": convergence_orders(a.dp, decays)}), flush=True)
+        print(json.dumps(convergence_record(a.dp, decays, "equiv_decay_per_m")), flush=True)
     return 0
 
 

@@ -52,8 +52,9 @@ from pathlib import Path
 os.environ.setdefault("OMP_WAIT_POLICY", "passive")  # before numba: shared, loaded cores
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from wavesph.cases.wave_decay import amplitude_profile, convergence_orders, separated_decay  # noqa: E402
-from wavesph.cases.schemes import add_scheme_arguments, scheme_from_args  # noqa: E402
+from wavesph.cases.wave_decay import amplitude_profile, convergence_record, separated_decay  # noqa: E402
+from wavesph.cases.schemes import (add_constant_arguments, add_scheme_arguments,  # noqa: E402
+                                   constants_from_args, scheme_from_args)
 from wave_client.theories import build_theory  # noqa: E402
 
 
@@ -77,37 +78,15 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--noise", action="store_true",
                     help="sample the particle-noise energy along x and in time (diagnostic)")
     ap.add_argument("--n-gauges", type=int, default=12, help="number of elevation gauges")
-    ap.add_argument("--h-over-dp", type=float, help="smoothing length / dp (scene default if unset)")
-    ap.add_argument("--alpha", type=float, help="artificial viscosity coefficient")
-    ap.add_argument("--slip", choices=["no_slip", "free_slip"], help="wall (bed) condition")
+    add_constant_arguments(ap, open_ends=True)
     ap.add_argument("--c0-factor", type=float, default=10.0, help="c0 = factor * sqrt(g d)")
-    ap.add_argument("--delta", type=float, help="delta-SPH density diffusion coefficient")
-    ap.add_argument("--cfl", type=float, help="Courant number")
-    ap.add_argument("--integrator", choices=["kdk", "symplectic_pc"])
-    ap.add_argument("--nu", type=float, help="laminar kinematic viscosity [m^2/s]")
-    ap.add_argument("--shifting", choices=["none", "fickian", "dplus"], help="particle shifting")
-    ap.add_argument("--shift-a", type=float, help="shifting coefficient A (Lind et al. 2012)")
-    ap.add_argument("--shift-fs-div", type=float, help="free-surface position-divergence limit")
-    ap.add_argument("--shift-dplus-scale", type=float, help="dplus: multiplier on CFL Ma (2h)^2")
-    ap.add_argument("--shift-open-end", choices=["full", "none"],
-                    help="shifting next to an open end's buffer")
-    ap.add_argument("--no-shift-carry", action="store_true",
-                    help="do not Taylor-carry rho, v of a shifted particle")
-    ap.add_argument("--alpha-wall", type=float, help="artificial viscosity factor against walls")
     ap.add_argument("--no-outlet-absorb", action="store_true",
                     help="outlet without the absorption correction (diagnostic: its reflection)")
     ap.add_argument("--inlet-pressure", choices=["hydrostatic", "extrapolated"],
                     help="inlet buffer pressure (scene default if unset)")
     add_scheme_arguments(ap)
     a = ap.parse_args(argv)
-    cst = {k: v for k, v in {"h_over_dp": a.h_over_dp, "alpha": a.alpha, "wall_slip": a.slip,
-                             "delta": a.delta, "cfl": a.cfl, "nu": a.nu,
-                             "integrator": a.integrator, "shifting": a.shifting,
-                             "shift_a": a.shift_a, "shift_fs_div": a.shift_fs_div,
-                             "alpha_wall_factor": a.alpha_wall,
-                             "shift_dplus_scale": a.shift_dplus_scale,
-                             "shift_carry": False if a.no_shift_carry else None,
-                             "shift_open_end": a.shift_open_end}.items() if v is not None}
+    cst = constants_from_args(a)
     scheme = scheme_from_args(a)
     if a.long:
         a.flume_wavelengths, a.gauge_wavelengths, a.n_gauges = 3.0, 2.25, 36
@@ -157,8 +136,7 @@ def main(argv: list[str] | None = None) -> int:
                           "particle_steps_per_s": round(prof.particles * prof.steps
                                                         / max(prof.wall_s, 1e-9))}), flush=True)
     if len(a.dp) > 1:
-        print(json.dumps({"dp": a.dp, "decay_per_m": [round(k, 4) for k in decays],
-                          "convergence_order": convergence_orders(a.dp, decays)}), flush=True)
+        print(json.dumps(convergence_record(a.dp, decays, "decay_per_m")), flush=True)
     return 0
 
 

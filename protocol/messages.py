@@ -173,6 +173,14 @@ class Message:
     TYPE: ClassVar[MessageType]
     LAYOUT: ClassVar[tuple[tuple[str, str], ...]] = ()
 
+    def __post_init__(self) -> None:
+        # array fields hold what the wire gives back (float64, uint32, list), so a message
+        # compares equal to its own round trip; LAYOUT says which fields are arrays
+        for name, kind in self.LAYOUT:
+            coerce = _COERCE.get(kind)
+            if coerce is not None:
+                setattr(self, name, coerce(getattr(self, name)))
+
     def serialize(self) -> bytes:
         """The payload bytes (without the frame header)."""
         w = _Writer(self.TYPE.name)
@@ -208,6 +216,9 @@ def _u32s(a: object) -> np.ndarray:
     if arr.dtype.kind in "iu" and arr.min() >= 0 and arr.max() <= _U32_MAX:
         return arr.astype(np.uint32)
     return arr  # left as given: serialize() names the field it refuses
+
+
+_COERCE = {"f64[]": _f64s, "u32[]": _u32s, "text[]": list}
 
 
 @dataclass(eq=False)
@@ -269,10 +280,6 @@ class Nodes(Message):
     side: np.ndarray = field(default_factory=lambda: np.zeros(0, np.uint32))
     gauge_x: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
-    def __post_init__(self) -> None:
-        self.x, self.z, self.gauge_x = _f64s(self.x), _f64s(self.z), _f64s(self.gauge_x)
-        self.side = _u32s(self.side)
-
 
 @dataclass(eq=False)
 class Set(Message):
@@ -285,9 +292,6 @@ class Set(Message):
     u: np.ndarray    # horizontal velocity at each node at t1 [m/s]
     w: np.ndarray    # vertical velocity at each node at t1 [m/s]
     eta: np.ndarray  # wave-model elevation above still water at each node's x, at t1 [m]
-
-    def __post_init__(self) -> None:
-        self.u, self.w, self.eta = _f64s(self.u), _f64s(self.w), _f64s(self.eta)
 
 
 @dataclass(eq=False)
@@ -317,10 +321,6 @@ class Result(Message):
     wet: np.ndarray    # 1 where the gauge found water, 0 where dry
     u_ref: np.ndarray  # horizontal velocity at z_ref at each gauge [m/s] (0 where dry)
     w_ref: np.ndarray  # vertical velocity at z_ref at each gauge [m/s] (0 where dry)
-
-    def __post_init__(self) -> None:
-        self.eta, self.u_ref, self.w_ref = _f64s(self.eta), _f64s(self.u_ref), _f64s(self.w_ref)
-        self.wet = _u32s(self.wet)
 
 
 @dataclass(eq=False)
@@ -367,10 +367,6 @@ class Gauges(Message):
     names: list[str] = field(default_factory=list)
     kind: np.ndarray = field(default_factory=lambda: np.zeros(0, np.uint32))
     eta_gauge: np.ndarray = field(default_factory=lambda: np.zeros(0, np.uint32))
-
-    def __post_init__(self) -> None:
-        self.names = list(self.names)
-        self.kind, self.eta_gauge = _u32s(self.kind), _u32s(self.eta_gauge)
 
 
 @dataclass(eq=False)

@@ -13,6 +13,7 @@ import asyncio
 import logging
 import time
 from collections import deque
+from typing import Callable
 
 import numpy as np
 
@@ -43,6 +44,41 @@ class _SessionEnd(Exception):
 def error_frame(code: ErrorCode, text: str, seq: int = 0) -> bytes:
     """An ERROR frame outside a session (before the run is known)."""
     return encode_frame(Error(int(code), text[:4000]), seq)
+
+
+async def admit(manager: RunManager, transport: DoorTransport,
+                run_id_of: Callable[[Hello], str]) -> tuple[Run, list[tuple[int, Message]]] | None:
+    """The first frame, HELLO, within ``hello_timeout``: the run it names (``run_id_of`` gives
+    the id, or raises ProtocolError where the door refuses it) claimed, with the frames read so
+    far. None if the client left first (the transport is left to the caller) or was refused
+    (ERROR sent, transport closed)."""
+    seq = 0
+    try:
+        frames = await asyncio.wait_for(transport.recv(), manager.settings.hello_timeout)
+        if frames is None:
+            return None
+        seq, msg = frames[0]
+        if not isinstance(msg, Hello):
+            raise ProtocolError(ErrorCode.OUT_OF_ORDER, f"{msg.TYPE.name} before HELLO")
+        run = await claim_run(manager, run_id_of(msg), msg, transport, seq)
+        if run is None:
+            await transport.close()
+            return None
+    except ProtocolError as exc:
+        await _refuse(transport, exc.code, exc.text, seq)
+        return None
+    except TimeoutError:
+        await _refuse(transport, ErrorCode.TIMEOUT, f"no HELLO within {manager.settings.hello_timeout:g} s", 0)
+        return None
+    return run, frames
+
+
+async def _refuse(transport: DoorTransport, code: ErrorCode, text: str, seq: int) -> None:
+    try:  # bounded: a peer that reads nothing must not hold the door
+        await asyncio.wait_for(transport.send(error_frame(code, text, seq)), 5.0)
+    except Exception:  # noqa: BLE001 -- the peer may already be gone
+        pass
+    await transport.close()
 
 
 async def claim_run(manager: RunManager, run_id: str, hello: Hello,

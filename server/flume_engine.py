@@ -28,6 +28,7 @@ from sph_core.simulation import Simulation
 
 from .engine import EngineNodes, Measurement, SceneSummary
 from .schemas import RunRequest
+from .store import fresh_path  # sph/, then sph.1/ ... for resumed sessions
 
 REF = "_ref"  # suffix of the point probes the engine adds at z_ref
 
@@ -62,7 +63,7 @@ class FlumeEngine:
         if not -depth < z_ref <= 0:
             raise ValueError(f"coupling.z_ref: {z_ref} m is not in the water column (-{depth}, 0]")
         sim_scene, self.gauge_names, gauge_x = ref_scene(scene, z_ref)
-        self.flume = Simulation(sim_scene, run_dir=None if run_dir is None else _fresh_dir(Path(run_dir)),
+        self.flume = Simulation(sim_scene, run_dir=None if run_dir is None else fresh_path(Path(run_dir), "sph"),
                                 window=request.coupling.window_max)
         f = self.flume
         self.sides = [s for s in SIDES if s in f.open_sides]
@@ -169,15 +170,6 @@ class FlumeEngine:
 
     def close(self) -> None:
         self.flume.close()
-
-
-def _fresh_dir(run_dir: Path) -> Path:
-    """sph/ for the first session, sph.1/, sph.2/ ... for resumed ones: never overwrite outputs."""
-    k, d = 0, run_dir / "sph"
-    while d.exists():
-        k += 1
-        d = run_dir / f"sph.{k}"
-    return d
 
 
 def flume_engine(request: RunRequest, run_dir: Path) -> FlumeEngine:

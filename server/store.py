@@ -96,6 +96,16 @@ def save_sealed(save: Callable[[Path], None], path: Path) -> None:
     _seal_path(path).write_text(_sha256(path) + "\n")
 
 
+def fresh_path(folder: Path, stem: str, suffix: str = "") -> Path:
+    """``stem+suffix`` in ``folder``, else the first free ``stem.1+suffix``, ``stem.2+suffix``, ...:
+    each session of a resumed run writes its own, never over an earlier one's."""
+    k, path = 0, folder / f"{stem}{suffix}"
+    while path.exists():
+        k += 1
+        path = folder / f"{stem}.{k}{suffix}"
+    return path
+
+
 def has_seal(path: Path) -> bool:
     """``path`` and its seal exist (cheap; ``is_sealed`` reads the file)."""
     return path.exists() and _seal_path(path).exists()

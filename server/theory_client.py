@@ -21,6 +21,7 @@ from wave_client.coupling import CouplingCore, CouplingOptions, GaugeLog
 
 from .doors import serve_client
 from .run_manager import Run, RunManager
+from .store import fresh_path  # theory.csv, then theory.1.csv ... for resumed sessions
 
 log = logging.getLogger("wavesph.server")
 
@@ -91,15 +92,6 @@ class TheoryClient:
             self._log.close()
 
 
-def _log_path(run_dir: Path) -> Path:
-    """theory.csv, then theory.1.csv ... for resumed sessions: never overwrite a run's data."""
-    k, path = 0, run_dir / "theory.csv"
-    while path.exists():
-        k += 1
-        path = run_dir / f"theory.{k}.csv"
-    return path
-
-
 async def serve_theory(manager: RunManager, run: Run) -> None:
     """Drive an attached run with its request's theory source until the session ends."""
     source = run.request.source
@@ -108,5 +100,5 @@ async def serve_theory(manager: RunManager, run: Run) -> None:
                         CouplingOptions(window=source.window), run_id=run.info.id,
                         scene_hash=bytes.fromhex(run.info.scene_hash),
                         client_name=f"wavesph built-in {source.theory} theory")
-    client = TheoryClient(core, _log_path(run.dir))
+    client = TheoryClient(core, fresh_path(run.dir, "theory", ".csv"))
     await serve_client(manager, run, client, client.first())

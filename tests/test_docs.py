@@ -34,6 +34,19 @@ def test_generated_page_is_current(tool: str, page: str) -> None:
         f"{page} is stale: regenerate it with `python docs/tools/{tool}.py > {page}`")
 
 
+@pytest.mark.parametrize("tool, page", [
+    ("scene_reference", "docs/user/scene_reference.md"),
+    ("validation_tables", "docs/validation.md"),
+])
+def test_check_flag_exits_1_with_the_regenerate_command_when_stale(tool, page, monkeypatch, capsys) -> None:
+    mod = _load(tool)
+    assert mod.main(["--check"]) == 0
+    monkeypatch.setattr(mod, "render", lambda: "not the page\n")
+    assert mod.main(["--check"]) == 1
+    assert capsys.readouterr().err.strip() == f"{page} is stale: run python docs/tools/{tool}.py > {page}"
+    assert mod.main([]) == 0 and capsys.readouterr().out == "not the page\n"
+
+
 def test_scene_reference_lists_every_scene_key() -> None:
     """Each root key and each table's key of the Scene model has a row on the page."""
     from sph_core.scene import Constants, OpenBoundary, Scene, Scheme

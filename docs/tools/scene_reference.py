@@ -12,7 +12,6 @@ tests/test_docs.py fails when the committed page differs from a fresh one.
 
 from __future__ import annotations
 
-import argparse
 import re
 import sys
 import types
@@ -22,9 +21,11 @@ from typing import Any, Literal, Union, get_args, get_origin
 
 ROOT = Path(__file__).resolve().parents[2]
 PAGE = ROOT / "docs" / "user" / "scene_reference.md"
-if str(ROOT) not in sys.path:          # runnable from a checkout without installing
-    sys.path.insert(0, str(ROOT))
+for _folder in (ROOT, Path(__file__).resolve().parent):  # a checkout without installing; generated_page
+    if str(_folder) not in sys.path:
+        sys.path.insert(0, str(_folder))
 
+from generated_page import page_main                 # noqa: E402
 from pydantic import BaseModel                       # noqa: E402
 from pydantic.fields import FieldInfo                # noqa: E402
 from pydantic_core import PydanticUndefined         # noqa: E402
@@ -229,20 +230,7 @@ def render() -> str:
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--check", action="store_true",
-                    help=f"exit 1 if {PAGE.relative_to(ROOT)} differs from a fresh one")
-    args = ap.parse_args(argv)
-    text = render()
-    if args.check:
-        if PAGE.read_text(encoding="utf-8") != text:
-            print(f"{PAGE.relative_to(ROOT)} is stale: run "
-                  "python docs/tools/scene_reference.py > docs/user/scene_reference.md",
-                  file=sys.stderr)
-            return 1
-        return 0
-    sys.stdout.write(text)
-    return 0
+    return page_main(argv, __doc__.splitlines()[0], Path(__file__), PAGE, render)
 
 
 if __name__ == "__main__":

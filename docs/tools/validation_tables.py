@@ -12,7 +12,6 @@ A new measurement is a new line; the page is regenerated, never edited by hand
 
 from __future__ import annotations
 
-import argparse
 import json
 import sys
 from pathlib import Path
@@ -21,6 +20,10 @@ from typing import Any
 ROOT = Path(__file__).resolve().parents[2]
 RESULTS = ROOT / "bench" / "results"
 PAGE = ROOT / "docs" / "validation.md"
+if str(Path(__file__).resolve().parent) not in sys.path:  # generated_page, beside this file
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+from generated_page import page_main  # noqa: E402
 
 # question -> (title, what it asks[, a figure]); tables appear in this order, unknown ones last
 QUESTIONS: dict[str, tuple[str, ...]] = {
@@ -138,19 +141,7 @@ def render(results: Path = RESULTS) -> str:
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--check", action="store_true",
-                    help=f"exit 1 if {PAGE.relative_to(ROOT)} differs from a fresh one")
-    args = ap.parse_args(argv)
-    text = render()
-    if args.check:
-        if PAGE.read_text(encoding="utf-8") != text:
-            print(f"{PAGE.relative_to(ROOT)} is stale: run "
-                  "python docs/tools/validation_tables.py > docs/validation.md", file=sys.stderr)
-            return 1
-        return 0
-    sys.stdout.write(text)
-    return 0
+    return page_main(argv, __doc__.splitlines()[0], Path(__file__), PAGE, render)
 
 
 if __name__ == "__main__":

@@ -2,14 +2,12 @@
 
 from __future__ import annotations
 
-import asyncio
-
 from fastapi import APIRouter, WebSocket
 
 from protocol import ErrorCode, Hello, ProtocolError
 from protocol.session import HELLO_LIMIT
 
-from ..doors import claim_run, error_frame, serve_client
+from ..doors import admit, serve_client
 from ..deps import websocket_subprotocol, websocket_token_ok
 from ..transports import WebSocketDoor
 
@@ -24,31 +22,13 @@ async def couple_websocket(ws: WebSocket, run_id: str) -> None:
     await ws.accept(subprotocol=websocket_subprotocol(ws))
     manager = ws.app.state.manager
     transport = WebSocketDoor(ws, min(HELLO_LIMIT, manager.settings.max_frame))
-    seq = 0
-    try:
-        frames = await asyncio.wait_for(transport.recv(), manager.settings.hello_timeout)
-        if frames is None:
-            return
-        seq, msg = frames[0]
-        if not isinstance(msg, Hello):
-            raise ProtocolError(ErrorCode.OUT_OF_ORDER, f"{msg.TYPE.name} before HELLO")
-        if msg.run_id not in ("", run_id):
-            raise ProtocolError(ErrorCode.BUSY, f"HELLO.run_id {msg.run_id!r} differs from the URL's {run_id!r}")
-        run = await claim_run(manager, run_id, msg, transport, seq)
-        if run is None:
-            return await transport.close()
-    except ProtocolError as exc:
-        await _refuse(transport, exc.code, exc.text, seq)
-        return
-    except TimeoutError:
-        await _refuse(transport, ErrorCode.TIMEOUT, f"no HELLO within {manager.settings.hello_timeout:g} s", 0)
-        return
-    await serve_client(manager, run, transport, frames)
 
+    def run_id_of(hello: Hello) -> str:
+        if hello.run_id not in ("", run_id):
+            raise ProtocolError(ErrorCode.BUSY, f"HELLO.run_id {hello.run_id!r} differs from the URL's {run_id!r}")
+        return run_id
 
-async def _refuse(transport: WebSocketDoor, code: ErrorCode, text: str, seq: int) -> None:
-    try:
-        await transport.send(error_frame(code, text, seq))
-    except Exception:  # noqa: BLE001 -- the peer may already be gone
-        pass
-    await transport.close()
+    admitted = await admit(manager, transport, run_id_of)
+    if admitted is not None:
+        run, frames = admitted
+        await serve_client(manager, run, transport, frames)

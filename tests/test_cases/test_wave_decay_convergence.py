@@ -15,7 +15,7 @@ import math
 import pytest
 
 from wavesph.cases.standing_wave import standing_wave_decay
-from wavesph.cases.wave_decay import convergence_orders
+from wavesph.cases.wave_decay import convergence_orders, convergence_record
 from sph_core.scene import Constants
 
 DPS = [0.025, 0.02, 0.01]   # tank 1.0 m long: whole numbers of spacings (no gap at the wall)
@@ -37,3 +37,11 @@ def test_standing_wave_loss_converges_with_resolution():
     assert overall >= 0.4, (decays, orders, overall)
     # H/dp 4 (dp 0.01): <= 3 % per wavelength (measured 2.4 %; issue target 2 %)
     assert runs[2].loss_per_wavelength(2.0) <= 0.03, decays
+
+
+def test_convergence_record_is_the_benches_summary_line():
+    # decay halves when dp halves: order 1; a non-positive decay has no order
+    record = convergence_record([0.02, 0.01, 0.005], [0.040004, 0.02, -0.01], "decay_per_m")
+    assert list(record) == ["dp", "decay_per_m", "convergence_order"]
+    assert record["decay_per_m"] == [0.04, 0.02, -0.01]
+    assert record["convergence_order"] == [1.0, None]

@@ -13,11 +13,12 @@ import threading
 
 import numpy as np
 import pytest
-from scipy.optimize import brentq
 
 from protocol import (ErrorCode, FrameDecoder, Nodes, ProtocolError, Result, SphSession, Welcome,
                       scene_hash)
 from protocol.session import PeerError, Reply, SetWindow, SolveWindow
+
+from linear_wave import airy
 
 G_ACC, DEPTH, H, T = 9.81, 0.6, 0.04, 1.2
 X_INLET = 0.0
@@ -82,15 +83,6 @@ class PythonPeer:
         self.listener.close()
 
 
-def airy(t: float, x: float, z: np.ndarray):
-    omega = 2 * np.pi / T
-    k = brentq(lambda k: omega**2 - G_ACC * k * np.tanh(k * DEPTH), 1e-6, 100.0, xtol=1e-15)
-    a, phase, zc = H / 2, k * x - omega * t, np.minimum(z, 0.0)
-    u = a * omega * np.cosh(k * (zc + DEPTH)) / np.sinh(k * DEPTH) * np.cos(phase)
-    w = a * omega * np.sinh(k * (zc + DEPTH)) / np.sinh(k * DEPTH) * np.sin(phase)
-    return u, w, a * np.cos(phase)
-
-
 def test_c_client_couples_a_linear_wave(c_client):
     peer = PythonPeer()
     run = subprocess.run([str(c_client), "127.0.0.1", str(peer.port), "run-c", "8", str(H), str(T), "0.05"],
@@ -102,7 +94,7 @@ def test_c_client_couples_a_linear_wave(c_client):
     for i, (words, window) in enumerate(zip(lines, peer.sets)):
         t1 = 0.05 * (i + 1)
         assert window.t0 == pytest.approx(0.05 * i) and window.t1 == pytest.approx(t1)
-        u, w, eta = airy(t1, X_INLET, peer.nodes.z)
+        u, w, eta = airy(X_INLET, peer.nodes.z, t1, H, T, DEPTH, G_ACC)
         np.testing.assert_allclose(window.u, u, rtol=1e-12, atol=1e-15)
         np.testing.assert_allclose(window.w, w, rtol=1e-12, atol=1e-15)
         np.testing.assert_allclose(window.eta, eta, rtol=1e-12, atol=1e-15)

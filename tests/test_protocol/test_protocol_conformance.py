@@ -9,6 +9,7 @@ import subprocess
 import sys
 import threading
 from pathlib import Path
+from typing import Callable
 
 import numpy as np
 
@@ -56,30 +57,26 @@ def _handshake(sock: socket.socket, dec: FrameDecoder) -> int:
     return welcome.n_nodes
 
 
-def test_a_client_with_a_gap_in_its_seq_fails_the_seq_check():
-    def broken(port: int) -> None:
+def _one_window_without_bye(solve_seq: int) -> Callable[[int], None]:
+    """A client that couples one window, its SOLVE sent as frame ``solve_seq`` (4 in order), and
+    leaves after the reply without BYE."""
+    def client(port: int) -> None:
         with socket.create_connection(("127.0.0.1", port)) as sock:
-            dec = FrameDecoder()
-            n = _handshake(sock, dec)
+            n = _handshake(sock, FrameDecoder())
             z = np.zeros(n)
-            sock.sendall(encode_frame(Set(0.0, 0.05, z, z, z), 3) + encode_frame(Solve(), 5))
+            sock.sendall(encode_frame(Set(0.0, 0.05, z, z, z), 3) + encode_frame(Solve(), solve_seq))
             sock.recv(1 << 16)
+    return client
 
-    rep = _scripted(broken)
+
+def test_a_client_with_a_gap_in_its_seq_fails_the_seq_check():
+    rep = _scripted(_one_window_without_bye(solve_seq=5))
     assert not rep.ok
     assert rep.failed()[0] == "message order and seq 1, 2, 3, ..."
 
 
 def test_a_client_that_leaves_without_bye_fails_the_bye_check():
-    def no_bye(port: int) -> None:
-        with socket.create_connection(("127.0.0.1", port)) as sock:
-            dec = FrameDecoder()
-            n = _handshake(sock, dec)
-            z = np.zeros(n)
-            sock.sendall(encode_frame(Set(0.0, 0.05, z, z, z), 3) + encode_frame(Solve(), 4))
-            dec.feed(sock.recv(1 << 16))
-
-    rep = _scripted(no_bye)
+    rep = _scripted(_one_window_without_bye(solve_seq=4))
     assert rep.failed() == ["BYE at the end"]
     assert ("PASS", "at least one window solved", "1 windows") in rep.lines
 

@@ -8,7 +8,10 @@ from pathlib import Path
 
 import httpx
 
+from protocol import Nodes, Welcome
 from wavesph.local_server import InProcessServer
+
+from coupling_client import TcpClient, handshake
 
 
 def scene(**overrides) -> dict:
@@ -23,6 +26,18 @@ def scene(**overrides) -> dict:
     }
     base.update(overrides)
     return base
+
+
+def open_flume(name: str, t_end: float, depth: float) -> dict:
+    """A 1.2 m flume with open ends, both absorbing (the left's elevation imposed, the right's
+    extrapolated), dp 0.04 m, one elevation gauge g1 at x = 0.6 m."""
+    return {"name": name, "dp": 0.04, "t_end": t_end, "still_water_level": depth,
+            "tank": {"x0": 0.0, "x1": 1.2, "z0": 0.0, "z1": 0.45},
+            "water_blocks": [{"x0": 0.0, "x1": 1.2, "z0": 0.0, "z1": depth}],
+            "open_boundaries": [{"side": "left", "elevation": "imposed", "absorb": True},
+                                {"side": "right", "elevation": "extrapolated", "absorb": True}],
+            "probes": [{"kind": "elevation", "name": "g1", "x": 0.6}],
+            "output": {"probe_every": 0.05}}
 
 
 class LiveServer(InProcessServer):
@@ -50,6 +65,14 @@ class LiveServer(InProcessServer):
         r = self.http.post("/runs", json={"scene": scene(**scene_overrides), "mode": mode})
         assert r.status_code == 201, r.text
         return r.json()
+
+    def couple(self, run_id: str, timeout: float = 10.0, **handshake_kw) -> tuple[TcpClient, Welcome, Nodes]:
+        """A TCP client of the run once it waits for one, past HELLO and GETNODES (``timeout``:
+        the client's reads; a longer one waits longer for the run too, e.g. an SPH flume's build)."""
+        self.wait_state(run_id, "waiting_for_client", timeout=max(30.0, timeout))
+        client = TcpClient(self.tcp_port, timeout=timeout)
+        welcome, nodes = handshake(client, run_id, **handshake_kw)
+        return client, welcome, nodes
 
     def wait_state(self, run_id: str, *states: str, timeout: float = 30.0) -> dict:
         deadline = time.monotonic() + timeout

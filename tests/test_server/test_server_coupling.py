@@ -63,9 +63,7 @@ def test_coupled_run_end_to_end(srv, engines, door):
 
 def test_goback_redoes_the_last_window_and_its_gauge_row(srv, engines):
     run = srv.create()
-    srv.wait_state(run["id"], "waiting_for_client")
-    client = TcpClient(srv.tcp_port)
-    welcome, nodes = handshake(client, run["id"])
+    client, welcome, nodes = srv.couple(run["id"])
     run_windows(client, welcome, nodes, 2)
     back = client.request(GoBack(), expect=Result)
     assert back.t == pytest.approx(0.05) and back.eta[0] == pytest.approx(0.01)
@@ -129,9 +127,7 @@ def test_bad_input_on_the_tcp_door_gets_a_clear_error_and_the_server_keeps_servi
     bye(c)
     srv.wait_state(run["id"], "finished")
     run2 = srv.create()
-    srv.wait_state(run2["id"], "waiting_for_client")
-    c = TcpClient(srv.tcp_port)
-    welcome, nodes = handshake(c, run2["id"])
+    c, welcome, nodes = srv.couple(run2["id"])
     run_windows(c, welcome, nodes, 1)
     bye(c)
     srv.wait_state(run2["id"], "finished")
@@ -139,9 +135,7 @@ def test_bad_input_on_the_tcp_door_gets_a_clear_error_and_the_server_keeps_servi
 
 def test_nan_array_and_wrong_shape_are_refused_naming_the_field(srv):
     run = srv.create()
-    srv.wait_state(run["id"], "waiting_for_client")
-    c = TcpClient(srv.tcp_port)
-    welcome, nodes = handshake(c, run["id"])
+    c, welcome, nodes = srv.couple(run["id"])
     n = welcome.n_nodes
     good = c.session.request(Set(0.0, 0.05, np.arange(n, dtype=float), np.zeros(n), np.zeros(n)))
     c.send_raw(good.replace(struct.pack("<d", 1.0), struct.pack("<d", float("nan"))))  # u[1]
@@ -150,18 +144,14 @@ def test_nan_array_and_wrong_shape_are_refused_naming_the_field(srv):
     assert "SET.u[1]" in info["status"]
 
     run = srv.create()
-    srv.wait_state(run["id"], "waiting_for_client")
-    c = TcpClient(srv.tcp_port)
-    welcome, nodes = handshake(c, run["id"])
+    c, welcome, nodes = srv.couple(run["id"])
     c.request(Set(0.0, 0.05, np.ones(n + 1), np.zeros(n + 1), np.zeros(n + 1)))
     assert f"SET.u has {n + 1} values" in _expect_error(c, ErrorCode.SHAPE_MISMATCH)
 
 
 def test_oversized_frame_is_refused_from_its_header(srv):
     run = srv.create()
-    srv.wait_state(run["id"], "waiting_for_client")
-    c = TcpClient(srv.tcp_port)
-    handshake(c, run["id"])
+    c, _, _ = srv.couple(run["id"])
     c.send_raw(HEADER.pack(MAGIC, 1, MessageType.SET, 3, 10**8))  # announces 100 MB, sends none
     _expect_error(c, ErrorCode.FRAME_TOO_LARGE)
 
@@ -185,9 +175,7 @@ def test_websocket_text_message_and_second_client(srv):
 def test_silent_client_times_out(tmp_path, factory):
     with live_server(tmp_path, factory, idle_timeout=0.5, hello_timeout=0.5) as srv:
         run = srv.create()
-        srv.wait_state(run["id"], "waiting_for_client")
-        c = TcpClient(srv.tcp_port)
-        handshake(c, run["id"])
+        c, _, _ = srv.couple(run["id"])
         assert "no frame for 0.5 s" in _expect_error(c, ErrorCode.TIMEOUT)
         info = srv.wait_state(run["id"], "failed")
         assert info["status"] == "failed: client timed out (silent for 0.5 s)"
@@ -198,9 +186,7 @@ def test_silent_client_times_out(tmp_path, factory):
 def test_unstable_engine_is_reported_to_client_and_in_the_status(tmp_path, factory):
     with live_server(tmp_path, lambda r, d: factory(r, d, unstable_after=0.12)) as srv:
         run = srv.create()
-        srv.wait_state(run["id"], "waiting_for_client")
-        c = TcpClient(srv.tcp_port)
-        welcome, nodes = handshake(c, run["id"])
+        c, welcome, nodes = srv.couple(run["id"])
         run_windows(c, welcome, nodes, 2)
         n = welcome.n_nodes
         c.request(Set(0.1, 0.15, np.zeros(n), np.zeros(n), np.zeros(n)), Solve())
@@ -212,9 +198,7 @@ def test_unstable_engine_is_reported_to_client_and_in_the_status(tmp_path, facto
 
 def test_cancel_during_coupling_sends_cancelled(srv):
     run = srv.create()
-    srv.wait_state(run["id"], "waiting_for_client")
-    c = TcpClient(srv.tcp_port)
-    welcome, nodes = handshake(c, run["id"])
+    c, welcome, nodes = srv.couple(run["id"])
     run_windows(c, welcome, nodes, 1)
     info = srv.http.delete(f"/runs/{run['id']}").json()
     assert info["status"] == "cancelled"
@@ -225,9 +209,7 @@ def test_cancel_during_coupling_sends_cancelled(srv):
 def test_client_vanishing_during_a_solve_keeps_that_window(tmp_path, factory):
     with live_server(tmp_path, lambda r, d: factory(r, d, solve_delay=0.5)) as srv:
         run = srv.create()
-        srv.wait_state(run["id"], "waiting_for_client")
-        c = TcpClient(srv.tcp_port)
-        welcome, nodes = handshake(c, run["id"])
+        c, welcome, nodes = srv.couple(run["id"])
         n = welcome.n_nodes
         c.request(Set(0.0, 0.05, np.ones(n), np.zeros(n), np.ones(n)), Solve())
         c.sock.setsockopt(socket.SOL_SOCKET, socket.SO_LINGER, struct.pack("ii", 1, 0))
@@ -277,9 +259,7 @@ def test_concurrent_runs_one_bad_client_does_not_disturb_the_other(srv):
 def test_a_run_whose_client_vanished_resumes_from_its_last_window(srv, engines):
     run = srv.create()
     assert srv.http.post(f"/runs/{run['id']}/resume").status_code == 409  # nothing to resume yet
-    srv.wait_state(run["id"], "waiting_for_client")
-    c = TcpClient(srv.tcp_port)
-    welcome, nodes = handshake(c, run["id"])
+    c, welcome, nodes = srv.couple(run["id"])
     run_windows(c, welcome, nodes, 3)
     c.close()
     info = srv.wait_state(run["id"], "failed")

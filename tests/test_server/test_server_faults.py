@@ -317,12 +317,8 @@ def test_client_of_a_queued_run_reserves_it_and_waits_for_welcome(tmp_path, fact
 def test_second_hello_is_named_as_such(srv):
     from protocol import ErrorCode, Hello, RemoteError, Result
 
-    from coupling_client import TcpClient, handshake
-
     run = srv.create()
-    srv.wait_state(run["id"], "waiting_for_client")
-    c = TcpClient(srv.tcp_port)
-    handshake(c, run["id"])
+    c, _, _ = srv.couple(run["id"])
     c.request(Hello(1, bytes(32), run["id"], "again"))
     with pytest.raises(RemoteError) as exc:
         c.session.reply(*c.recv(), expect=Result)
@@ -344,13 +340,11 @@ def test_public_tcp_host_without_token_names_the_tcp_host(tmp_path):
 def test_meta_catches_up_with_gauges_after_a_crash(tmp_path, factory):
     import shutil
 
-    from coupling_client import TcpClient, handshake, run_windows
+    from coupling_client import run_windows
 
     with live_server(tmp_path, factory, meta_interval=1000.0) as srv:
         run = srv.create()
-        srv.wait_state(run["id"], "waiting_for_client")
-        c = TcpClient(srv.tcp_port)
-        welcome, nodes = handshake(c, run["id"])
+        c, welcome, nodes = srv.couple(run["id"])
         run_windows(c, welcome, nodes, 5)
         # the disk as a kill -9 would leave it now: gauges.csv has 5 rows, meta.json fewer
         crashed = tmp_path / "crashed" / "runs"
@@ -365,13 +359,11 @@ def test_meta_catches_up_with_gauges_after_a_crash(tmp_path, factory):
 
 
 def test_damaged_saved_state_is_not_resumable(tmp_path, factory):
-    from coupling_client import TcpClient, handshake, run_windows
+    from coupling_client import run_windows
 
     with live_server(tmp_path, factory) as srv:
         run = srv.create()
-        srv.wait_state(run["id"], "waiting_for_client")
-        c = TcpClient(srv.tcp_port)
-        welcome, nodes = handshake(c, run["id"])
+        c, welcome, nodes = srv.couple(run["id"])
         run_windows(c, welcome, nodes, 2)
         c.close()
         assert srv.wait_state(run["id"], "failed")["resumable"]
@@ -393,13 +385,11 @@ def test_damaged_saved_state_is_not_resumable(tmp_path, factory):
 def test_state_is_saved_by_simulated_progress_too(tmp_path, factory):
     import shutil
 
-    from coupling_client import TcpClient, bye, handshake, run_windows
+    from coupling_client import bye, run_windows
 
     with live_server(tmp_path, factory, checkpoint_every=1000.0, checkpoint_every_t=0.1) as srv:
         run = srv.create()
-        srv.wait_state(run["id"], "waiting_for_client")
-        c = TcpClient(srv.tcp_port)
-        welcome, nodes = handshake(c, run["id"])
+        c, welcome, nodes = srv.couple(run["id"])
         run_windows(c, welcome, nodes, 3)  # to t = 0.15: a state saved at t = 0.1
         crashed = tmp_path / "crashed" / "runs"  # the disk as a kill -9 leaves it now
         shutil.copytree(tmp_path / "runs", crashed)
@@ -408,9 +398,7 @@ def test_state_is_saved_by_simulated_progress_too(tmp_path, factory):
         info = srv.http.get(f"/runs/{run['id']}").json()
         assert info["resumable"] and info["windows"] == 3
         assert srv.http.post(f"/runs/{run['id']}/resume").status_code == 202
-        srv.wait_state(run["id"], "waiting_for_client")
-        c = TcpClient(srv.tcp_port)
-        welcome, nodes = handshake(c, run["id"])
+        c, welcome, nodes = srv.couple(run["id"])
         assert welcome.t_start == pytest.approx(0.1)
         run_windows(c, welcome, nodes, 1, t0=0.1)
         bye(c)

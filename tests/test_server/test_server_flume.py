@@ -9,34 +9,23 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from scipy.optimize import brentq
 
 from protocol import Result, Set, Solve
 from server.flume_engine import FlumeEngine
 from server.main import create_app  # noqa: F401  (default engine factory: the flume)
 from server.schemas import RunRequest
 
-from server_harness import live_server
-from coupling_client import TcpClient, bye, handshake
+from server_harness import live_server, open_flume
+from coupling_client import bye
+from linear_wave import airy
 
 G, DEPTH, H, T, WINDOW = 9.81, 0.3, 0.02, 1.0, 0.05
-FLUME = {"name": "flume", "dp": 0.04, "t_end": 1.0, "still_water_level": DEPTH,
-         "tank": {"x0": 0.0, "x1": 1.2, "z0": 0.0, "z1": 0.45},
-         "water_blocks": [{"x0": 0.0, "x1": 1.2, "z0": 0.0, "z1": DEPTH}],
-         "open_boundaries": [{"side": "left", "elevation": "imposed", "absorb": True},
-                             {"side": "right", "elevation": "extrapolated", "absorb": True}],
-         "probes": [{"kind": "elevation", "name": "g1", "x": 0.6}],
-         "output": {"probe_every": 0.05}}
+FLUME = open_flume("flume", t_end=1.0, depth=DEPTH)
 
 
-def airy(x: np.ndarray, z: np.ndarray, t: float):
-    """Linear wave at nodes (z up from still water; no extrapolation above it)."""
-    omega = 2 * np.pi / T
-    k = brentq(lambda k: omega**2 - G * k * np.tanh(k * DEPTH), 1e-6, 100.0, xtol=1e-15)
-    a, phase, zc = H / 2, k * x - omega * t, np.minimum(z, 0.0)
-    u = a * omega * np.cosh(k * (zc + DEPTH)) / np.sinh(k * DEPTH) * np.cos(phase)
-    w = a * omega * np.sinh(k * (zc + DEPTH)) / np.sinh(k * DEPTH) * np.sin(phase)
-    return u, w, a * np.cos(phase)
+def wave(x: np.ndarray, z: np.ndarray, t: float):
+    """The flume's linear wave at nodes."""
+    return airy(x, z, t, H, T, DEPTH, G)
 
 
 def test_flume_over_tcp_equals_the_flume_in_process(tmp_path):
@@ -46,15 +35,13 @@ def test_flume_over_tcp_equals_the_flume_in_process(tmp_path):
         r = srv.http.post("/runs", json=body)
         assert r.status_code == 201, r.text
         run = r.json()
-        srv.wait_state(run["id"], "waiting_for_client", timeout=120)
-        c = TcpClient(srv.tcp_port, timeout=120)
-        welcome, nodes = handshake(c, run["id"], scene_hash=bytes.fromhex(run["scene_hash"]))
+        c, welcome, nodes = srv.couple(run["id"], timeout=120, scene_hash=bytes.fromhex(run["scene_hash"]))
         assert welcome.depth == pytest.approx(DEPTH) and welcome.z_ref == pytest.approx(-DEPTH / 2)
         assert sorted(set(nodes.side.tolist())) == [0, 1] and nodes.gauge_x.size == 3
         assert nodes.x[nodes.side == 0].max() == 0.0 and nodes.x[nodes.side == 1].min() == 1.2
         t = 0.0
         for _ in range(4):
-            u, w, eta = airy(nodes.x, nodes.z, t + WINDOW)
+            u, w, eta = wave(nodes.x, nodes.z, t + WINDOW)
             sent.append((t, t + WINDOW, u, w, eta))
             got.append(c.request(Set(t, t + WINDOW, u, w, eta), Solve(), expect=Result))
             t += WINDOW
@@ -80,9 +67,7 @@ def test_flume_refuses_boundary_data_outside_the_tank(tmp_path):
     body = {"scene": FLUME, "mode": "coupled", "coupling": {"window_max": WINDOW}}
     with live_server(tmp_path) as srv:
         run = srv.http.post("/runs", json=body).json()
-        srv.wait_state(run["id"], "waiting_for_client", timeout=120)
-        c = TcpClient(srv.tcp_port, timeout=120)
-        welcome, nodes = handshake(c, run["id"])
+        c, welcome, nodes = srv.couple(run["id"], timeout=120)
         n = welcome.n_nodes
         c.request(Set(0.0, WINDOW, np.zeros(n), np.zeros(n), np.full(n, 5.0)), Solve())
         from protocol import ErrorCode, RemoteError
@@ -100,12 +85,10 @@ def test_resumed_flume_continues_exactly(tmp_path):
     with live_server(tmp_path) as srv:
         run = srv.http.post("/runs", json=body).json()
         for session in range(2):
-            srv.wait_state(run["id"], "waiting_for_client", timeout=120)
-            c = TcpClient(srv.tcp_port, timeout=120)
-            welcome, nodes = handshake(c, run["id"])
+            c, welcome, nodes = srv.couple(run["id"], timeout=120)
             t = welcome.t_start
             for _ in range(2):
-                got.append(c.request(Set(t, t + WINDOW, *airy(nodes.x, nodes.z, t + WINDOW)), Solve(),
+                got.append(c.request(Set(t, t + WINDOW, *wave(nodes.x, nodes.z, t + WINDOW)), Solve(),
                                      expect=Result))
                 t += WINDOW
             c.close()
@@ -116,7 +99,7 @@ def test_resumed_flume_continues_exactly(tmp_path):
     engine = FlumeEngine(RunRequest.model_validate(body), None)
     t = 0.0
     for res in got:
-        engine.set_window(t, t + WINDOW, *airy(nodes.x, nodes.z, t + WINDOW))
+        engine.set_window(t, t + WINDOW, *wave(nodes.x, nodes.z, t + WINDOW))
         m = engine.solve_window()
         t += WINDOW
         assert res.steps == m.steps

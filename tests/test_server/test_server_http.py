@@ -124,9 +124,7 @@ def test_event_loop_is_not_blocked_by_stepping(tmp_path, factory):
     gate = threading.Event()  # the solve lasts until the test opens it: no timing guess
     with live_server(tmp_path, lambda r, d: factory(r, d, gate=gate)) as srv:
         run = srv.create()
-        srv.wait_state(run["id"], "waiting_for_client")
-        c = TcpClient(srv.tcp_port)
-        welcome, nodes = handshake(c, run["id"])
+        c, welcome, nodes = srv.couple(run["id"])
         n = welcome.n_nodes
         from protocol import Set, Solve
         import numpy as np
@@ -158,9 +156,7 @@ def test_run_detail_says_when_kernels_compile(monkeypatch, cached, detail):
 def test_restart_lists_finished_runs_with_their_data(tmp_path, factory):
     with live_server(tmp_path, factory) as srv:
         run = srv.create()
-        srv.wait_state(run["id"], "waiting_for_client")
-        c = TcpClient(srv.tcp_port)
-        welcome, nodes = handshake(c, run["id"])
+        c, welcome, nodes = srv.couple(run["id"])
         run_windows(c, welcome, nodes, 3)
         bye(c)
         srv.wait_state(run["id"], "finished")
@@ -207,18 +203,14 @@ def test_settings_from_environment(tmp_path):
 def test_run_interrupted_by_a_server_stop_resumes_after_restart(tmp_path, factory):
     with live_server(tmp_path, factory) as srv:
         run = srv.create()
-        srv.wait_state(run["id"], "waiting_for_client")
-        c = TcpClient(srv.tcp_port)
-        welcome, nodes = handshake(c, run["id"])
+        c, welcome, nodes = srv.couple(run["id"])
         run_windows(c, welcome, nodes, 2)
     # the server stopped under the connected client: the run says so, and kept its state
     with live_server(tmp_path, factory) as srv:
         info = srv.http.get(f"/runs/{run['id']}").json()
         assert info["status"] == "failed: server stopped before the run ended" and info["resumable"]
         assert srv.http.post(f"/runs/{run['id']}/resume").status_code == 202
-        srv.wait_state(run["id"], "waiting_for_client")
-        c = TcpClient(srv.tcp_port)
-        welcome, nodes = handshake(c, run["id"])
+        c, welcome, nodes = srv.couple(run["id"])
         assert welcome.t_start == pytest.approx(0.1)
         run_windows(c, welcome, nodes, 1, t0=0.1)
         bye(c)

@@ -15,16 +15,10 @@ import pytest
 from wave_client.coupling import CouplingOptions, couple
 from wave_client.theories import build_theory
 
-from server_harness import live_server
+from server_harness import live_server, open_flume
 
 DEPTH, H, T, RAMP = 0.3, 0.02, 1.0, 0.5
-FLUME = {"name": "theory-flume", "dp": 0.04, "t_end": 0.3, "still_water_level": DEPTH,
-         "tank": {"x0": 0.0, "x1": 1.2, "z0": 0.0, "z1": 0.45},
-         "water_blocks": [{"x0": 0.0, "x1": 1.2, "z0": 0.0, "z1": DEPTH}],
-         "open_boundaries": [{"side": "left", "elevation": "imposed", "absorb": True},
-                             {"side": "right", "elevation": "extrapolated", "absorb": True}],
-         "probes": [{"kind": "elevation", "name": "g1", "x": 0.6}],
-         "output": {"probe_every": 0.05}}
+FLUME = open_flume("theory-flume", t_end=0.3, depth=DEPTH)
 SOURCE = {"theory": "stokes", "H": H, "T": T, "order": 2, "ramp_periods": RAMP / T}
 
 

@@ -60,6 +60,16 @@ def heave_release(length: float, depth: float, breadth: float, draft: float, mas
     rhs_s = sp.lil_matrix((n, ns))      # contribution of the surface values (Dirichlet)
     rhs_w = np.zeros(n)                 # contribution of W = 1 (bottom Neumann)
     spos = {int(i): s for s, i in enumerate(surf_i)}
+
+    def couple(r: int, a: int, b: int) -> None:
+        """Row r's coefficient 1 on node (a, b): a known surface value goes to the right side."""
+        if surface(a, b):
+            rhs_s[r, spos[a]] -= 1.0
+        else:
+            rows.append(r)
+            cols.append(idx[a, b])
+            vals.append(1.0)
+
     for i in range(nx + 1):
         for j in range(nz + 1):
             r = idx[i, j]
@@ -71,22 +81,11 @@ def heave_release(length: float, depth: float, breadth: float, draft: float, mas
             for di, dj in ((1, 0), (-1, 0), (0, 1), (0, -1)):
                 a, b = i + di, j + dj
                 if 0 <= a <= nx and 0 <= b <= nz and not in_box(a, b):
-                    if surface(a, b):
-                        rhs_s[r, spos[a]] -= 1.0
-                    else:
-                        rows.append(r)
-                        cols.append(idx[a, b])
-                        vals.append(1.0)
+                    couple(r, a, b)
                 else:
                     # ghost node: mirror of the opposite neighbour; a box-bottom ghost (above the
                     # bottom) adds 2 dx W (dphi/dz = W), the others are dphi/dn = 0
-                    a2, b2 = i - di, j - dj
-                    if surface(a2, b2):
-                        rhs_s[r, spos[a2]] -= 1.0
-                    else:
-                        rows.append(r)
-                        cols.append(idx[a2, b2])
-                        vals.append(1.0)
+                    couple(r, i - di, j - dj)
                     if dj == 1 and ia < i < ib and j == jb:
                         rhs_w[r] -= 2.0 * dx
     lu = splu(sp.csc_matrix((vals, (rows, cols)), shape=(n, n)))

@@ -38,3 +38,37 @@ def scheme_from_args(a: argparse.Namespace) -> dict[str, Any]:
     if a.scheme == "isph" and a.ppe_solver is not None:
         out["ppe_solver"] = a.ppe_solver
     return out
+
+
+def add_constant_arguments(ap: argparse.ArgumentParser, open_ends: bool = False) -> None:
+    """The [constants] options a bench varies (sph_core.scene.Constants); unset keeps the scene's."""
+    ap.add_argument("--h-over-dp", type=float, help="smoothing length / dp (scene default if unset)")
+    ap.add_argument("--alpha", type=float, help="artificial viscosity coefficient")
+    ap.add_argument("--slip", choices=["no_slip", "free_slip"], help="wall (bed) condition")
+    ap.add_argument("--delta", type=float, help="delta-SPH density diffusion coefficient")
+    ap.add_argument("--cfl", type=float, help="Courant number")
+    ap.add_argument("--integrator", choices=["kdk", "symplectic_pc"])
+    ap.add_argument("--nu", type=float, help="laminar kinematic viscosity [m^2/s]")
+    ap.add_argument("--shifting", choices=["none", "fickian", "dplus"], help="particle shifting")
+    ap.add_argument("--shift-a", type=float, help="shifting coefficient A (Lind et al. 2012)")
+    ap.add_argument("--shift-fs-div", type=float, help="free-surface position-divergence limit")
+    ap.add_argument("--shift-dplus-scale", type=float, help="dplus: multiplier on CFL Ma (2h)^2")
+    if open_ends:
+        ap.add_argument("--shift-open-end", choices=["full", "none"],
+                        help="shifting next to an open end's buffer")
+    ap.add_argument("--no-shift-carry", action="store_true",
+                    help="do not Taylor-carry rho, v of a shifted particle")
+    ap.add_argument("--alpha-wall", type=float, help="artificial viscosity factor against walls")
+
+
+def constants_from_args(a: argparse.Namespace) -> dict[str, Any]:
+    """The [constants] table of the options add_constant_arguments parsed: only those given."""
+    given = {"h_over_dp": a.h_over_dp, "alpha": a.alpha, "wall_slip": a.slip,
+             "delta": a.delta, "cfl": a.cfl, "nu": a.nu,
+             "integrator": a.integrator, "shifting": a.shifting,
+             "shift_a": a.shift_a, "shift_fs_div": a.shift_fs_div,
+             "alpha_wall_factor": a.alpha_wall,
+             "shift_dplus_scale": a.shift_dplus_scale,
+             "shift_carry": False if a.no_shift_carry else None,
+             "shift_open_end": getattr(a, "shift_open_end", None)}
+    return {k: v for k, v in given.items() if v is not None}

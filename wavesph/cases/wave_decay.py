@@ -175,3 +175,10 @@ def convergence_orders(dps: list[float], decays: list[float]) -> list[float | No
     for (d1, k1), (d2, k2) in zip(zip(dps, decays), zip(dps[1:], decays[1:])):
         out.append(round(math.log(k1 / k2) / math.log(d1 / d2), 3) if k1 > 0 and k2 > 0 else None)
     return out
+
+
+def convergence_record(dps: list[float], decays: list[float], key: str) -> dict[str, Any]:
+    """A dp sweep's summary line: the spacings, each one's decay [1/m] under ``key`` (4
+    decimals), and the observed orders between successive spacings."""
+    return {"dp": dps, key: [round(k, 4) for k in decays],
+            "convergence_order": convergence_orders(dps, decays)}
