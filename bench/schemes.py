@@ -56,7 +56,6 @@ ENTRIES: list[tuple[str, dict[str, Any]]] = [
     # wave_failed with the UnstableError
     ("isph_bicgstab", {"scheme": {"kind": "isph", "ppe_solver": "bicgstab"}}),  # the default
     ("isph_amg", {"scheme": {"kind": "isph", "ppe_solver": "amg"}}),
-    ("isph_explicit", {"scheme": {"kind": "isph", "ppe_solver": "explicit"}}),
 ]
 
 _G = 9.81

@@ -10,8 +10,8 @@ One step (i fluid, j neighbour, r_ij = r_i - r_j, grad_i W_ij = -F_ij r_ij, V_j 
 on the sorted state at t^n (docs/schemes.md "## ISPH" has the measurements behind each choice):
 
 1. free surface (Dirichlet p = 0): the position divergence sum_j V_j F_ij r_ij^2 <= 1.5
-   (``free_surface = "divergence"``, the default; 2 inside the fluid in 2D, Lind et al. 2012), or
-   seed 004's fake density rho_f,i = sum_j m_j W_ij <= 0.9 rho0 (eq. 23-24, ``"density"``);
+   (``free_surface_threshold``; 2 inside the fluid in 2D, Lind et al. 2012; seed 004's density
+   criterion is retired: docs/decisions/free_surface.md);
 2. predictor (eq. 7): u*_i = u^n_i + dt (g + nu lap u_i), the Lo & Shao (2002) laminar term of
    wcsph.fluid_pass; walls: Adami et al. (2012) no-slip velocity;
 3. pressure Poisson equation (eq. 9-12), one sparse system over the interior fluid particles
@@ -30,17 +30,18 @@ on the sorted state at t^n (docs/schemes.md "## ISPH" has the measurements behin
    condition): with the wall velocity also in div u* the hydrostatic column came out 1.45x too
    heavy, and with the plain Adami rows fluid driven at the bed went through it (the wall pressure
    rises with the fluid's). Free-surface particles enter with p = 0. Solved by ``ppe_solver``:
-   ``explicit`` = the seed's Jacobi iteration p_k <- (b_k - sum_{j != k} a_kj p_j) / a_kk
-   (Hosseini et al. 2007, eq. 13; the wall rows updated in the same sweep), ``bicgstab`` (the
-   default) = BiCGSTAB preconditioned by the diagonal, jitted, ``amg`` = BiCGSTAB preconditioned
-   by smoothed-aggregation AMG (pyamg), ``ilu`` = BiCGSTAB with incomplete LU, ``direct`` =
-   SuperLU; the iterative ones warm-started from the last pressure. The no-penetration part
+   ``bicgstab`` (the default) = BiCGSTAB preconditioned by the diagonal, jitted, ``amg`` =
+   BiCGSTAB preconditioned by smoothed-aggregation AMG (pyamg), both warm-started from the last
+   pressure (the seed's Jacobi iteration, ILU and SuperLU are retired:
+   docs/decisions/ppe_solver.md). The no-penetration part
    stops the approach within ``isph_wall_stop`` steps (rho |u_n| d / (stop dt)); it and the
    source scale as 1/dt, so ``IsphStepper.run`` never ends a run on a sliver step;
 4. corrector (eq. 16-17): u^{n+1} = u* - dt grad p_i / rho0, r^{n+1} = r^n + dt (u^n + u^{n+1}) / 2,
    grad p by the renormalised difference B_i^-1 sum_j V_j (p_j - p_i) grad_i W_ij (Bonet & Lok
-   1999; ``isph_gradient = "corrected"``, the default) or seed eq. 5 (``"symmetric"``: the
-   surface layer, its kernel cut, then falls at ~g/3 and the still tank blew up within 40 steps);
+   1999), seed eq. 5 only where B_i is near-singular (seed eq. 5 everywhere is retired: the
+   surface layer, its kernel cut, fell at ~g/3; docs/decisions/isph_gradient.md); wall
+   particles with p < 0 (the air side of a wetted wall) are left out like air
+   (docs/decisions/isph_dry_walls.md);
 5. open ends (the hooks of step.py's kdk step, same places): update_buffers after the drift
    (buffers imposed and moved, crossings), extrapolate_buffers after the sort, measure_boundaries
    at the end; then every particle's density is reset to rho0 (the buffers' Tait density of
@@ -84,13 +85,12 @@ from .shifting import shift_particles
 from .wcsph import (FASTMATH, ST_CAPACITY, ST_LEFT_DOMAIN, ST_NONFINITE, ST_REACHED_T,
                     ST_STEP_LIMIT)
 
-PPE_SOLVERS = ("explicit", "amg", "ilu", "direct", "bicgstab")
-FS_DEFAULT_THRESHOLD = {"density": 0.9, "divergence": 1.5}
+PPE_SOLVERS = ("bicgstab", "amg")
 MAX_ROW = 64   # non-zeros per PPE row, generous: a full 2D support at h/dp 2 has ~50 neighbours
 
 
 @njit(parallel=True, cache=True, fastmath=FASTMATH)
-def free_surface_flags(ps, n, cells, prm, by_density, threshold, flag, rho_k):
+def free_surface_flags(ps, n, cells, prm, threshold, flag, rho_k):
     """flag[i] = 1 for a free-surface fluid particle, 0 for an interior one, -1 for the rest;
     rho_k[i] = sum_j m_j W_ij (fluid and wall, self included) of every fluid particle."""
     x = ps.x
@@ -124,10 +124,7 @@ def free_surface_flags(ps, n, cells, prm, by_density, threshold, flag, rho_k):
                             sr += m[j] * w_of_q(q, aw)
                             sdiv += m[j] / rho0 * f_of_q(q, af) * r2
             rho_k[i] = sr
-            if by_density:
-                flag[i] = 1 if sr <= threshold * rho0 else 0
-            else:
-                flag[i] = 1 if sdiv <= threshold else 0
+            flag[i] = 1 if sdiv <= threshold else 0
 
 
 @njit(parallel=True, cache=True, fastmath=FASTMATH)
@@ -418,39 +415,6 @@ def compact_rows(m, indptr, indices, data, out_ptr):
 
 
 @njit(parallel=True, cache=True)
-def jacobi(indptr, indices, data, b, x, x2, m, tol, max_iter):
-    """The seed's explicit iteration (Hosseini et al. 2007): Jacobi sweeps on the CSR system
-    (diagonal first in each row) until |b - A x| <= tol |b|; returns (iterations, relative
-    residual). The residual of the sweep's input is a_kk (x_new - x)_k, so it costs nothing."""
-    bn = 0.0
-    for k in range(m):
-        bn += b[k] * b[k]
-    bn = math.sqrt(bn)
-    if bn == 0.0:
-        bn = 1.0
-    it = 0
-    rel = 1.0
-    while it < max_iter:
-        r2 = 0.0
-        for k in prange(m):
-            s = b[k]
-            for c in range(indptr[k] + 1, indptr[k + 1]):
-                s -= data[c] * x[indices[c]]
-            d = data[indptr[k]]
-            xn = s / d
-            r = d * (xn - x[k])
-            r2 += r * r
-            x2[k] = xn
-        for k in prange(m):
-            x[k] = x2[k]
-        it += 1
-        rel = math.sqrt(r2) / bn
-        if rel <= tol:
-            break
-    return it, rel
-
-
-@njit(parallel=True, cache=True)
 def scatter_pressure(ps, m, slot, sol, flag):
     """p of every unknown from the solution; free-surface fluid p = 0. Walls keep a negative
     solution (unlike wcsph.wall_pass's no-suction clamp): the corrector must see the pressures
@@ -464,11 +428,13 @@ def scatter_pressure(ps, m, slot, sol, flag):
 
 
 @njit(parallel=True, cache=True, fastmath=FASTMATH)
-def correct(ps, n, cells, prm, dt, corrected, dry_walls):
+def correct(ps, n, cells, prm, dt):
     """u^{n+1} = u* - dt (grad p / rho)_i (eq. 16), r^{n+1} = r^n + dt (u^n + u^{n+1}) / 2
-    (eq. 17); grad p by seed eq. 5 (symmetric), or ``corrected``: the renormalised difference
-    B_i^-1 sum_j V_j (p_j - p_i) grad_i W_ij (Bonet & Lok 1999), exact for a linear field on a
-    truncated support (B_i, the sum: renormalisation.moments; seed eq. 5 where det B_i <= 0.01).
+    (eq. 17); grad p by the renormalised difference B_i^-1 sum_j V_j (p_j - p_i) grad_i W_ij
+    (Bonet & Lok 1999), exact for a linear field on a truncated support (B_i, the sum:
+    renormalisation.moments), seed eq. 5 (symmetric) where det B_i <= 0.01. Wall particles with
+    p < 0 (the air side of a wetted wall, above the free surface) are left out like air: with
+    them the surface corners of still water crept away from the wall.
     Returns (#non-finite, #outside the tank box, max |v|^2)."""
     x = ps.x
     z = ps.z
@@ -494,15 +460,14 @@ def correct(ps, n, cells, prm, dt, corrected, dry_walls):
             fx = 0.0
             fz = 0.0
             symmetric = True
-            if corrected:
-                # grad p = M^-1 sum_j V_j (p_j - p_i) grad_i W_ij over the neighbours below
-                s = moments(i, ps, cells, prm, p, vx, vz, dry_walls)
-                det = s.mxx * s.mzz - s.mxz * s.mxz
-                if det > 0.01:  # 1 on a full 2D lattice support
-                    gpx, gpz = solve(s.mxx, s.mxz, s.mzz, det, s.phix, s.phiz)
-                    fx = -gpx / rho[i]
-                    fz = -gpz / rho[i]
-                    symmetric = False
+            # grad p = M^-1 sum_j V_j (p_j - p_i) grad_i W_ij over the neighbours below
+            s = moments(i, ps, cells, prm, p, vx, vz, False)
+            det = s.mxx * s.mzz - s.mxz * s.mxz
+            if det > 0.01:  # 1 on a full 2D lattice support
+                gpx, gpz = solve(s.mxx, s.mxz, s.mzz, det, s.phix, s.phiz)
+                fx = -gpx / rho[i]
+                fz = -gpz / rho[i]
+                symmetric = False
             if symmetric:
                 # -(1/rho) grad p = sum_j m_j (p_i/rho_i^2 + p_j/rho_j^2) F r_ij
                 cxl, cxh, czl, czh = block_of(cell[i], cells)
@@ -510,12 +475,7 @@ def correct(ps, n, cells, prm, dt, corrected, dry_walls):
                     row = zz * ncx
                     for j in range(cell_start[row + cxl], cell_start[row + cxh + 1]):
                         kj = kind[j]
-                        # without dry_walls, a wall particle with p < 0 (the air side of a
-                        # wetted wall, above the free surface) is left out like air: with it,
-                        # the surface corners of still water crept away from the wall
-                        # (docs/schemes.md)
-                        if j != i and 0 <= kj <= OUTLET and (kj != WALL or dry_walls
-                                                             or p[j] >= 0.0):
+                        if j != i and 0 <= kj <= OUTLET and (kj != WALL or p[j] >= 0.0):
                             dx = x[i] - x[j]
                             dz = z[i] - z[j]
                             r2 = dx * dx + dz * dz
@@ -649,38 +609,28 @@ def solve_ppe(solver: str, m: int, ptr: np.ndarray, indices: np.ndarray, data: n
               b: np.ndarray, x0: np.ndarray, tol: float, max_iter: int,
               scratch: np.ndarray) -> tuple[np.ndarray, int, float]:
     """Solve the m x m CSR system (diagonal first in each row) by ``solver`` (PPE_SOLVERS) from
-    the warm start ``x0`` (overwritten by ``explicit``); returns (solution, iterations,
+    the warm start ``x0`` (overwritten by ``bicgstab``); returns (solution, iterations,
     relative residual |b - A x| / |b|)."""
-    if solver == "explicit":
-        it, rel = jacobi(ptr, indices, data, b, x0, scratch, m, tol, max_iter)
-        return x0, int(it), float(rel)
     if solver == "bicgstab":
         work = scratch.reshape(-1)[: 8 * m].reshape(8, m) if scratch.size >= 8 * m else np.empty((8, m))
         it, rel = bicgstab_jacobi(ptr, indices, data, b, x0, m, tol, max_iter, work)
         return x0, int(it), float(rel)
+    if solver != "amg":
+        raise ValueError(f"ppe_solver: one of {PPE_SOLVERS}, got {solver!r}")
+    import pyamg  # only this solver needs it
     nnz = int(ptr[m])
     a = sp.csr_matrix((data[:nnz], indices[:nnz], ptr[: m + 1]), shape=(m, m))
-    if solver == "direct":  # SuperLU: the reference the iterative solvers are checked by
-        sol = spla.spsolve(a.tocsc(), b)
-        it = 1
-    else:
-        if solver == "amg":
-            import pyamg  # only this solver needs it
-            pre = pyamg.smoothed_aggregation_solver(a, symmetry="nonsymmetric",
-                                                    max_coarse=200).aspreconditioner()
-        else:
-            ilu = spla.spilu(a.tocsc(), drop_tol=1e-4, fill_factor=5)
-            pre = spla.LinearOperator((m, m), ilu.solve)
-        count = [0]
+    pre = pyamg.smoothed_aggregation_solver(a, symmetry="nonsymmetric",
+                                            max_coarse=200).aspreconditioner()
+    count = [0]
 
-        def _count(_xk: np.ndarray) -> None:
-            count[0] += 1
+    def _count(_xk: np.ndarray) -> None:
+        count[0] += 1
 
-        sol, _info = spla.bicgstab(a, b, x0=x0, rtol=tol, atol=0.0, maxiter=max_iter, M=pre,
-                                   callback=_count)
-        it = count[0]
+    sol, _info = spla.bicgstab(a, b, x0=x0, rtol=tol, atol=0.0, maxiter=max_iter, M=pre,
+                               callback=_count)
     bn = float(np.linalg.norm(b)) or 1.0
-    return sol, int(it), float(np.linalg.norm(b - a @ sol)) / bn
+    return sol, int(count[0]), float(np.linalg.norm(b - a @ sol)) / bn
 
 
 def isph_dt(v2max: float, a2max: float, prm: Any, v_ref: float = 0.0) -> float:
@@ -704,24 +654,19 @@ class IsphStepper:
     statistics (``ppe_iterations``, ``ppe_solves``, ``ppe_unknowns``, ``solve_time``)."""
 
     def __init__(self, capacity: int, prm: Any, dp: float, solver: str = "bicgstab",
-                 tolerance: float = 1e-5, max_iter: int = 20000, free_surface: str = "density",
-                 fs_threshold: float | None = None, shifting: bool = True,
-                 gradient: str = "corrected", v_ref: float = 0.0,
-                 density_relaxation: float = 0.0, wall_stop: float = 1.0, dry_walls: bool = False) -> None:
+                 tolerance: float = 1e-5, max_iter: int = 20000, fs_threshold: float = 1.5,
+                 shifting: bool = True, v_ref: float = 0.0,
+                 density_relaxation: float = 0.0, wall_stop: float = 1.0) -> None:
         if solver not in PPE_SOLVERS:
             raise ValueError(f"ppe_solver: one of {PPE_SOLVERS}, got {solver!r}")
         self.prm = prm
         self.solver = solver
         self.tol = float(tolerance)
         self.max_iter = int(max_iter)
-        self.by_density = free_surface == "density"
-        self.fs_threshold = float(fs_threshold if fs_threshold is not None
-                                  else FS_DEFAULT_THRESHOLD[free_surface])
+        self.fs_threshold = float(fs_threshold)
         self.shifting = bool(shifting) and prm.shift_a > 0.0
-        self.corrected = gradient == "corrected"
         self.v_ref = float(v_ref)
         self.wall_stop = float(wall_stop)
-        self.dry_walls = bool(dry_walls)
         # a typical fluid diagonal sum_j B_ij ~ (2 / rho0) sum_j V_j F_ij = 7 / (rho0 h^2): the
         # scale of the wall rows
         self.wscale = 7.0 / (prm.rho0 * prm.h * prm.h)
@@ -745,7 +690,7 @@ class IsphStepper:
         self.data = np.zeros(cap * MAX_ROW)
         self.b = np.zeros(cap)
         self.x0 = np.zeros(cap)
-        self.x2 = np.zeros(8 * cap)  # Jacobi's second vector, BiCGSTAB's eight
+        self.x2 = np.zeros(8 * cap)  # BiCGSTAB's eight vectors
         self.ppe_iterations = 0
         self.ppe_solves = 0
         self.ppe_unknowns = 0
@@ -810,8 +755,7 @@ class IsphStepper:
         the state ends sorted in ``ps2``. Returns (n, n_bad, n_out, max |v|^2, max |a*|^2); n < 0:
         the open ends ran out of particle capacity (state in ``ps``, not sorted)."""
         prm = self.prm
-        free_surface_flags(ps, n, cells, prm, self.by_density, self.fs_threshold, self.flag,
-                           self.rho_k)
+        free_surface_flags(ps, n, cells, prm, self.fs_threshold, self.flag, self.rho_k)
         if self.rho_ref == 0.0:  # the initial lattice's interior kernel density (~1.006 rho0)
             inner = self.flag[:n] == 0
             self.rho_ref = float(np.median(self.rho_k[:n][inner])) if inner.any() else prm.rho0
@@ -828,7 +772,7 @@ class IsphStepper:
             body_loads(ps, n, cells, prm, bd)
             bodies_kick_drift(bd, t, dt)
             bodies_kick(bd, t, dt)
-        n_bad, n_out, v2 = correct(ps, n, cells, prm, dt, self.corrected, self.dry_walls)
+        n_bad, n_out, v2 = correct(ps, n, cells, prm, dt)
         place_bodies(ps, n, bd)
         v2 = max(v2, bodies_v2max(bd))   # a fast body bounds dt as fluid does
         if ends.active:  # after the drift, as step.py's kdk step: buffers moved, crossings

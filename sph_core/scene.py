@@ -29,6 +29,11 @@ RETIRED: dict[tuple[str, str], tuple[Any, ...]] = {
     ("Scheme", "limiter"): ("vanleer",),
     ("Scheme", "low_dissipation"): (False,),
     ("Scheme", "low_dissipation_eta"): (),
+    # ISPH (docs/schemes.md "## ISPH" has the measurements)
+    ("Scheme", "isph_gradient"): ("corrected",),
+    ("Scheme", "ppe_solver"): ("bicgstab", "amg"),   # still a field: the accepted values pass
+    ("Scheme", "free_surface"): ("divergence",),
+    ("Scheme", "isph_dry_walls"): (False,),
 }
 
 
@@ -53,6 +58,8 @@ class _Model(BaseModel):
             elif value not in accepted:
                 raise ValueError(f"{key}: {value!r} was measured and retired "
                                  f"(see {retired_page(key)})")
+            elif key in cls.model_fields:   # an option with some values retired, not all
+                kept[key] = value
         return kept
 
 
@@ -246,7 +253,7 @@ class Scheme(_Model):
     (constants.alpha and constants.delta are not used; constants.alpha_wall_factor scales the
     velocity dissipation against walls).
 
-    The ``ppe_*``, ``free_surface*``, ``isph_*`` options apply to ``kind = "isph"`` only
+    The ``ppe_*``, ``free_surface_threshold``, ``isph_*`` options apply to ``kind = "isph"`` only
     (sph_core.isph: projection method, a pressure Poisson equation per step)."""
 
     kind: Literal["wcsph", "riemann", "isph"] = Field("wcsph", description=(
@@ -258,28 +265,20 @@ class Scheme(_Model):
         "gradients (muscl), or the particles' own values (none, first order)"))
     # van Leer's limiter and beta = 1 were measured best (docs/schemes.md); the minmod limiter
     # and the low-dissipation beta are retired (docs/decisions/limiter.md, low_dissipation.md)
-    ppe_solver: Literal["explicit", "amg", "ilu", "direct", "bicgstab"] = Field("bicgstab", description=(
-        "ISPH pressure Poisson solver: explicit = the seed's Jacobi iteration (Hosseini et al. "
-        "2007); amg = BiCGSTAB preconditioned by smoothed-aggregation AMG (pyamg); ilu = "
-        "BiCGSTAB preconditioned by incomplete LU (scipy); direct = sparse LU (SuperLU), the "
-        "reference; bicgstab = BiCGSTAB preconditioned by the diagonal, jitted (no set-up)"))
+    # retired (RETIRED above): the Jacobi, ILU and direct solvers, seed 004's density criterion of
+    # the free surface and symmetric pressure gradient, and the dry walls in the corrector
+    ppe_solver: Literal["bicgstab", "amg"] = Field("bicgstab", description=(
+        "ISPH pressure Poisson solver: bicgstab = BiCGSTAB preconditioned by the diagonal, "
+        "jitted (no set-up); amg = BiCGSTAB preconditioned by smoothed-aggregation AMG (pyamg)"))
     ppe_tolerance: float = Field(1e-5, gt=0, lt=1, description=(
         "ISPH: relative residual |b - A p| / |b| at which the pressure solve stops"))
     ppe_max_iter: int = Field(20000, ge=1, description="ISPH: iteration cap of the pressure solve")
-    free_surface: Literal["density", "divergence"] = Field("divergence", description=(
-        "ISPH free-surface criterion (Dirichlet p = 0): density = seed 004's kernel sum "
-        "rho_f = sum m W <= threshold rho0; divergence = position divergence <= threshold "
-        "(the default: with density the top layer of still water settled until it no longer "
-        "counted as surface, and the surface corners oscillated; docs/schemes.md)"))
-    free_surface_threshold: float | None = Field(None, gt=0, description=(
-        "ISPH: threshold of the free-surface criterion (default 0.9 for density, seed 004; "
-        "1.5 for divergence)"))
+    free_surface_threshold: float = Field(1.5, gt=0, description=(
+        "ISPH: a fluid particle is on the free surface (Dirichlet p = 0) where its position "
+        "divergence sum_j V_j F_ij r_ij^2 is at most this (2 inside the fluid in 2D; Lind et al. "
+        "2012)"))
     isph_cfl: float = Field(0.2, gt=0, le=0.5, description=(
         "ISPH Courant number on the flow speed: dt <= isph_cfl h / max|v| (no sound speed)"))
-    isph_gradient: Literal["corrected", "symmetric"] = Field("corrected", description=(
-        "ISPH pressure gradient of the corrector: symmetric = seed 004 eq. 5; corrected = "
-        "renormalised difference form (Bonet & Lok 1999), exact for linear p also where the "
-        "kernel is cut by the free surface"))
     isph_vref_factor: float = Field(1.0, ge=0, description=(
         "ISPH: the time step's speed is at least this x sqrt(2 g H), H the water height "
         "(0: the flow's max|v| alone)"))
@@ -291,11 +290,6 @@ class Scheme(_Model):
         "ISPH: fluid approaching a wall is stopped by a ghost-pressure rise rho |u_n| d / tau "
         "over this many steps, tau = isph_wall_stop dt (d the fluid's distance from the wall "
         "particle along the wall normal); 1: within one step"))
-    isph_dry_walls: bool = Field(False, description=(
-        "ISPH corrector: wall particles with a negative pressure (the air side of a wetted wall, "
-        "above the free surface) count in the pressure gradient (true, the original) or are left "
-        "out like air (false: with them the still-water surface corners crept away from the "
-        "wall and broke down at ~2.9 s)"))
     isph_shifting: bool = Field(True, description=(
         "ISPH: Fickian particle shifting (Lind et al. 2012) with Constants.shift_a after each step"))
 

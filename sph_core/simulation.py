@@ -163,12 +163,10 @@ class Simulation:
         if self.isph:
             self.stepper = IsphStepper(ps.capacity, self.prm, dp, scheme.ppe_solver,
                                        scheme.ppe_tolerance, scheme.ppe_max_iter,
-                                       scheme.free_surface, scheme.free_surface_threshold,
-                                       scheme.isph_shifting, scheme.isph_gradient,
+                                       scheme.free_surface_threshold, scheme.isph_shifting,
                                        v_ref=scheme.isph_vref_factor * math.sqrt(2.0 * c.g * scene.water_height),
                                        density_relaxation=scheme.isph_density_relaxation,
-                                       wall_stop=scheme.isph_wall_stop,
-                                       dry_walls=scheme.isph_dry_walls)
+                                       wall_stop=scheme.isph_wall_stop)
             dt, n_new = self.stepper.initialise(ps.view, ps.view2, self.cells, ps.n,
                                                 self.open.ends, self.bodies.state)
         else:
