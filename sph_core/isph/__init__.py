@@ -35,7 +35,7 @@ on the sorted state at t^n (docs/schemes.md "## ISPH" has the measurements behin
    pressure (the seed's Jacobi iteration, ILU and SuperLU are retired:
    docs/decisions/ppe_solver.md). The no-penetration part
    stops the approach within ``isph_wall_stop`` steps (rho |u_n| d / (stop dt)); it and the
-   source scale as 1/dt, so ``IsphStepper.run`` never ends a run on a sliver step;
+   source scale as 1/dt, so its loop (steppers.drive) never ends a run on a sliver step;
 4. corrector (eq. 16-17): u^{n+1} = u* - dt grad p_i / rho0, r^{n+1} = r^n + dt (u^n + u^{n+1}) / 2,
    grad p by the renormalised difference B_i^-1 sum_j V_j (p_j - p_i) grad_i W_ij (Bonet & Lok
    1999), seed eq. 5 only where B_i is near-singular (seed eq. 5 everywhere is retired: the

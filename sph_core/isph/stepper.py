@@ -12,9 +12,13 @@ import numpy as np
 from ..bodies import bodies_kick, bodies_kick_drift, bodies_v2max, body_loads, place_bodies
 from ..neighbours import sort_by_cell
 from ..open_boundary import extrapolate_buffers, measure_boundaries, update_buffers
-from ..particles import N_SORTED_KDK
+from ..particles import FLUID, N_SORTED_KDK, WALL
+from ..riemann import NO_RECONSTRUCTION
+from ..scene import Scene
 from ..shifting import shift_particles
-from ..wcsph import ST_CAPACITY, ST_LEFT_DOMAIN, ST_NONFINITE, ST_REACHED_T, ST_STEP_LIMIT
+from ..state import Params
+from ..steppers import drive
+from ..wcsph import ST_CAPACITY, ST_LEFT_DOMAIN, ST_NONFINITE, ST_REACHED_T
 from .passes import correct, free_surface_flags, predict, scatter_pressure, wall_state
 from .ppe import MAX_ROW, PPE_SOLVERS, compact_rows, ppe_assemble, ppe_unknowns, solve_ppe
 
@@ -36,36 +40,33 @@ def isph_dt(v2max: float, a2max: float, prm: Any, v_ref: float = 0.0) -> float:
 
 
 class IsphStepper:
-    """The ISPH time loop of one Simulation: same call and returns as ``step.run``, plus the PPE
+    """The ISPH scheme of one Simulation (steppers.Stepper): its Params, its initial state, one
+    projection step (``step``) and the loop around it (steppers.drive), plus the PPE
     statistics (``ppe_iterations``, ``ppe_solves``, ``ppe_unknowns``, ``solve_time``)."""
 
-    def __init__(self, capacity: int, prm: Any, dp: float, solver: str = "bicgstab",
-                 tolerance: float = 1e-5, max_iter: int = 20000, fs_threshold: float = 1.5,
-                 shifting: bool = True, v_ref: float = 0.0,
-                 density_relaxation: float = 0.0, wall_stop: float = 1.0) -> None:
-        if solver not in PPE_SOLVERS:
-            raise ValueError(f"ppe_solver: one of {PPE_SOLVERS}, got {solver!r}")
-        self.prm = prm
-        self.solver = solver
-        self.tol = float(tolerance)
-        self.max_iter = int(max_iter)
-        self.fs_threshold = float(fs_threshold)
-        self.shifting = bool(shifting) and prm.shift_a > 0.0
-        self.v_ref = float(v_ref)
-        self.wall_stop = float(wall_stop)
-        # a typical fluid diagonal sum_j B_ij ~ (2 / rho0) sum_j V_j F_ij = 7 / (rho0 h^2): the
-        # scale of the wall rows
-        self.wscale = 7.0 / (prm.rho0 * prm.h * prm.h)
+    passes_per_step = 1   # one pressure solve per step, whatever constants.integrator says
+
+    def __init__(self, scene: Scene, capacity: int) -> None:
+        sc = scene.scheme
+        c = scene.constants
+        if sc.ppe_solver not in PPE_SOLVERS:
+            raise ValueError(f"ppe_solver: one of {PPE_SOLVERS}, got {sc.ppe_solver!r}")
+        self.solver = sc.ppe_solver
+        self.tol = float(sc.ppe_tolerance)
+        self.max_iter = int(sc.ppe_max_iter)
+        self.fs_threshold = float(sc.free_surface_threshold)
+        self.isph_shifting = bool(sc.isph_shifting)
+        self.v_ref = float(sc.isph_vref_factor * math.sqrt(2.0 * c.g * scene.water_height))
+        self.wall_stop = float(sc.isph_wall_stop)
+        self.relax = float(sc.isph_density_relaxation)
+        self.rho0 = c.rho0
+        self.g = c.g
+        self.vol = scene.dp * scene.dp
+        self.prm: Any = None
         cap = int(capacity)
         self.flag = np.zeros(cap, dtype=np.int8)
         self.rho_k = np.zeros(cap)
         self.rho_ref = 0.0
-        self.relax = float(density_relaxation)
-        # the relaxation's time scale: the nominal step cfl h / v_ref, not the actual dt (with
-        # 1/dt^2 a shrinking step strengthened it, which shrank the step further: the dam break
-        # blew up within 0.005 s)
-        self.dt_ref = prm.cfl * prm.h / v_ref if v_ref > 0.0 else 0.25 * math.sqrt(
-            prm.h / math.hypot(prm.gx, prm.gz))
         self.wsum = np.zeros(cap)
         self.dwall = np.zeros(cap)
         self.idx = np.zeros(cap, dtype=np.int64)
@@ -84,11 +85,45 @@ class IsphStepper:
         self.solve_time = 0.0
 
     # --------------------------------------------------------------- set-up
-    def initialise(self, ps: Any, ps2: Any, cells: Any, n: int, ends: Any,
-                   bd: Any) -> tuple[float, int]:
-        """Place the rigid bodies ``bd`` (bodies.Bodies), sort the initial state into ``ps2``
-        (the caller swaps), buffer pressures and boundary gauges of the open ``ends``
-        (state.OpenEnds); returns (dt, n)."""
+    def initial_fluid(self, z: np.ndarray, surface: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Incompressible: density rho0; the hydrostatic pressure is the warm start of the first
+        pressure solve."""
+        return np.full(z.size, self.rho0), self.rho0 * self.g * (surface - z)
+
+    def params(self, scene: Scene, base: dict[str, Any], n_layers: int) -> Params:
+        """Params of ISPH: no artificial viscosity (the bodies' load pass reads alpha), the flow
+        speed's Courant number, Fickian shifting only (its figures in docs/schemes.md were
+        measured without the carry), no wall-face no-penetration shares (the PPE has its own
+        no-penetration pressure, isph_wall_stop)."""
+        c = scene.constants
+        shifting = c.shifting == "fickian" or self.isph_shifting
+        prm = Params(**base, alpha=0.0, cfl=scene.scheme.isph_cfl,
+                     shift_a=c.shift_a if shifting else 0.0, shift_dplus=False,
+                     shift_carry=False, wall_ga=0.0, wall_g0=0.0, wall_gb=0.0, riemann=False,
+                     limiter=NO_RECONSTRUCTION)
+        self.prm = prm
+        self.shifting = self.isph_shifting and prm.shift_a > 0.0
+        # a typical fluid diagonal sum_j B_ij ~ (2 / rho0) sum_j V_j F_ij = 7 / (rho0 h^2): the
+        # scale of the wall rows
+        self.wscale = 7.0 / (prm.rho0 * prm.h * prm.h)
+        # the relaxation's time scale: the nominal step cfl h / v_ref, not the actual dt (with
+        # 1/dt^2 a shrinking step strengthened it, which shrank the step further: the dam break
+        # blew up within 0.005 s)
+        self.dt_ref = prm.cfl * prm.h / self.v_ref if self.v_ref > 0.0 else 0.25 * math.sqrt(
+            prm.h / math.hypot(prm.gx, prm.gz))
+        return prm
+
+    def initialise(self, ps: Any, ps2: Any, cells: Any, ends: Any, bd: Any,
+                   n: int) -> tuple[float, int]:
+        """Incompressible buffers of the open ``ends`` (density rho0, mass rho0 dp^2: open_ends
+        made them WCSPH's), place the rigid bodies ``bd`` (bodies.Bodies), sort the initial
+        state into ``ps2`` (the caller swaps), buffer pressures and boundary gauges; returns
+        (dt, n)."""
+        if ends.active:
+            kind = ps.kind[:n]
+            buf = (kind != FLUID) & (kind != WALL) & (kind >= 0)
+            ps.rho[:n][buf] = self.rho0
+            ps.m[:n][buf] = self.rho0 * self.vol
         place_bodies(ps, n, bd)
         n = sort_by_cell(ps, ps2, N_SORTED_KDK, n, cells)
         self._open_ends_sorted(ps2, n, cells, ends)
@@ -173,52 +208,23 @@ class IsphStepper:
 
     def run(self, ps: Any, ps2: Any, cells: Any, ends: Any, bd: Any, n: int, t: float, dt: float,
             t_stop: float, max_steps: int) -> tuple[float, float, int, int, int, int, float, int]:
-        """Steps until t reaches t_stop or max_steps were taken, or a guard trips; returns as
-        ``step.run``: (t, dt_next, steps, status, swapped, n_flagged, v_max, n)."""
-        swapped = 0
-        steps = 0
-        status = ST_REACHED_T
-        n_flag = 0
-        v2 = 0.0
-        while True:
-            if t >= t_stop:
-                status = ST_REACHED_T
-                break
-            if steps >= max_steps:
-                status = ST_STEP_LIMIT
-                break
-            # no sliver steps: a projection's pressure carries (div u^n) / dt, so a step of a
-            # tiny fraction of dt (window and output times meeting) gives a pressure field far
-            # from the flow's, which the open ends' buffers then take over (extrapolated) and
-            # the probes record. Measured: a 3.7e-5 s step after 2.3e-3 s ones raised the
-            # fluid's largest pressure from 2.6 to 7.2 kPa; the open flume blew up within
-            # 0.015 s; in the closed dam break such steps before each probe record gave
-            # wall-pressure spikes of 10^5-10^7 Pa (docs/schemes.md). So the last two steps
-            # share a remainder below 1.5 dt, and a round-off remainder (< 1e-6 dt) is not
-            # stepped.
-            rem = t_stop - t
-            if rem <= 1e-6 * dt:
-                t = t_stop
-                continue
-            last = rem <= dt
-            dts = rem if last else (0.5 * rem if rem < 1.5 * dt else dt)
-            n_new, n_bad, n_out, v2, a2 = self.step(ps, ps2, cells, n, t, dts, ends, bd)
-            if n_new < 0:  # the state stays in ps, as step.run's
-                status, n_flag = ST_CAPACITY, n
-                break
-            n = n_new
-            ps, ps2 = ps2, ps
-            swapped = 1 - swapped
-            t = t_stop if last else t + dts
-            steps += 1
-            if n_bad:
-                status, n_flag = ST_NONFINITE, n_bad
-                break
-            if n_out:
-                status, n_flag = ST_LEFT_DOMAIN, n_out
-                break
-            dt = isph_dt(v2, a2, self.prm, self.v_ref)
-        return t, dt, steps, status, swapped, n_flag, math.sqrt(v2), n
+        """Steps (``step``) until t reaches t_stop or max_steps were taken, or a guard trips, in
+        steppers.drive's loop; returns as ``step.run``: (t, dt_next, steps, status, swapped,
+        n_flagged, v_max, n)."""
+        cur = [ps, ps2, n]   # the current state, its twin, the slots in use
+
+        def take(t: float, dt: float) -> tuple[int, int, float, float, bool]:
+            n_new, n_bad, n_out, v2, a2 = self.step(cur[0], cur[1], cells, cur[2], t, dt, ends,
+                                                    bd)
+            if n_new < 0:  # out of capacity: the state stays in ps, as step.run's
+                return ST_CAPACITY, cur[2], v2, dt, False
+            cur[0], cur[1], cur[2] = cur[1], cur[0], n_new
+            status, n_flag = ((ST_NONFINITE, n_bad) if n_bad else
+                              (ST_LEFT_DOMAIN, n_out) if n_out else (ST_REACHED_T, 0))
+            return status, n_flag, v2, isph_dt(v2, a2, self.prm, self.v_ref), True
+
+        t, dt, steps, status, swapped, n_flag, v_max = drive(take, t, dt, t_stop, max_steps)
+        return t, dt, steps, status, swapped, n_flag, v_max, cur[2]
 
     def stats(self) -> dict[str, Any]:
         """PPE statistics since the start (for meta.json and the benches)."""
