@@ -8,8 +8,8 @@ slow the flume scene (goal: <= 10 % fewer particle-steps/s)?
 Output: one JSON object per line, each with check, value, reference, rel_error, wall_s (and
 flap_pitch runs the coupled demo flume with its flap: linear theory as the reference). The wedge
 (Zhao et al. 1996 drop test) is compared with Wagner's theory, not the experiment (its data
-were not found in a copyable form; docs/BODIES.md). The body checks need h/dp 2 and no wall
-artificial viscosity (docs/BODIES.md, heave study):
+were not found in a copyable form; docs/studies/BODIES.md). The body checks need h/dp 2 and no wall
+artificial viscosity (docs/studies/BODIES.md, heave study):
 
     python bench/bodies.py [--dp 0.02] [--checks archimedes_draft heave_period ...] \
         [--constants '{"h_over_dp": 2.0, "alpha_wall_factor": 0.0}']

@@ -1,5 +1,5 @@
 """Does the ISPH still-water surface corner drift because of the wall particles above the water?
-One JSON object per line (docs/schemes.md "## ISPH", 2026-11-23).
+One JSON object per line (docs/studies/schemes.md "## ISPH", 2026-11-23).
 
     PYTHONPATH=. NUMBA_NUM_THREADS=1 python bench/isph_corner.py 1.6   # walls to 1.6 d (the test's tank)
     PYTHONPATH=. NUMBA_NUM_THREADS=1 python bench/isph_corner.py 1     # walls end dp/4 above the water

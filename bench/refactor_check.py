@@ -5,7 +5,7 @@ Runs a fixed set of small scenes a fixed number of steps and saves (``--save``) 
 WCSPH with both integrators, Riemann SPH with MUSCL, Fickian and delta-plus shifting, a free
 floating body, force and point probes, and a short flume with open ends driven by a linear wave
 (imposed inlet, extrapolated outlet: buffers, ghost pressure, boundary gauges, absorption) whose
-shifting stops beside the buffers (``shift_open_end = "none"``).
+shifting stops beside the buffers (``shift_open_end = "none"``); ISPH closed, with open ends and with a prescribed body.
 
     python bench/refactor_check.py --save /tmp/ref.npz          # on the code before the change
     python bench/refactor_check.py --compare /tmp/ref.npz       # after it
@@ -64,7 +64,39 @@ def _scenes() -> dict:
         "floating_box": floating_box_scene(dp=0.02, tank_length=0.8, t_end=1.0),
         "flume_open_dplus": _flume("dplus"),
         "flume_open_fickian": _flume("fickian"),
+        **_isph_scenes(db),
     }
+
+
+def _isph_scenes(db: dict) -> dict:
+    """ISPH: the dam break, a still tank, a flume with open ends (no sources: the ends hold
+    still water), a prescribed plate (a moving wall of the pressure equation)."""
+    from wavesph.cases.dambreak import dambreak_scene
+    from sph_core.scene import make_scene
+
+    isph = {"kind": "isph"}
+    d = 0.25
+    still = {"name": "still", "dp": d / 10, "t_end": 1.0, "still_water_level": d,
+             "tank": {"x0": 0.0, "x1": 2 * d, "z0": 0.0, "z1": 1.6 * d},
+             "water_blocks": [{"x0": 0.0, "x1": 2 * d, "z0": 0.0, "z1": d}], "scheme": isph,
+             "probes": [{"kind": "pressure_line", "name": "bed", "points": [[d, 0.0125]]}]}
+    flume = {"dp": 0.02, "t_end": 10.0, "still_water_level": 0.3, "scheme": isph,
+             "tank": {"x0": 0.0, "x1": 0.6, "z0": 0.0, "z1": 0.42},
+             "water_blocks": [{"x0": 0.0, "x1": 0.6, "z0": 0.0, "z1": 0.3}],
+             "open_boundaries": [{"side": "left", "elevation": "imposed"},
+                                 {"side": "right", "elevation": "extrapolated"}]}
+    plate = {"dp": 0.02, "t_end": 1.0, "scheme": isph,
+             "tank": {"x0": 0, "x1": 1.0, "z0": 0, "z1": 0.6},
+             "water_blocks": [{"x0": 0, "x1": 1.0, "z0": 0, "z1": 0.3}],
+             "probes": [{"kind": "force", "name": "plate", "x0": 0.38, "x1": 0.62, "z0": 0.24,
+                         "z1": 0.38}],
+             "bodies": [{"name": "plate", "shape": "box", "x0": 0.4, "x1": 0.6, "z0": 0.26,
+                         "z1": 0.36, "motion": "prescribed",
+                         "series": [(0.0, 0.0, 0.0, 0.0), (1.0, 0.1, -0.05, 0.2)]}]}
+    return {"isph_dambreak": dambreak_scene(**db, scheme=isph),
+            "isph_still": make_scene(still),
+            "isph_open": make_scene(flume),
+            "isph_plate": make_scene(plate)}
 
 
 def _run(scene, steps: int) -> tuple[dict, dict, int]:

@@ -44,7 +44,7 @@ from wavesph.cases.schemes import RIEMANN_VARIANTS  # noqa: E402
 from wavesph.studies.sweeps import OLD_DEFAULTS  # noqa: E402
 
 # h/dp 2 without artificial viscosity against walls: the wave-decay study's best WCSPH options
-# (docs/wave_decay_study.md); every entry but the first uses them, so the schemes differ only in
+# (docs/studies/wave_decay_study.md); every entry but the first uses them, so the schemes differ only in
 # the scheme
 BEST_WAVE = {"h_over_dp": 2.0, "alpha_wall_factor": 0.0}
 ENTRIES: list[tuple[str, dict[str, Any]]] = [
@@ -52,11 +52,10 @@ ENTRIES: list[tuple[str, dict[str, Any]]] = [
     ("wcsph", {"constants": BEST_WAVE}),                   # = today's scene defaults
     *[(name, {"scheme": sch, "constants": BEST_WAVE}) for name, sch in RIEMANN_VARIANTS.items()],
     # ISPH runs at its own h/dp sqrt 2 (sph_core.scene.ISPH_H_OVER_DP); its wave flume is
-    # unstable (docs/schemes.md "ISPH with open ends and bodies"), so its wave line reports
+    # unstable (docs/studies/schemes.md "ISPH with open ends and bodies"), so its wave line reports
     # wave_failed with the UnstableError
     ("isph_bicgstab", {"scheme": {"kind": "isph", "ppe_solver": "bicgstab"}}),  # the default
     ("isph_amg", {"scheme": {"kind": "isph", "ppe_solver": "amg"}}),
-    ("isph_explicit", {"scheme": {"kind": "isph", "ppe_solver": "explicit"}}),
 ]
 
 _G = 9.81

@@ -17,7 +17,7 @@ Prints one JSON object:
   ``mean_5_50ms_pa``: the mean load 5-50 ms after arrival (after the spike; dry counts as 0);
   ``noise_rms``: RMS of (raw - the 1 ms moving average) over the 0.25 s after arrival;
   ``sensor1_*_windows``: SPH / experiment ratios of the peak after 1-10 ms moving averages and
-  of the impulse over 5-50 ms after arrival (docs/wall_pressure.md, 2026-11-23);
+  of the impulse over 5-50 ms after arrival (docs/studies/wall_pressure.md, 2026-11-23);
 - cost: steps, wall time (say whether the machine was loaded), particle-steps/s.
 
     python bench/wall_impact.py --dp 0.004 --t-end 2.0 [--h-over-dp 2] [--c0-factor 10]

@@ -13,7 +13,7 @@
 --long: a flume 3 wavelengths long, 36 gauges over 2.25 wavelengths, the window after the
 outlet's reflection has come back to the inlet: resolves the decay to ~0.1 %/m (dp 0.02: fitted
 2.56, separated 2.58 %/m; a fit over the default 0.75 L span moves by ~1 %/m with the outlet's
-reflection pattern; docs/absorption.md), ~5x the particle-steps of the default flume.
+reflection pattern; docs/studies/absorption.md), ~5x the particle-steps of the default flume.
 
 A flume one wavelength long with open ends driven by second-order Stokes theory (the wave of the
 coupled flume, wavesph/cases/coupled_flume.py, by default), gauges from 2h past the inlet to 3/4 of the

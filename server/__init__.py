@@ -28,5 +28,5 @@ theory_source | settings. The run manager gets the engine factory and the built-
 injected, so it knows neither the solver nor the doors.
 
 Python entry point: ``server.main.create_app(settings, engine_factory=flume_engine)``; the coupled
-engine contract is ``server.engine.CouplingEngine`` (see docs/ARCHITECTURE.md).
+engine contract is ``server.engine.CouplingEngine`` (see docs/developer/architecture.md).
 """

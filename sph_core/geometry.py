@@ -7,7 +7,7 @@ at the wall sees a full kernel support (2h) of dummy particles. The side walls a
 sloping beds) between them are spaced ``wall_dx`` = (x1 - x0) / round((x1 - x0) / dp), so that
 they meet both columns one spacing away whatever the tank length. (On the dp lattice a tank
 402.5 dp long left a gap of 1.5 dp at the right corner in every layer, through which a violent
-impact pushed fluid out of the tank: docs/wall_pressure.md.)
+impact pushed fluid out of the tank: docs/studies/wall_pressure.md.)
 """
 
 from __future__ import annotations
@@ -143,7 +143,7 @@ def build_layout(scene: Scene) -> Layout:
     # dummy, every point above it fluid, with no gap band, so each lattice column meets the bed
     # at the flat floor's fluid-to-dummy spacing dp. (A band of dp/2 left a one-particle void in
     # about half of the columns along a slope: the shoreline wedge went into tension and burst,
-    # docs/SHORELINE_JET.md.)
+    # docs/studies/SHORELINE_JET.md.)
     for bed in scene.beds:
         _, below = _polyline_distance(bed, fluid_x, fluid_z)
         keep &= ~below

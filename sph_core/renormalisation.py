@@ -1,5 +1,5 @@
 """The renormalisation matrix and the first-order neighbour sums built with it: ONE neighbour
-walk (``moments``, through pairs.gather) that both shifting laws (shifting.py), ISPH's corrected pressure gradient (isph.py) and Riemann SPH's MUSCL
+walk (``moments``, through pairs.gather) that both shifting laws (shifting.py), ISPH's corrected pressure gradient (isph/passes.py) and Riemann SPH's MUSCL
 gradients (riemann.py) share.
 
 For particle i and its neighbours j (fluid, wall, active buffer; j != i), r_ji = r_j - r_i,

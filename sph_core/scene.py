@@ -34,6 +34,11 @@ RETIRED: dict[tuple[str, str], tuple[Any, ...]] = {
     ("OpenBoundary", "absorption_transfer"): ("piston",),
     ("OpenBoundary", "absorption_profile"): ("mode",),
     ("OpenBoundary", "surface"): ("face",),
+    # ISPH (docs/studies/schemes.md "## ISPH" has the measurements)
+    ("Scheme", "isph_gradient"): ("corrected",),
+    ("Scheme", "ppe_solver"): ("bicgstab", "amg"),   # still a field: the accepted values pass
+    ("Scheme", "free_surface"): ("divergence",),
+    ("Scheme", "isph_dry_walls"): (False,),
 }
 
 
@@ -186,7 +191,7 @@ class Constants(_Model):
     c0_factor: float = Field(10.0, gt=0, description="c0 = c0_factor * sqrt(2 g H), H = water height")
     # h/dp 2 (~50 neighbours): the wave keeps far more of itself than at sqrt(2) (flume 14 ->
     # 6.2 %/m at H/dp 2, 25x less particle noise, phase speed -3.6 -> -0.3 %; one step costs
-    # ~2x, 0.7x the steps: ~1.25x per simulated second; docs/wave_decay_study.md)
+    # ~2x, 0.7x the steps: ~1.25x per simulated second; docs/studies/wave_decay_study.md)
     h_over_dp: float = Field(2.0, ge=1.0, le=2.0, description=(
         "smoothing length h / dp; 2 (default) for waves, sqrt(2) is cheaper (~0.8x per "
         "simulated second) and noisier"))
@@ -251,7 +256,7 @@ class Scheme(_Model):
     (constants.alpha and constants.delta are not used; constants.alpha_wall_factor scales the
     velocity dissipation against walls).
 
-    The ``ppe_*``, ``free_surface*``, ``isph_*`` options apply to ``kind = "isph"`` only
+    The ``ppe_*``, ``free_surface_threshold``, ``isph_*`` options apply to ``kind = "isph"`` only
     (sph_core.isph: projection method, a pressure Poisson equation per step)."""
 
     kind: Literal["wcsph", "riemann", "isph"] = Field("wcsph", description=(
@@ -261,30 +266,22 @@ class Scheme(_Model):
     reconstruction: Literal["muscl", "none"] = Field("muscl", description=(
         "riemann: left/right states extrapolated to the pair's mid-point with limited "
         "gradients (muscl), or the particles' own values (none, first order)"))
-    # van Leer's limiter and beta = 1 were measured best (docs/schemes.md); the minmod limiter
+    # van Leer's limiter and beta = 1 were measured best (docs/studies/schemes.md); the minmod limiter
     # and the low-dissipation beta are retired (docs/decisions/limiter.md, low_dissipation.md)
-    ppe_solver: Literal["explicit", "amg", "ilu", "direct", "bicgstab"] = Field("bicgstab", description=(
-        "ISPH pressure Poisson solver: explicit = the seed's Jacobi iteration (Hosseini et al. "
-        "2007); amg = BiCGSTAB preconditioned by smoothed-aggregation AMG (pyamg); ilu = "
-        "BiCGSTAB preconditioned by incomplete LU (scipy); direct = sparse LU (SuperLU), the "
-        "reference; bicgstab = BiCGSTAB preconditioned by the diagonal, jitted (no set-up)"))
+    # retired (RETIRED above): the Jacobi, ILU and direct solvers, seed 004's density criterion of
+    # the free surface and symmetric pressure gradient, and the dry walls in the corrector
+    ppe_solver: Literal["bicgstab", "amg"] = Field("bicgstab", description=(
+        "ISPH pressure Poisson solver: bicgstab = BiCGSTAB preconditioned by the diagonal, "
+        "jitted (no set-up); amg = BiCGSTAB preconditioned by smoothed-aggregation AMG (pyamg)"))
     ppe_tolerance: float = Field(1e-5, gt=0, lt=1, description=(
         "ISPH: relative residual |b - A p| / |b| at which the pressure solve stops"))
     ppe_max_iter: int = Field(20000, ge=1, description="ISPH: iteration cap of the pressure solve")
-    free_surface: Literal["density", "divergence"] = Field("divergence", description=(
-        "ISPH free-surface criterion (Dirichlet p = 0): density = seed 004's kernel sum "
-        "rho_f = sum m W <= threshold rho0; divergence = position divergence <= threshold "
-        "(the default: with density the top layer of still water settled until it no longer "
-        "counted as surface, and the surface corners oscillated; docs/schemes.md)"))
-    free_surface_threshold: float | None = Field(None, gt=0, description=(
-        "ISPH: threshold of the free-surface criterion (default 0.9 for density, seed 004; "
-        "1.5 for divergence)"))
+    free_surface_threshold: float = Field(1.5, gt=0, description=(
+        "ISPH: a fluid particle is on the free surface (Dirichlet p = 0) where its position "
+        "divergence sum_j V_j F_ij r_ij^2 is at most this (2 inside the fluid in 2D; Lind et al. "
+        "2012)"))
     isph_cfl: float = Field(0.2, gt=0, le=0.5, description=(
         "ISPH Courant number on the flow speed: dt <= isph_cfl h / max|v| (no sound speed)"))
-    isph_gradient: Literal["corrected", "symmetric"] = Field("corrected", description=(
-        "ISPH pressure gradient of the corrector: symmetric = seed 004 eq. 5; corrected = "
-        "renormalised difference form (Bonet & Lok 1999), exact for linear p also where the "
-        "kernel is cut by the free surface"))
     isph_vref_factor: float = Field(1.0, ge=0, description=(
         "ISPH: the time step's speed is at least this x sqrt(2 g H), H the water height "
         "(0: the flow's max|v| alone)"))
@@ -296,11 +293,6 @@ class Scheme(_Model):
         "ISPH: fluid approaching a wall is stopped by a ghost-pressure rise rho |u_n| d / tau "
         "over this many steps, tau = isph_wall_stop dt (d the fluid's distance from the wall "
         "particle along the wall normal); 1: within one step"))
-    isph_dry_walls: bool = Field(False, description=(
-        "ISPH corrector: wall particles with a negative pressure (the air side of a wetted wall, "
-        "above the free surface) count in the pressure gradient (true, the original) or are left "
-        "out like air (false: with them the still-water surface corners crept away from the "
-        "wall and broke down at ~2.9 s)"))
     isph_shifting: bool = Field(True, description=(
         "ISPH: Fickian particle shifting (Lind et al. 2012) with Constants.shift_a after each step"))
 
@@ -388,13 +380,13 @@ OUTLET_PRESSURE = "extrapolated"
 # Within h of its surface a hydrostatic buffer takes the fluid's own pressure through the ghost
 # nodes (open_boundary.SURFACE_BAND_H). Extrapolated everywhere, the inlet let a fluid particle
 # through the floor at its bottom corner (case V, dp 0.02) and generated 5 % less amplitude
-# within 0.3 m of the face (docs/wave_decay_study.md).
+# within 0.3 m of the face (docs/studies/wave_decay_study.md).
 INLET_PRESSURE = "hydrostatic"
 # ... of an ISPH inlet: extrapolated. ISPH puts p = 0 on its surface particles' centres, dp/2 below
 # the surface, so its pressure is ~rho0 g dp/2 below the continuum hydrostatic one a hydrostatic
 # buffer holds; in the still open flume (d 0.3 m, dp 0.02, tests/test_sph_core/test_open_boundary.py)
 # that pushed the inlet's surface corner at 0.10 m/s within 0.1 s and the run blew up at 0.87 s;
-# extrapolated, the flume stays still (docs/schemes.md "ISPH with open ends and bodies").
+# extrapolated, the flume stays still (docs/studies/schemes.md "ISPH with open ends and bodies").
 ISPH_INLET_PRESSURE = "extrapolated"
 
 
@@ -411,7 +403,7 @@ class OpenBoundary(_Model):
     filter following Biesel's piston transfer function frequency by frequency, delayed by the
     gauge's offset and exact at the wave period (``absorption_period``, else the source
     theory's); the correction's vertical profile is linear theory's cosh k(z + d) at that period
-    (uniform when no period is known); ``sph_core.absorption``, docs/absorption.md. The plain
+    (uniform when no period is known); ``sph_core.absorption``, docs/studies/absorption.md. The plain
     gains (``absorption`` shallow/linear), the flux transfer, the uniform profile and the
     gauge's own reading as the outlet's surface were measured and retired (docs/decisions/)."""
 

@@ -27,7 +27,7 @@ shift would keep the hydrostatic density of its old height. |dr_i| is capped at 
 The displacement and the carried increments are gathered into the scratch rows xn, zn, vxn,
 vzn, rhon (kdk does not use them; symplectic_pc rewrites them at its next predictor) and applied
 in a second loop, so no particle reads a neighbour that has already moved. Measured effect on
-the wave of bench/wave_decay.py: none for the better at h/dp 2 (docs/wave_decay_study.md).
+the wave of bench/wave_decay.py: none for the better at h/dp 2 (docs/studies/wave_decay_study.md).
 
 delta-plus uses 11 scratch rows (xn, zn, vxn, vzn, rhon and the MUSCL gradient rows gpx..gwz,
 which riemann_gradients rewrites before every use) for three passes: B, lambda, the normal, the
@@ -81,7 +81,7 @@ def _limited(sx, sz, tangential, nx, nz, max_shift):
 # next to an open end's buffer (an active buffer particle within 2h; scene
 # constants.shift_open_end): 0 "full" shift, 1 "none". The buffer is a lattice moved by the
 # imposed flow, and the crossing rules count fluid in and out by where particles are: a shift
-# beside it moves fluid that the imposed flux did not carry. Measured (docs/wave_decay_study.md
+# beside it moves fluid that the imposed flux did not carry. Measured (docs/studies/wave_decay_study.md
 # "flume-vs-tank gap", oscillating flow through both ends, delta-plus): "none" keeps the count
 # as without shifting ("tangential", retired: docs/decisions/shift_open_end.md, gained water).
 SHIFT_OPEN_END = {"full": 0, "none": 1}

@@ -10,11 +10,11 @@
 
 Every scene runs the same loop: the open inlet/outlet ends are a value (``self.open``, an
 ``open_ends.OpenBoundaries``: named constructors ``from_scene`` / ``closed``), and the time loop
-is one jitted call (``step.run``) up to the next output time (and, with open ends, the next window
-end); Python only handles boundary data, probes, snapshots, metadata and the progress callback.
-ISPH scenes (``scene.scheme.kind == "isph"``) step with ``isph.IsphStepper.run`` instead, a
-Python loop over jitted passes around a sparse pressure solve, with the same returns and the same
-open-end hooks (its buffers and fluid keep density rho0).
+is one call of the scheme's stepper (``self.stepper``, steppers.py: ``WcsphStepper`` runs the
+jitted ``step.run``; ``isph.IsphStepper`` a Python loop over jitted passes around a sparse
+pressure solve, with the same returns and the same open-end hooks) up to the next output time
+(and, with open ends, the next window end); the stepper also makes the run's Params and initial
+state. Python only handles boundary data, probes, snapshots, metadata and the progress callback.
 """
 
 from __future__ import annotations
@@ -27,11 +27,10 @@ from typing import Any, Callable, Mapping
 import numba
 import numpy as np
 
-from . import riemann, step, wcsph
-from .isph import IsphStepper
+from . import wcsph
 from .bodies import BodyLog, BodySet
 from .boundary_data import BoundaryData, BoundaryDataError, BoundarySample
-from .eos import hydrostatic_density, tait_b
+from .eos import tait_b
 from .geometry import build_layout
 from .kernels import w_of_q, wendland_alpha
 from .neighbours import CellGrid, compute_cells, counting_sort
@@ -42,21 +41,16 @@ from .particles import FLUID, INACTIVE, M, P, RHO, VX, VZ, WALL, X, Z, Checkpoin
 from .probes import (fluid_neighbour_counts, interpolate_points, line_mass_density,
                      surface_from_line)
 from .shifting import SHIFT_OPEN_END
-from .scene import ElevationProbe, FrontProbe, PointProbe, Scene, Scheme
+from .scene import ElevationProbe, FrontProbe, PointProbe, Scene
 from .state import Params
-from .wall_contact import face_shares
+from .steppers import Stepper, WcsphStepper, make_stepper, scheme_params
 
 STEPS_PER_CALL = 200  # steps per jitted call between progress callbacks
 # cells per kernel support radius 2h (neighbours.py): 2 = cells of side h, a 5 x 5 search block
 CELLS_PER_SUPPORT = 2
 
 
-def scheme_params(scheme: Scheme) -> dict[str, Any]:
-    """The Params fields of the scene's [scheme] (riemann, limiter)."""
-    if scheme.kind != "riemann":
-        return {"riemann": False, "limiter": riemann.NO_RECONSTRUCTION}
-    lim = riemann.VANLEER if scheme.reconstruction == "muscl" else riemann.NO_RECONSTRUCTION
-    return {"riemann": True, "limiter": lim}
+__all__ = ["Simulation", "UnstableError", "scheme_params"]
 
 
 class UnstableError(RuntimeError):
@@ -82,7 +76,6 @@ class Simulation:
                  window: float = 0.02, cells_per_support: int = CELLS_PER_SUPPORT) -> None:
         self.scene = scene
         c = scene.constants
-        scheme = scene.scheme
         layout = build_layout(scene)
         dp, h = scene.dp, scene.h
         self.h = h
@@ -99,26 +92,19 @@ class Simulation:
             layout.fluid_surface = layout.fluid_surface[keep]
         n = layout.wall_x.size + layout.fluid_x.size + self.bodies.x.size
         self.particles = ps = ParticleSet(max(int(n * (1.0 + spare)), n + 1))
+        # the scheme: its Params, initial state and time loop (steppers.py)
+        self.stepper: Stepper = make_stepper(scene, ps.capacity)
         vol = dp * dp
         ps.add(layout.wall_x, layout.wall_z, WALL, np.full(layout.wall_x.size, c.rho0),
                np.full(layout.wall_x.size, c.rho0 * vol))
-        self.isph = scene.scheme.kind == "isph"
-        if self.isph:  # incompressible: constant density rho0
-            rho_f = np.full(layout.fluid_x.size, c.rho0)
-        else:
-            rho_f = hydrostatic_density(layout.fluid_z, layout.fluid_surface, c.rho0, c.g, self.b)
-        # mass = rho * dp^2: the lattice is the compressed hydrostatic state, so the initial
-        # pressure is hydrostatic and the particle volume is exactly dp^2
+        # mass = rho * dp^2: the particle volume is exactly dp^2
+        rho_f, p_f = self.stepper.initial_fluid(layout.fluid_z, layout.fluid_surface)
         ps.add(layout.fluid_x, layout.fluid_z, FLUID, rho_f, rho_f * vol)
-        if self.isph:  # hydrostatic pressure: the warm start of the first pressure solve
-            ps.f[P, ps.n - rho_f.size: ps.n] = c.rho0 * c.g * (layout.fluid_surface - layout.fluid_z)
+        if p_f is not None:
+            ps.f[P, ps.n - rho_f.size: ps.n] = p_f
         self.bodies.attach(ps, c.rho0, dp)
         self.n_layers = layout.n_layers
         self.open.attach(ps, scene, self.b, layout.n_layers * dp)
-        if self.isph and self.open.active:  # incompressible buffers: constant density and mass
-            buf = (ps.kind[: ps.n] != FLUID) & (ps.kind[: ps.n] != WALL) & (ps.kind[: ps.n] >= 0)
-            ps.f[RHO, : ps.n][buf] = c.rho0
-            ps.f[M, : ps.n][buf] = c.rho0 * vol
         t = scene.tank
         wall = layout.n_layers * dp
         self.grid = CellGrid.covering(t.x0 - wall, t.x1 + wall, t.z0 - wall, t.z1, 2.0 * h,
@@ -129,51 +115,19 @@ class Simulation:
         # has gone through the wall; the top z1 is open
         fx0, fx1 = self.open.fluid_box(t.x0 - 0.5 * dp, t.x1 + 0.5 * dp, dp)
         lo, hi = c.density_band
-        # shifting (shifting.py): delta-plus's CFL Ma (2h)^2 is D = 4 h max|v| dt
-        dplus = c.shifting == "dplus" and not self.isph
-        if dplus:
-            shift_a = 4.0 * c.shift_dplus_scale
-        elif c.shifting == "fickian" or (self.isph and scheme.isph_shifting):
-            shift_a = c.shift_a
-        else:
-            shift_a = 0.0
-        self.prm = Params(h=h, alpha_w=aw, alpha_f=5.0 * aw / (h * h), rho0=c.rho0, c0=self.c0,
-                          b=self.b, gamma=7.0, gx=0.0, gz=-c.g, nu=c.nu,
-                          # ISPH has no artificial viscosity (the bodies' load pass reads alpha)
-                          alpha=0.0 if self.isph else c.alpha,
-                          delta=c.delta, cfl=scheme.isph_cfl if self.isph else c.cfl,
-                          rho_lo=lo, rho_hi=hi,
-                          noslip=c.wall_slip == "no_slip", fx0=fx0, fx1=fx1,
-                          fz0=t.z0 - 0.5 * dp, fz1=t.z1, alpha_wall=c.alpha_wall_factor,
-                          shift_a=shift_a, shift_fs_div=c.shift_fs_div,
-                          # ISPH's figures (docs/schemes.md) were measured without the carry
-                          shift_dplus=dplus, shift_carry=c.shift_carry and not self.isph,
-                          shift_inv_wdp=1.0 / w_of_q(dp / h, aw),
-                          shift_open=SHIFT_OPEN_END[c.shift_open_end],
-                          # no penetration at wall faces (WCSPH and Riemann; ISPH has its own
-                          # no-penetration pressure, isph_wall_stop)
-                          **dict(zip(("wall_ga", "wall_g0", "wall_gb"),
-                                     (0.0, 0.0, 0.0) if self.isph
-                                     else face_shares(h, dp, layout.n_layers, aw))),
-                          **scheme_params(scene.scheme))
-        self.passes_per_step = wcsph.PASSES_PER_STEP[c.integrator]
+        # the scheme-neutral Params; the stepper adds its scheme's (viscosity, Courant number,
+        # shifting law, wall shares, flux)
+        base = dict(h=h, alpha_w=aw, alpha_f=5.0 * aw / (h * h), rho0=c.rho0, c0=self.c0,
+                    b=self.b, gamma=7.0, gx=0.0, gz=-c.g, nu=c.nu, delta=c.delta,
+                    rho_lo=lo, rho_hi=hi, noslip=c.wall_slip == "no_slip", fx0=fx0, fx1=fx1,
+                    fz0=t.z0 - 0.5 * dp, fz1=t.z1, alpha_wall=c.alpha_wall_factor,
+                    shift_fs_div=c.shift_fs_div, shift_inv_wdp=1.0 / w_of_q(dp / h, aw),
+                    shift_open=SHIFT_OPEN_END[c.shift_open_end])
+        self.stepper.params(scene, base, layout.n_layers)
+        self.passes_per_step = self.stepper.passes_per_step
         self._counts = np.zeros(ps.capacity, dtype=np.int64)
-        self.stepper: IsphStepper | None = None
-        if self.isph:
-            self.stepper = IsphStepper(ps.capacity, self.prm, dp, scheme.ppe_solver,
-                                       scheme.ppe_tolerance, scheme.ppe_max_iter,
-                                       scheme.free_surface, scheme.free_surface_threshold,
-                                       scheme.isph_shifting, scheme.isph_gradient,
-                                       v_ref=scheme.isph_vref_factor * math.sqrt(2.0 * c.g * scene.water_height),
-                                       density_relaxation=scheme.isph_density_relaxation,
-                                       wall_stop=scheme.isph_wall_stop,
-                                       dry_walls=scheme.isph_dry_walls)
-            dt, n_new = self.stepper.initialise(ps.view, ps.view2, self.cells, ps.n,
-                                                self.open.ends, self.bodies.state)
-        else:
-            ends, bd, _, riemann, _ = self._step_parts()
-            dt, n_new = step.initialise(ps.view, ps.view2, self.cells, self.prm, ends, bd,
-                                        riemann, ps.n)
+        dt, n_new = self.stepper.initialise(ps.view, ps.view2, self.cells, self.open.ends,
+                                            self.bodies.state, ps.n)
         self.dt = float(dt)
         ps.swap()
         ps.n = int(n_new)
@@ -212,6 +166,15 @@ class Simulation:
         self._record_outputs()
 
     # ---------------------------------------------------------------- state access
+    @property
+    def prm(self) -> Params:
+        """The run's Params (the stepper's)."""
+        return self.stepper.prm
+
+    @prm.setter
+    def prm(self, value: Params) -> None:
+        self.stepper.prm = value
+
     @property
     def nodes(self) -> dict:
         """BoundaryNodes of each open end (where a source gives u, w)."""
@@ -306,7 +269,7 @@ class Simulation:
                 "excluded": len(self.excluded), "excluded_particles": self.excluded[-20:],
                 "c0": self.c0, "h": self.h, "integrator": self.scene.constants.integrator,
                 "scheme": self.scene.scheme.kind,
-                **(self.stepper.stats() if self.stepper is not None else {}),
+                **self.stepper.stats(),
                 "passes_per_step": self.passes_per_step, "threads": numba.get_num_threads(),
                 "particle_steps_per_s": (self.n_particles * self.steps / self.wall_time
                                          if self.wall_time > 0 else None),
@@ -426,19 +389,14 @@ class Simulation:
         self._run(math.inf, int(n_steps))
 
     def _run(self, t_stop: float, max_steps: int) -> None:
-        """One call of the jitted loop up to ``t_stop`` or ``max_steps`` steps."""
+        """One call of the stepper's loop up to ``t_stop`` or ``max_steps`` steps."""
         ps = self.particles
         ends = self.open.ends
         ends.next_id[0] = ps.next_id
         tic = time.perf_counter()
-        if self.stepper is not None:
-            t, dt, steps, status, swapped, n_flag, vmax, n = self.stepper.run(
-                ps.view, ps.view2, self.cells, ends, self.bodies.state, ps.n, self.t, self.dt,
-                t_stop, max_steps)
-        else:
-            t, dt, steps, status, swapped, n_flag, vmax, n = step.run(
-                ps.view, ps.view2, self.cells, self.prm, *self._step_parts(), ps.n, self.t,
-                self.dt, t_stop, max_steps)
+        t, dt, steps, status, swapped, n_flag, vmax, n = self.stepper.run(
+            ps.view, ps.view2, self.cells, ends, self.bodies.state, ps.n, self.t, self.dt,
+            t_stop, max_steps)
         self.wall_time += time.perf_counter() - tic
         if swapped:
             ps.swap()
@@ -456,11 +414,6 @@ class Simulation:
             raise UnstableError(self.steps, self.t, cause)
         if status not in (wcsph.ST_REACHED_T, wcsph.ST_STEP_LIMIT):
             self._stopped(status, n_flag)
-
-    def _step_parts(self) -> tuple:
-        """The optional parts of the jitted step, None where this scene has none (step.py)."""
-        return step.step_parts(self.open.ends, self.bodies.state, self.scene.constants.integrator,
-                               self.scene.scheme.kind == "riemann", self.prm.shift_a > 0.0)
 
     # ---------------------------------------------------------------- open ends
     def boundary_gauges(self) -> dict[str, float | None]:
@@ -576,12 +529,12 @@ class Simulation:
         at the current state, as at the start of a run. The particles are kept as they are: a
         caller changing gravity sets the matching density field first. WCSPH only (the ISPH
         stepper holds its own copy of the parameters)."""
-        if self.stepper is not None:
+        if not isinstance(self.stepper, WcsphStepper):
             raise ValueError("set_gravity: WCSPH runs only (the ISPH stepper keeps its own gravity)")
         ps = self.particles
         self.prm = self.prm._replace(gx=float(gx), gz=float(gz))
-        ends, bd, _, riemann, _ = self._step_parts()
-        dt, n = step.initialise(ps.view, ps.view2, self.cells, self.prm, ends, bd, riemann, ps.n)
+        dt, n = self.stepper.initialise(ps.view, ps.view2, self.cells, self.open.ends,
+                                        self.bodies.state, ps.n)
         ps.swap()
         ps.n = int(n)
         self.dt = float(dt)

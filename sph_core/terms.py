@@ -284,13 +284,20 @@ WALL_SUMS_ZERO = WallSums(0.0, 0.0, 0.0, 0.0)
 
 
 @njit(cache=True, inline="always")
+def adami_sum(a, w, pj, rhoj, br, vxj, vzj):
+    """WallSums ``a`` plus one fluid neighbour's share: kernel weight w, pressure pj, density
+    rhoj, br = (g - a_s) . r_sf the hydrostatic lever, velocity (vxj, vzj)."""
+    return WallSums(a.sw + w, a.sp + (pj + rhoj * br) * w, a.svx + vxj * w, a.svz + vzj * w)
+
+
+@njit(cache=True, inline="always")
 def adami_pair(i, j, dx, dz, r2, ps, ctx, a):
     """Wall particle i and fluid neighbour j (Adami, Hu & Adams 2012): the kernel-weighted
     pressure with the hydrostatic correction and velocity. ctx = (inv_h, alpha_w, bx, bz), b
-    = g - a_i the wall's apparent gravity."""
+    = g - a_i the wall's apparent gravity. (ISPH's wall rows sum the same, without the fluid's
+    pressure: isph.terms.wall_pair.)"""
     w = w_of_q(math.sqrt(r2) * ctx[0], ctx[1])
-    return WallSums(a.sw + w, a.sp + (ps.p[j] + ps.rho[j] * (ctx[2] * dx + ctx[3] * dz)) * w,
-                    a.svx + ps.vx[j] * w, a.svz + ps.vz[j] * w)
+    return adami_sum(a, w, ps.p[j], ps.rho[j], ctx[2] * dx + ctx[3] * dz, ps.vx[j], ps.vz[j])
 
 
 @njit(cache=True, inline="always")

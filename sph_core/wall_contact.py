@@ -2,7 +2,7 @@
 its velocity towards the wall (the no-penetration correction DualSPHysics 5.4 adds to its mDBC
 walls, "NoPenetration"; read, not copied: JSphCpu.cpp ComputeNoPenVel).
 
-Why (docs/wall_pressure.md, 2026-11-23 "the dry-bed front"): the Adami wall (wcsph.wall_pass)
+Why (docs/studies/wall_pressure.md, 2026-11-23 "the dry-bed front"): the Adami wall (wcsph.wall_pass)
 resists a fluid particle only through the particle's density, and a particle can approach the
 wall at constant density: in a thin film stretched along a bed (a dam break's front) continuity
 keeps the bottom particle's density only if it approaches the wall particles at

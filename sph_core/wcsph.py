@@ -132,7 +132,7 @@ def fluid_pass(ps, n, cells, prm, riemann):
             # no tension across a wall while the particle approaches it (p_i -> max(p_i, 0)): a
             # particle in tension is otherwise pulled into the wall (a dry-bed front sinks
             # through the bed); one that moves away keeps the pull, so a thin swash film stays
-            # on its beach (docs/wall_pressure.md). The Riemann flux has no such pair term
+            # on its beach (docs/studies/wall_pressure.md). The Riemann flux has no such pair term
             # (tx = 0): its walls always feel max(p_i, 0)
             pwi = fi.p
             if fi.p < 0.0 and (riemann is not None

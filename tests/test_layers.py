@@ -1,6 +1,6 @@
 """The package layering and the project's names cannot rot silently.
 
-- The import-linter contracts of pyproject.toml ([tool.importlinter]; docs/ARCHITECTURE.md says
+- The import-linter contracts of pyproject.toml ([tool.importlinter]; docs/developer/architecture.md says
   why each holds) are kept.
 - `wavesph couple` with a theory runs without loading the SPH solver, numba, the server or the
   cases.

@@ -60,7 +60,7 @@ def test_mass_exactly_conserved_and_fluid_stays_in_tank(coarse):
 
 
 def _isph_xfail(request, reason: str) -> None:
-    """ISPH's measured shortfall on this case (docs/schemes.md "## ISPH"): strict xfail."""
+    """ISPH's measured shortfall on this case (docs/studies/schemes.md "## ISPH"): strict xfail."""
     if request.node.callspec.params["coarse"] == "isph":
         request.applymarker(pytest.mark.xfail(strict=True, reason="ISPH (a/dp 20, h/dp sqrt 2): "
                                               + reason + "; measured, not tuned away"))
@@ -78,7 +78,7 @@ def test_front_within_10_percent_of_koshizuka_oka(coarse, request):
 def test_front_within_10_percent_of_martin_moyce(coarse, request):
     """With the case's alpha = 0.1 (DualSPHysics CaseDambreak); with alpha = 0.01 the front leads
     by up to 13.8 % at T = 1.2 (measured, reported, not tuned away). Riemann SPH has no alpha:
-    11.6 % (docs/schemes.md); within 10 % of Koshizuka & Oka."""
+    11.6 % (docs/studies/schemes.md); within 10 % of Koshizuka & Oka."""
     if request.node.callspec.params["coarse"] == "riemann":
         request.applymarker(pytest.mark.xfail(strict=True, reason=(
             "Riemann SPH (MUSCL, van Leer, beta 1): max front error 11.6 % against Martin & "

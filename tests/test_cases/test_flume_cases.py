@@ -24,7 +24,7 @@ THEORY = {"standing": ("standing", {}), "linear": ("linear", {}),
           "stream_function": ("stream", {"n_fourier": 16})}
 
 
-# measured (docs/schemes.md "ISPH with open ends and bodies"): the open ends' buffers hold still
+# measured (docs/studies/schemes.md "ISPH with open ends and bodies"): the open ends' buffers hold still
 # water and a through-flow, but a progressive wave makes jets at their surface corners
 ISPH_WAVE_FLUME = ("ISPH: unstable at t = 2.49 s (24 particles excluded before, then one over the "
                    "tank top at the outlet end); measured, not tuned away")

@@ -4,7 +4,7 @@ corner in every dummy layer before the wall rows were spaced to meet the columns
 
 Measured before that fix (h/dp sqrt(2), this test's settings): a fluid particle left through
 the bottom right corner at t = 0.848 s (x = 1.606, z = -0.0075 m); at dp 0.008 in a 201.5 dp tank
-two left at 1.31 and 1.70 s; at dp 0.004 (402.5 dp, the case's own tank) see docs/wall_pressure.md.
+two left at 1.31 and 1.70 s; at dp 0.004 (402.5 dp, the case's own tank) see docs/studies/wall_pressure.md.
 """
 
 import math

@@ -1,7 +1,7 @@
 """The SPH wave's own loss falls with resolution (slow: about 10 min on one loaded core).
 
 The closed-tank standing wave of wavesph.cases.standing_wave (the wave of bench/wave_decay.py without
-inlet, outlet or gauge; docs/wave_decay_study.md) at three resolutions with the scene's
+inlet, outlet or gauge; docs/studies/wave_decay_study.md) at three resolutions with the scene's
 defaults: h/dp 2, alpha 0.01, no artificial viscosity against the walls (alpha_wall_factor 0:
 with it the loss does not converge, 6.09 -> 4.73 %/m). Measured on the study's machine
 (6 periods): equivalent decay 2.28, 1.80 and 1.24 %/m at dp 0.025, 0.02 and 0.01 (order 0.67

@@ -326,7 +326,7 @@ def _isph(scene_dict: dict):
 @pytest.mark.xfail(strict=True, reason=(
     "ISPH: the fixed box's heave load after the first step is 0.907 x rho0 g B d (0.89-0.90 "
     "over 0.5 s): p = 0 sits on the surface particles' centres, dp/2 below the surface, a "
-    "deficit of (dp/2)/d = 10 % at a draft of 5 dp (docs/schemes.md '## ISPH'). Measured"))
+    "deficit of (dp/2)/d = 10 % at a draft of 5 dp (docs/studies/schemes.md '## ISPH'). Measured"))
 def test_isph_hydrostatic_load_on_a_fixed_box_is_archimedes() -> None:
     """ISPH solves no pressure before its first step: the load is the first step's."""
     d = floating_box_scene(dp=0.02, breadth=0.4, height=0.2, density=500.0).model_dump()

@@ -1,6 +1,6 @@
 """Particle layout: a sloped bed meets the fluid lattice at spacing dp in every column
-(docs/SHORELINE_JET.md); the wall's dummy rows close the corners whatever the tank length
-(docs/wall_pressure.md)."""
+(docs/studies/SHORELINE_JET.md); the wall's dummy rows close the corners whatever the tank length
+(docs/studies/wall_pressure.md)."""
 
 from __future__ import annotations
 
@@ -52,7 +52,7 @@ def tank_scene(length: float, dp: float, h_over_dp: float = 1.4142, beds=()):
 def test_bottom_rows_meet_both_side_walls_without_a_gap(cells, h_over_dp):
     """Every bottom layer runs from the left wall's columns to the right wall's with spacings
     within 1 % of dp. A tank 100.5 dp long used to leave a 1.5 dp gap at the right corner in
-    every layer (the dam-break leak of docs/wall_pressure.md)."""
+    every layer (the dam-break leak of docs/studies/wall_pressure.md)."""
     dp = 0.01
     lay = build_layout(tank_scene(cells * dp, dp, h_over_dp))
     for k in range(lay.n_layers):

@@ -14,13 +14,16 @@ DP = D / 25       # 25 layers
 PROBE_Z = [0.02, 0.05, 0.08, 0.11]   # all below half depth
 SCHEMES = {"wcsph": {}, "riemann": {"kind": "riemann"}, "isph": {"kind": "isph"}}
 # Riemann SPH needs h/dp 2 (the default): at h/dp sqrt 2 it measured bed pressure up to 9 % off and
-# surface particles at 0.024 m/s (limit 0.0157) on this scene (docs/schemes.md)
+# surface particles at 0.024 m/s (limit 0.0157) on this scene (docs/studies/schemes.md)
 
 
-# ISPH's 3.2 s at d/dp 25 costs minutes (a sparse solve per step): slow; it does not hold the
-# tank that long (tests/test_sph_core/test_isph.py, docs/schemes.md "## ISPH")
-ISPH_STILL = ("ISPH: unstable at t = 2.89 s of 3.19 (12 particles excluded before, then one over "
-              "the tank top): its surface corners creep inward and break down at ~2 s; measured")
+# ISPH's 3.2 s at d/dp 25 is slow (a sparse solve per step). It holds the tank that long since
+# its corrector leaves the dry wall particles out (tests/test_sph_core/test_isph.py); its pressure
+# is low by what p = 0 on the surface particles' centres costs
+ISPH_PRESSURE = ("ISPH: 3.5 % below rho0 g (d - z) at z = 0.11 m over the second half: p = 0 sits "
+                 "on the surface particles' centres, dp/2 below the surface, and the density "
+                 "relaxation pulls the cut-support layers together (docs/studies/schemes.md "
+                 "'## ISPH'); measured, not tuned")
 
 
 # Riemann SPH's tank (h/dp 2) took 70 s (cold numba cache) and 108 s (warm) of the default run,
@@ -29,8 +32,7 @@ ISPH_STILL = ("ISPH: unstable at t = 2.89 s of 3.19 (12 particles excluded befor
 # speed 1 % of sqrt(g d)) in the open-ended flume (6 s),
 # tests/test_sph_core/test_open_boundary.py::test_still_water_with_open_ends_*[riemann]
 @pytest.fixture(scope="module", params=["wcsph", pytest.param("riemann", marks=pytest.mark.slow),
-                                        pytest.param("isph", marks=[
-    pytest.mark.slow, pytest.mark.xfail(strict=True, reason=ISPH_STILL)])])
+                                        pytest.param("isph", marks=pytest.mark.slow)])
 def still_run(request):
     scene = make_scene({
         "name": "still", "dp": DP, "t_end": 20 * math.sqrt(D / 9.81), "still_water_level": D,
@@ -51,7 +53,9 @@ def still_run(request):
     return sim, scene, m0, n0, np.array(speeds)
 
 
-def test_pressure_stays_hydrostatic(still_run):
+def test_pressure_stays_hydrostatic(still_run, request):
+    if request.node.callspec.params["still_run"] == "isph":
+        request.applymarker(pytest.mark.xfail(strict=True, reason=ISPH_PRESSURE))
     sim, scene, *_ = still_run
     rho0, g = scene.constants.rho0, scene.constants.g
     late = [r for r in sim.history if r["t"] >= 0.5 * scene.t_end]

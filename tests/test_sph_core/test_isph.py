@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import scipy.sparse as sp
+import scipy.sparse.linalg as spla
 
 from wavesph.cases.dambreak import dambreak_scene, front_errors, martin_moyce_table
 from sph_core import isph
@@ -40,8 +41,7 @@ def assembled_ppe(res: int = 10):
     sim = Simulation(still_scene(res, 1.0))
     st, ps, prm, dt = sim.stepper, sim.particles.view, sim.prm, sim.dt
     n = sim.particles.n
-    isph.free_surface_flags(ps, n, sim.cells, prm, st.by_density, st.fs_threshold, st.flag,
-                            st.rho_k)
+    isph.free_surface_flags(ps, n, sim.cells, prm, st.fs_threshold, st.flag, st.rho_k)
     st.rho_ref = float(np.median(st.rho_k[:n][st.flag[:n] == 0]))
     isph.wall_state(ps, n, sim.cells, prm, dt, st.wall_stop, st.wsum, st.dwall)
     isph.predict(ps, n, sim.cells, prm, dt)
@@ -70,9 +70,10 @@ def test_wall_particles_without_fluid_neighbours_get_zero_pressure():
 @pytest.mark.parametrize("solver", isph.PPE_SOLVERS)
 def test_ppe_solvers_agree_and_give_the_hydrostatic_slope(solver):
     st, sim, m, z = assembled_ppe()
-    ref, _, rel_ref = isph.solve_ppe("direct", m, st.ptr, st.indices, st.data, st.b[:m],
-                                     np.zeros(m), 1e-10, 1000, st.x2)
-    assert rel_ref < 1e-10
+    nnz = int(st.ptr[m])
+    a = sp.csr_matrix((st.data[:nnz], st.indices[:nnz], st.ptr[: m + 1]), shape=(m, m))
+    ref = spla.spsolve(a.tocsc(), st.b[:m])   # SuperLU: the reference
+    assert np.linalg.norm(st.b[:m] - a @ ref) < 1e-10 * np.linalg.norm(st.b[:m])
     sol, it, rel = isph.solve_ppe(solver, m, st.ptr, st.indices, st.data, st.b[:m].copy(),
                                   np.zeros(m), 1e-8, 200000, st.x2)
     assert rel <= 1e-8 * 1.01 and it >= 1
@@ -125,8 +126,24 @@ def test_isph_accepts_open_ends_and_fixed_bodies_and_refuses_free_ones_by_field(
             make_scene({**base, "bodies": [{**body, "motion": motion, **extra}]})
 
 
+@pytest.mark.parametrize("key, value", [("isph_gradient", "symmetric"), ("ppe_solver", "explicit"),
+                                        ("ppe_solver", "ilu"), ("ppe_solver", "direct"),
+                                        ("free_surface", "density"), ("isph_dry_walls", True)])
+def test_retired_options_name_their_decision_page(key, value):
+    with pytest.raises(SceneError, match=rf"scheme\.{key}: {value!r} was measured and retired "
+                                         rf"\(see docs/decisions/{key}\.md\)"):
+        still_scene(10, 1.0, **{key: value})
+
+
+def test_surviving_values_of_retired_options_are_accepted():
+    sc = still_scene(10, 1.0, isph_gradient="corrected", free_surface="divergence",
+                     isph_dry_walls=False, ppe_solver="amg")
+    assert sc.scheme.ppe_solver == "amg" and sc.scheme.free_surface_threshold == 1.5
+    assert not hasattr(sc.scheme, "isph_gradient") and not hasattr(sc.scheme, "isph_dry_walls")
+
+
 def test_short_isph_run_keeps_mass_and_records_ppe_stats():
-    sim = Simulation(still_scene(10, 0.2, ppe_solver="explicit"))
+    sim = Simulation(still_scene(10, 0.2))
     m0, n0 = sim.fluid_state()["m"], sim.n_fluid
     sim.advance_to(0.2)
     st = sim.fluid_state()
@@ -141,7 +158,7 @@ def test_short_isph_run_keeps_mass_and_records_ppe_stats():
 def test_run_takes_no_sliver_step_before_a_record():
     """The PPE source and the wall's no-penetration pressure scale as 1/dt: a sliver step that
     lands on a record time gave recorded wall pressures of 10^5-10^7 Pa in the dam break
-    (docs/schemes.md "## ISPH"). IsphStepper.run shares a short remainder between the last two
+    (docs/studies/schemes.md "## ISPH"). IsphStepper.run shares a short remainder between the last two
     steps instead."""
     sim = Simulation(still_scene(10, 0.2))
     st = sim.stepper
@@ -175,7 +192,7 @@ def check_still(sim, m0, n0):
     p = np.array([r["bed_p0"] for r in h])
     # p = 0 is imposed on the surface particles' centres, dp/2 below the surface (-2 %), and
     # the density relaxation pulls the cut-support layers under the surface together
-    # (docs/schemes.md "## ISPH"); WCSPH: -0.3 %
+    # (docs/studies/schemes.md "## ISPH"); WCSPH: -0.3 %
     assert np.max(np.abs(p / exact - 1)) < 0.04
     # no drift: the last quarter's mean equals the third quarter's
     half = len(p) // 2
@@ -195,9 +212,9 @@ def test_isph_still_water_bed_pressure_hydrostatic_without_drift():
 @pytest.mark.slow
 def test_isph_still_water_holds_20_sqrt_d_over_g():
     """As WCSPH (tests/test_sph_core/test_hydrostatic.py). Held since the corrector leaves the wall
-    particles above the water (p < 0) out of the pressure gradient (isph_dry_walls = false);
+    particles above the water (p < 0) out of the pressure gradient (docs/decisions/isph_dry_walls.md);
     with them the surface corners crept away from the wall and broke down at ~2.9 s
-    (docs/schemes.md "## ISPH", 2026-11-23)."""
+    (docs/studies/schemes.md "## ISPH", 2026-11-23)."""
     check_still(*run_still(20 * math.sqrt(D / 9.81)))
 
 
@@ -213,6 +230,6 @@ def test_isph_dambreak_front_against_martin_moyce():
     t, x = np.array([(r["t"], r["front_x"]) for r in sim.history]).T
     err = front_errors(t, x, a, t_max=3.0,
                        table=martin_moyce_table(DATA / "dambreak_martin_moyce_1952.csv"))
-    # measured 16.5 % (WCSPH 8.4 %): docs/schemes.md "## ISPH"
+    # measured 16.5 % (WCSPH 8.4 %): docs/studies/schemes.md "## ISPH"
     assert err["max_rel_error"] < 0.20, err
     assert sim.n_fluid + len(sim.excluded) == n0

@@ -90,7 +90,7 @@ def test_no_particle_leaves_through_the_bed_under_a_dry_bed_front():
     """The run above lost 2-3 particles through the bed at h/dp 2 (left the tank at z = -dp/2,
     x = 1.4-2.0 m, t = 0.36-0.77 s) before the no-penetration correction (sph_core.wall_contact):
     the front's bottom particles sank between the wall particles to keep their density in the
-    stretching film (docs/wall_pressure.md, 2026-11-23 "the dry-bed front")."""
+    stretching film (docs/studies/wall_pressure.md, 2026-11-23 "the dry-bed front")."""
     sim = _dry_bed_dam_break()
     assert sim.excluded == []
     ps = sim.particles

@@ -74,7 +74,7 @@ def test_still_water_with_open_ends_is_hydrostatic(still_flume, request):
             "ISPH: 5.8 % below rho0 g (d - z) in the lower half at 1 s (6.1-6.9 % over 0.1-0.9 "
             "s), as in its closed tank: p = 0 sits on the surface particles' centres, dp/2 below "
             "the surface "
-            "(rho0 g dp/2 = 98 Pa at dp 0.02); docs/schemes.md '## ISPH'. Measured, not tuned")))
+            "(rho0 g dp/2 = 98 Pa at dp 0.02); docs/studies/schemes.md '## ISPH'. Measured, not tuned")))
     st = still_flume.fluid_state()
     low = st["z"] < 0.5 * D
     p_ref = 1000.0 * G * (D - st["z"][low])
@@ -194,7 +194,7 @@ def test_pushed_windows_drive_the_flume_like_the_source_they_sample(scheme):
 @pytest.mark.parametrize("scheme", ["wcsph", "riemann", pytest.param("isph", marks=[
     pytest.mark.slow, pytest.mark.xfail(strict=True, reason=(
         "ISPH: unstable at t = 1.498 s (5 particles excluded before, then one over the tank top "
-        "above the block at x = 0.48 m): ISPH's impacts on structures (docs/schemes.md "
+        "above the block at x = 0.48 m): ISPH's impacts on structures (docs/studies/schemes.md "
         "'## ISPH'); measured, not tuned away"))])])
 def test_inlet_with_a_beach_and_a_structure_keeps_running_and_counting(scheme):
     """Left inlet driving a shallow-water wave onto a 1:4 beach with a block on the bed; the right

@@ -161,7 +161,7 @@ def test_particle_thrown_beside_a_side_wall_stays_in_the_tank(integrator, h_over
     """The surface-row particle next to a side wall, thrown up at 3 m/s, is held back by the
     fluid's tension and must not be pulled through the wall (issue 11 item 5). It was, at h/dp 2:
     in tension (p ~ -16 kPa) its pressure term attracted it to the wall particles as to fluid, and
-    it left at x = x0 - dp/2, z 0.12 m after 0.021 s (docs/wall_pressure.md, 2026-11-23)."""
+    it left at x = x0 - dp/2, z 0.12 m after 0.021 s (docs/studies/wall_pressure.md, 2026-11-23)."""
     dp = 0.02
     scene = make_scene({
         "dp": dp, "t_end": 0.1, "still_water_level": 0.1,
@@ -196,7 +196,7 @@ def test_thin_front_on_a_dry_bed_does_not_sink_through_it(integrator):
     density and sank between the wall particles (main befe411, kdk: one centre reached the first
     dummy row, z = -dp/2, at 0.443 s and the run, exclude_limit 0, stopped). With the
     no-penetration correction (sph_core.wall_contact) no centre passes the bed's face
-    (docs/wall_pressure.md, 2026-11-23 "the dry-bed front")."""
+    (docs/studies/wall_pressure.md, 2026-11-23 "the dry-bed front")."""
     dp = 0.02
     scene = make_scene({
         "dp": dp, "t_end": 0.6,

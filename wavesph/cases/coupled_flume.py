@@ -306,8 +306,8 @@ def run_coupled(c: FlumeCase, dp: float, out: Path, two_way: bool = True,
     --model boussinesq --config <out>/wave_scene.toml [--absorb]` runs it. Figures and series.
 
     absorb: who absorbs the beach's reflection at the SPH inlet; exactly one absorber, or the
-    gain doubles (docs/ARCHITECTURE.md). Default: "incident" for two-way (measured best,
-    docs/absorption.md), "client" otherwise. ``constants`` override the SPH scene's.
+    gain doubles (docs/developer/architecture.md). Default: "incident" for two-way (measured best,
+    docs/studies/absorption.md), "client" otherwise. ``constants`` override the SPH scene's.
       "none": two-way only: the model's characteristic boundary takes SPH's reflected wave
         L = (eta - u_ref / r) / 2 and hands it back in the inlet data, so the inlet passes it.
       "client": `wavesph couple --absorb`; mismatch = the inlet gauge's reading minus the
@@ -315,7 +315,7 @@ def run_coupled(c: FlumeCase, dp: float, out: Path, two_way: bool = True,
       "incident": two-way, plus the client's correction on the incident characteristic only
         (`--absorb --absorb-wave incident`): the boundary lets SPH's reflection out, the
         correction makes SPH's inlet carry the model's incident wave and level
-        (docs/absorption.md; dp 0.02: RMSE/H 7.2 % against 9.1 % without, 6.6 %
+        (docs/studies/absorption.md; dp 0.02: RMSE/H 7.2 % against 9.1 % without, 6.6 %
         absorption-only).
       "sph": the scene's open boundary (`absorb = true`). Over the socket its reference is the
         elevation SET gives for the face (the protocol carries eta at the nodes' x only), not

@@ -25,7 +25,7 @@ def add_scheme_arguments(ap: argparse.ArgumentParser) -> None:
     ap.add_argument("--scheme", choices=["wcsph", "riemann", "isph"], default="wcsph",
                     help="[scheme] kind (sph_core.scene.Scheme)")
     ap.add_argument("--reconstruction", choices=["muscl", "none"], help="riemann: reconstruction")
-    ap.add_argument("--ppe-solver", choices=["explicit", "amg", "ilu", "direct"],
+    ap.add_argument("--ppe-solver", choices=["bicgstab", "amg"],
                     help="isph: pressure Poisson solver (scene default: amg)")
 
 

@@ -4,7 +4,7 @@ Geometry (their Fig. 1, 2D section): a tank 1.61 m long and 0.6 m high; the wate
 0.6 m long and H = 0.3 m high at the left wall, released at t = 0; the surge hits the far (right)
 wall at x = 1.61 m. Pressure sensors on that wall at z = 3, 15, 30 and 80 mm above the bed
 (sensor 1 = 3 mm). The tank length is 402.5 dp at dp = 0.004 m: not a whole
-number of spacings, the case that exposed the corner leak (docs/wall_pressure.md).
+number of spacings, the case that exposed the corner leak (docs/studies/wall_pressure.md).
 
 Experiment: L. Lobovsky, E. Botia-Vera, F. Castellana, J. Mas-Soler, A. Souto-Iglesias,
 "Experimental investigation of dynamic pressure loads during dam break", J. Fluids Struct. 48

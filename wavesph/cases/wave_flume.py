@@ -153,7 +153,7 @@ def flume_case(model: Any, *, height: float, period: float, depth: float, wavele
     there. The model starts everywhere at once, so until SPH's ramped wave reaches the outlet
     the outlet is told a wave that is not there: its correction answers a mismatch of the whole
     wave, and what it emits then crosses the gauges during the standard window (at kd 2, H/dp 4:
-    6.2 % there, 0.5-2 % once it has passed; docs/absorption.md, 2026-11-23)."""
+    6.2 % there, 0.5-2 % once it has passed; docs/studies/absorption.md, 2026-11-23)."""
     length = 0.5 * wavelength if standing else wavelength
     # the ramp starts the model everywhere at once, SPH's wave front travels from the inlet:
     # compare once the fully ramped wave has reached mid-flume at the (linear) group velocity

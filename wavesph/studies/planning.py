@@ -218,7 +218,7 @@ MAX_PLAN_PARTICLES = 5e7   # beyond this a method cannot reach the target on any
 
 def _unstable_flumes(rows: list[dict[str, Any]], method: str) -> bool:
     """A method whose flume points in the sweep data ended unstable is not planned for waves
-    (ISPH's wave flume today, docs/schemes.md)."""
+    (ISPH's wave flume today, docs/studies/schemes.md)."""
     return any(r["method"] == method and r["case"].startswith("flume_") and r["status"] == "unstable"
                for r in rows)
 

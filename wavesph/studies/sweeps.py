@@ -59,13 +59,13 @@ METHODS: dict[str, dict[str, Any]] = {
     "wcsph_symplectic_h2": {"integrator": "symplectic_pc", "h_over_dp": 2.0,
                             "alpha_wall_factor": 1.0},
     # no artificial viscosity against walls: the wave-decay study's main finding
-    # (docs/wave_decay_study.md), and particle shifting on top of it
+    # (docs/studies/wave_decay_study.md), and particle shifting on top of it
     "wcsph_kdk_h2_wallav0": {"h_over_dp": 2.0, "alpha_wall_factor": 0.0},
     "wcsph_kdk_h2_wallav0_shift": {"h_over_dp": 2.0, "alpha_wall_factor": 0.0,
                                    "shifting": "fickian"},
     **{name: {"h_over_dp": 2.0, "alpha_wall_factor": 0.0, "scheme": sch}
        for name, sch in RIEMANN_VARIANTS.items()},
-    # ISPH at its h/dp sqrt 2; its wave flume is unstable (docs/schemes.md), so its flume points
+    # ISPH at its h/dp sqrt 2; its wave flume is unstable (docs/studies/schemes.md), so its flume points
     # end "unstable" with the reason
     "isph_amg": {"h_over_dp": ISPH_H_OVER_DP, "alpha_wall_factor": 0.0,
                  "scheme": {"kind": "isph", "ppe_solver": "amg"}},

@@ -1,0 +1,149 @@
+"""ISPH's per-pair terms: the folds of ``pairs.gather`` that its passes compose (passes.py,
+ppe.py), with the physical pieces they share with WCSPH (sph_core.terms: the Adami wall sums,
+the laminar viscosity).
+
+Same signature as every term, ``acc = term(i, j, dx, dz, r2, ps, ctx, acc)`` (dx = x_i - x_j);
+``ctx`` is a tuple read by index (numba's parfor analysis rejects unpacking it inside a term).
+Equations: the package docstring (r_ij = r_i - r_j, grad_i W_ij = -F_ij r_ij, V_j = m_j / rho0).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import NamedTuple
+
+from numba import njit
+
+from ..kernels import f_of_q, w_of_q
+from ..particles import FLUID, INLET, WALL
+from ..terms import WallSums, adami_sum, kernel_f, viscous_momentum
+
+MAX_ROW = 64   # non-zeros per PPE row, generous: a full 2D support at h/dp 2 has ~50 neighbours
+
+
+@njit(cache=True, inline="always")
+def surface_pair(i, j, dx, dz, r2, ps, ctx, a):
+    """(kernel density sum_j m_j W_ij, position divergence sum_j V_j F_ij r_ij^2) of a fluid
+    particle. ctx = (inv_h, alpha_w, alpha_f, rho0)."""
+    q = math.sqrt(r2) * ctx[0]
+    mj = ps.m[j]
+    return a[0] + mj * w_of_q(q, ctx[1]), a[1] + mj / ctx[3] * f_of_q(q, ctx[2]) * r2
+
+
+class WallRowSums(NamedTuple):
+    """What a wall particle gathers: the Adami sums (terms.WallSums, sp without the fluid's
+    pressure) and the unnormalised wall normal -sum_j W_ij r_ij."""
+
+    sw: float
+    sp: float
+    svx: float
+    svz: float
+    nx: float
+    nz: float
+
+
+WALL_ROW_SUMS_ZERO = WallRowSums(0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+
+
+@njit(cache=True, inline="always")
+def wall_pair(i, j, dx, dz, r2, ps, ctx, a):
+    """Wall particle i and a fluid or buffer neighbour j: the Adami sums (terms.adami_sum) with
+    the fluid's pressure left out (it is an unknown of the wall's PPE row; a buffer's is known),
+    and the wall normal. ctx = (inv_h, alpha_w, bx, bz), b = g - a_i."""
+    w = w_of_q(math.sqrt(r2) * ctx[0], ctx[1])
+    pj = 0.0 if ps.kind[j] == FLUID else ps.p[j]
+    s = adami_sum(WallSums(a.sw, a.sp, a.svx, a.svz), w, pj, ps.rho[j],
+                  ctx[2] * dx + ctx[3] * dz, ps.vx[j], ps.vz[j])
+    return WallRowSums(s.sw, s.sp, s.svx, s.svz, a.nx - dx * w, a.nz - dz * w)
+
+
+@njit(cache=True, inline="always")
+def wall_stop_pair(i, j, dx, dz, r2, ps, ctx, a):
+    """Wall particle i and fluid neighbour j approaching it (u_n = (u_j - v_i) . n < 0, n the
+    wall's unit normal into the fluid): the ghost-pressure rise rho_j |u_n| d / tau W_ij that
+    stops it within tau, d = n . r_ji. ctx = (inv_h, alpha_w, nx, nz, vx_i, vz_i, tau)."""
+    un = (ps.vx[j] - ctx[4]) * ctx[2] + (ps.vz[j] - ctx[5]) * ctx[3]
+    if un >= 0.0:
+        return a
+    w = w_of_q(math.sqrt(r2) * ctx[0], ctx[1])
+    d = -(dx * ctx[2] + dz * ctx[3])
+    return a + ps.rho[j] * (-un) * d / ctx[6] * w
+
+
+@njit(cache=True, inline="always")
+def viscous_pair(i, j, dx, dz, r2, ps, ctx, a):
+    """Fluid particle i and a fluid, buffer or (no-slip) wall neighbour j: Lo & Shao's laminar
+    viscosity, terms.viscous_momentum without pressure or artificial viscosity; against a wall
+    its Adami no-slip velocity. ctx = (terms.FluidConsts, terms.FluidI); a = (fx, fz)."""
+    k = ctx[0]
+    fi = ctx[1]
+    if ps.kind[j] == WALL:
+        if not k.noslip:
+            return a
+        dvx = fi.vx - ps.vwx[j]
+        dvz = fi.vz - ps.vwz[j]
+    else:
+        dvx = fi.vx - ps.vx[j]
+        dvz = fi.vz - ps.vz[j]
+    return viscous_momentum(a[0], a[1], 0.0, dvx, dvz, dx, dz, r2, kernel_f(r2, k), fi.rho,
+                            ps.rho[j], ps.m[j], 0.0, k)
+
+
+@njit(cache=True, inline="always")
+def fluid_row_pair(i, j, dx, dz, r2, ps, ctx, a):
+    """Fluid particle i's PPE row and neighbour j (fluid, wall, buffer): the Shao & Lo (2003)
+    Laplacian coefficient B_ij into the diagonal and, for an unknown j, the row's column
+    (written into ``indices``, ``data`` at base + count); a buffer's known pressure goes to
+    the right-hand side; the Khayyer et al. (2009) divergence of u* over fluid and buffer
+    neighbours (the walls' part is their ghost pressure: the Neumann condition).
+    ctx = (inv_h, alpha_f, eta2, vx_i, vz_i, rho_i, idx, indices, data, base);
+    a = (diag, div, known, count)."""
+    fij = f_of_q(math.sqrt(r2) * ctx[0], ctx[1])
+    kj = ps.kind[j]
+    mj = ps.m[j]
+    rhoj = ps.rho[j]
+    div = a[1]
+    # fluid, or an open end's buffer with its imposed velocity (with an outlet's buffer in
+    # through its pressure only, the outlet's bottom corner drained: 1.4 m/s there at 0.7 s;
+    # docs/studies/schemes.md "ISPH with open ends and bodies")
+    if kj != WALL:
+        div -= mj / rhoj * fij * ((ps.vx[j] - ctx[3]) * dx + (ps.vz[j] - ctx[4]) * dz)
+    rs = ctx[5] + rhoj
+    bij = 8.0 * mj / (rs * rs) * fij * r2 / (r2 + ctx[2])
+    known = a[2]
+    cnt = a[3]
+    kk = ctx[6][j]
+    if kk >= 0 and cnt < MAX_ROW:
+        ctx[7][ctx[9] + cnt] = kk
+        ctx[8][ctx[9] + cnt] = -bij
+        cnt += 1
+    elif kj >= INLET:  # a buffer particle: Dirichlet, its pressure is known
+        known += bij * ps.p[j]
+    return (a[0] + bij, div, known, cnt)
+
+
+@njit(cache=True, inline="always")
+def wall_row_pair(i, j, dx, dz, r2, ps, ctx, a):
+    """Wall particle i's PPE row and fluid neighbour j: the Adami weight -W_ij / sum W (scaled)
+    of j's unknown. ctx = (inv_h, alpha_w, wscale / sum W, idx, indices, data, base);
+    a = the row's count."""
+    kk = ctx[3][j]
+    if kk < 0 or a >= MAX_ROW:
+        return a
+    ctx[4][ctx[6] + a] = kk
+    ctx[5][ctx[6] + a] = -w_of_q(math.sqrt(r2) * ctx[0], ctx[1]) * ctx[2]
+    return a + 1
+
+
+@njit(cache=True, inline="always")
+def symmetric_pressure_pair(i, j, dx, dz, r2, ps, ctx, a):
+    """-(1/rho) grad p of seed 004 eq. 5, sum_j m_j (p_i/rho_i^2 + p_j/rho_j^2) F_ij r_ij, over
+    fluid, buffer and wet wall neighbours (a wall with p < 0, the air side of a wetted wall,
+    is left out like air). ctx = (inv_h, alpha_f, p_i / rho_i^2); a = (fx, fz)."""
+    rhoj = ps.rho[j]
+    pj = ps.p[j]
+    if ps.kind[j] == WALL and pj < 0.0:
+        return a
+    fij = f_of_q(math.sqrt(r2) * ctx[0], ctx[1])
+    pf = ps.m[j] * (ctx[2] + pj / (rhoj * rhoj))
+    return a[0] + pf * fij * dx, a[1] + pf * fij * dz
