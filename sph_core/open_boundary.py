@@ -59,8 +59,8 @@ from .eos import density, pressure
 from .kernels import f_of_q, w_of_q
 from .neighbours import cell_at
 from .pairs import fluid_only, fluidlike, gather
+from .terms import mass_pair  # the boundary gauge is an elevation probe's line
 from .particles import FLUID, INACTIVE, INLET, OUTLET
-from .probes import _mass_pair  # the boundary gauge is an elevation probe's line
 
 # idle buffer particles: above the boundary's surface, kept in place but not interacting.
 # End b has active kind INLET + b and idle kind INLET_IDLE + b.
@@ -388,7 +388,7 @@ def surface_z(ps, cells, xp, z_lo, z_hi, dz, prm):
     prev = 0.0
     for k in range(nz - 1, -1, -1):
         zk = z_lo + k * dz
-        s = gather(-1, xp, zk, cell_at(xp, zk, cells), ps, cells, s2, fluidlike, _mass_pair,
+        s = gather(-1, xp, zk, cell_at(xp, zk, cells), ps, cells, s2, fluidlike, mass_pair,
                    (h, prm.alpha_w), 0.0)
         if s >= level:
             if k == nz - 1:

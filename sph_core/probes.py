@@ -23,7 +23,7 @@ from .kernels import w_of_q
 from .neighbours import cell_at
 from .pairs import fluid_only, fluidlike, gather
 from .particles import FLUID
-from .terms import fluid_consts, kernel_f, pressure_factor
+from .terms import fluid_consts, kernel_f, mass_pair, pressure_factor
 
 
 @njit(cache=True, inline="always")
@@ -31,12 +31,6 @@ def _point_pair(i, j, dx, dz, r2, ps, ctx, a):
     """Shepard sums (sum V W, sum u V W, sum w V W, sum p V W) at a point; ctx = (h, alpha_w)."""
     vw = ps.m[j] / ps.rho[j] * w_of_q(math.sqrt(r2) / ctx[0], ctx[1])
     return a[0] + vw, a[1] + ps.vx[j] * vw, a[2] + ps.vz[j] * vw, a[3] + ps.p[j] * vw
-
-
-@njit(cache=True, inline="always")
-def _mass_pair(i, j, dx, dz, r2, ps, ctx, a):
-    """sum m W at a point (seed 004's kernel mass density); ctx = (h, alpha_w)."""
-    return a + ps.m[j] * w_of_q(math.sqrt(r2) / ctx[0], ctx[1])
 
 
 @njit(cache=True, inline="always")
@@ -80,7 +74,7 @@ def line_mass_density(ps, cells, xp, zs, h, alpha_w, out):
     s2 = 4.0 * h * h
     for k in range(zs.size):
         out[k] = gather(-1, xp, zs[k], cell_at(xp, zs[k], cells), ps, cells, s2, fluid_only,
-                        _mass_pair, (h, alpha_w), 0.0)
+                        mass_pair, (h, alpha_w), 0.0)
 
 
 def surface_from_line(zs: np.ndarray, rho_f: np.ndarray, level: float) -> float | None:

@@ -310,3 +310,10 @@ def body_reaction(i, j, dx, dz, r2, ps, k, a):
                              r2, fij, ps, k.av_wall, k)
     mj = ps.m[j]
     return a[0] - mj * pax, a[1] - mj * paz
+
+
+@njit(cache=True, inline="always")
+def mass_pair(i, j, dx, dz, r2, ps, ctx, a):
+    """sum m W at a point (seed 004's kernel mass density: the elevation probes' and the open
+    ends' boundary gauges' line); ctx = (h, alpha_w)."""
+    return a + ps.m[j] * w_of_q(math.sqrt(r2) / ctx[0], ctx[1])
