@@ -19,6 +19,14 @@ import numpy as np
 if not hasattr(np, "row_stack"):
     np.row_stack = np.vstack
 
+# numba reads NUMBA_ENABLE_CUDASIM into its config when numba is imported and again only when it
+# compiles something; numba.cuda picks the simulator or the driver from that config when it is
+# first imported. Read the environment again first, so that a variable set after numba's import
+# (the tests set it when no GPU is present) decides, not whether a compile happened in between.
+from numba.core import config as _numba_config  # noqa: E402
+
+_numba_config.reload_config()
+
 
 def simulated() -> bool:
     """True when numba-cuda runs its CPU simulator (NUMBA_ENABLE_CUDASIM=1)."""
