@@ -38,7 +38,7 @@ def run_cuda(dp: float, budget: float, modes: list[bool]) -> list[dict]:
     """One Simulation and CudaStepper per size, timed with plain launches and/or graphs."""
     import numba
 
-    from sph_core.cuda.stepper import LAUNCHES_PER_STEP, CudaStepper
+    from sph_core.cuda.cuda_stepper import LAUNCHES_PER_STEP, CudaStepper
     from sph_core.simulation import Simulation
 
     t0 = time.perf_counter()

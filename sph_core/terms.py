@@ -295,7 +295,7 @@ def adami_pair(i, j, dx, dz, r2, ps, ctx, a):
     """Wall particle i and fluid neighbour j (Adami, Hu & Adams 2012): the kernel-weighted
     pressure with the hydrostatic correction and velocity. ctx = (inv_h, alpha_w, bx, bz), b
     = g - a_i the wall's apparent gravity. (ISPH's wall rows sum the same, without the fluid's
-    pressure: isph.terms.wall_pair.)"""
+    pressure: isph.isph_terms.wall_pair.)"""
     w = w_of_q(math.sqrt(r2) * ctx[0], ctx[1])
     return adami_sum(a, w, ps.p[j], ps.rho[j], ctx[2] * dx + ctx[3] * dz, ps.vx[j], ps.vz[j])
 

@@ -66,88 +66,94 @@ FASTMATH = {"nsz", "arcp", "contract", "afn", "reassoc"}
 PASSES_PER_STEP = {"kdk": 1, "symplectic_pc": 2}
 
 
+@njit(cache=True, inline="always")
+def wall_state(i, ps, cells, prm):
+    """(p, rho, vwx, vwz) of wall particle i: Adami et al. (2012) pressure, density and no-slip
+    velocity from its fluid neighbours (terms.adami_pair). One particle's share of
+    ``wall_pass``: the CUDA step's kernel calls the same function."""
+    h = prm.h
+    ctx = (1.0 / h, prm.alpha_w, prm.gx - ps.ax[i], prm.gz - ps.az[i])
+    s = gather(i, ps.x[i], ps.z[i], ps.cell[i], ps, cells, 4.0 * h * h, fluidlike, adami_pair, ctx,
+               WALL_SUMS_ZERO)
+    if s.sw > 0.0:
+        # no suction: a negative extrapolated pressure (free surface near the wall) would pull
+        # fluid into the wall
+        pi = max(s.sp / s.sw, 0.0)
+        return (pi, density(pi, prm.rho0, prm.b, prm.gamma), 2.0 * ps.vx[i] - s.svx / s.sw,
+                2.0 * ps.vz[i] - s.svz / s.sw)
+    return 0.0, prm.rho0, ps.vx[i], ps.vz[i]
+
+
 @njit(parallel=True, cache=True, fastmath=FASTMATH)
 def wall_pass(ps, n, cells, prm):
     """Adami et al. (2012) pressure, density and no-slip velocity of every wall particle."""
+    # only the rows written need locals (numba drops prange stores made through ps.row[i])
     p = ps.p
     rho = ps.rho
     vwx = ps.vwx
     vwz = ps.vwz
     kind = ps.kind
-    h = prm.h
-    inv_h = 1.0 / h
-    s2 = 4.0 * h * h
     for i in prange(n):
         if kind[i] == WALL:
-            ctx = (inv_h, prm.alpha_w, prm.gx - ps.ax[i], prm.gz - ps.az[i])
-            s = gather(i, ps.x[i], ps.z[i], ps.cell[i], ps, cells, s2, fluidlike, adami_pair, ctx,
-                       WALL_SUMS_ZERO)
-            if s.sw > 0.0:
-                # no suction: a negative extrapolated pressure (free surface near the wall)
-                # would pull fluid into the wall
-                pi = max(s.sp / s.sw, 0.0)
-                p[i] = pi
-                rho[i] = density(pi, prm.rho0, prm.b, prm.gamma)
-                vwx[i] = 2.0 * ps.vx[i] - s.svx / s.sw
-                vwz[i] = 2.0 * ps.vz[i] - s.svz / s.sw
-            else:
-                p[i] = 0.0
-                rho[i] = prm.rho0
-                vwx[i] = ps.vx[i]
-                vwz[i] = ps.vz[i]
+            p[i], rho[i], vwx[i], vwz[i] = wall_state(i, ps, cells, prm)
+
+
+@njit(cache=True, inline="always")
+def fluid_rates(i, ps, cells, prm, riemann, k, fi):
+    """(ax, az, drho, pw, dvnx, dvnz) of fluid particle i: continuity, delta-SPH, pressure,
+    viscosity, gravity (terms.wcsph_pair), or with ``riemann`` True (not None) the Riemann SPH
+    flux (terms.riemann_pair; MUSCL gradients from riemann_gradients); pw is the pressure its
+    walls feel, dvn the no-penetration velocity change (wall_contact.py; zero when off). One
+    particle's share of ``fluid_pass``: the CUDA step's kernel calls the same function. ``k``,
+    ``fi``: terms.fluid_consts(prm) and terms.fluid_i(i, ps, k), built by the caller (inlined
+    into a prange loop, the NamedTuple they build fails numba's parfor array analysis; a CUDA
+    kernel needs them inlined)."""
+    if riemann is None:
+        a = gather(i, fi.x, fi.z, ps.cell[i], ps, cells, k.s2, interacting, wcsph_pair, (k, fi),
+                   FLUID_SUMS_ZERO)
+    else:
+        a = gather(i, fi.x, fi.z, ps.cell[i], ps, cells, k.s2, interacting, riemann_pair, (k, fi),
+                   FLUID_SUMS_ZERO)
+    fx = a.fx
+    fz = a.fz
+    # no tension across a wall while the particle approaches it (p_i -> max(p_i, 0)): a
+    # particle in tension is otherwise pulled into the wall (a dry-bed front sinks through the
+    # bed); one that moves away keeps the pull, so a thin swash film stays on its beach
+    # (docs/studies/wall_pressure.md). The Riemann flux has no such pair term (tx = 0): its
+    # walls always feel max(p_i, 0)
+    pwi = fi.p
+    if fi.p < 0.0 and (riemann is not None
+                       or approach_speed(a.gw, a.gnx, a.gnz, a.gvx, a.gvz, fi.vx, fi.vz) < 0.0):
+        fx += a.tx
+        fz += a.tz
+        pwi = 0.0
+    dvx = 0.0
+    dvz = 0.0
+    if prm.wall_g0 > 0.0:   # no penetration at wall faces (wall_contact.py): g0 = 0 turns it off
+        dvx, dvz = no_penetration(a.gw, a.gnx, a.gnz, a.gvx, a.gvz, fi.vx, fi.vz, prm.wall_ga,
+                                  prm.wall_g0, prm.wall_gb)
+    return fx + prm.gx, fz + prm.gz, fi.rho * a.cont + k.ddiff * a.diff, pwi, dvx, dvz
 
 
 @njit(parallel=True, cache=True, fastmath=FASTMATH)
 def fluid_pass(ps, n, cells, prm, riemann):
-    """The gather over fluid particles: continuity, delta-SPH, pressure, viscosity, gravity
-    (terms.wcsph_pair), or with ``riemann`` True (not None) the Riemann SPH flux
-    (terms.riemann_pair; MUSCL gradients from riemann_gradients). A None ``riemann`` compiles
-    the WCSPH pair alone (step.py). Writes ax, az, drho, pw and the no-penetration velocity
-    change dvnx, dvnz (wall_contact.py) of each fluid particle; returns nothing (reductions are
-    in the kicks)."""
-    # only the rows written need locals (numba drops prange stores made through ps.row[i])
+    """Rates of every fluid particle (``fluid_rates``): writes ax, az, drho, pw, dvnx, dvnz;
+    returns nothing (reductions are in the kicks). A None ``riemann`` compiles the WCSPH pair
+    alone (step.py)."""
     ax = ps.ax
     az = ps.az
     drho = ps.drho
+    pw = ps.pw
     dvnx = ps.dvnx
     dvnz = ps.dvnz
-    pw = ps.pw
     kind = ps.kind
-    # no penetration at wall faces (wall_contact.py): g0 = 0 turns it off
-    nopen = prm.wall_g0 > 0.0
     for i in prange(n):
         if kind[i] == FLUID:
-            # (built per particle: a NamedTuple live into a prange loop fails numba's parfor
-            # lowering, and it costs a few flops against ~30 pairs)
             k = fluid_consts(prm)
             fi = fluid_i(i, ps, k)
-            if riemann is None:
-                a = gather(i, fi.x, fi.z, ps.cell[i], ps, cells, k.s2, interacting, wcsph_pair,
-                           (k, fi), FLUID_SUMS_ZERO)
-            else:
-                a = gather(i, fi.x, fi.z, ps.cell[i], ps, cells, k.s2, interacting, riemann_pair,
-                           (k, fi), FLUID_SUMS_ZERO)
-            fx = a.fx
-            fz = a.fz
-            # no tension across a wall while the particle approaches it (p_i -> max(p_i, 0)): a
-            # particle in tension is otherwise pulled into the wall (a dry-bed front sinks
-            # through the bed); one that moves away keeps the pull, so a thin swash film stays
-            # on its beach (docs/studies/wall_pressure.md). The Riemann flux has no such pair term
-            # (tx = 0): its walls always feel max(p_i, 0)
-            pwi = fi.p
-            if fi.p < 0.0 and (riemann is not None
-                               or approach_speed(a.gw, a.gnx, a.gnz, a.gvx, a.gvz, fi.vx,
-                                                 fi.vz) < 0.0):
-                fx += a.tx
-                fz += a.tz
-                pwi = 0.0
-            pw[i] = pwi
-            ax[i] = fx + prm.gx
-            az[i] = fz + prm.gz
-            drho[i] = fi.rho * a.cont + k.ddiff * a.diff
-            if nopen:
-                dvnx[i], dvnz[i] = no_penetration(a.gw, a.gnx, a.gnz, a.gvx, a.gvz, fi.vx, fi.vz,
-                                                  prm.wall_ga, prm.wall_g0, prm.wall_gb)
+            ax[i], az[i], drho[i], pw[i], dvnx[i], dvnz[i] = fluid_rates(i, ps, cells, prm,
+                                                                          riemann, k, fi)
+
 
 # The integrator passes read rows through ``ps.row[i]`` and write through locals: numba drops
 # prange stores made through ``ps.row[i] = ...``.

@@ -3,10 +3,12 @@
 Scope today: a closed tank (no open ends, no bodies, no shifting), the kdk integrator, delta-SPH
 + Monaghan AV + Lo & Shao viscosity, Adami walls, the no-penetration correction and the
 approach-gated wall tension (``wcsph.wall_pass`` / ``fluid_pass`` without Riemann SPH), from
-the same pair terms as the CPU step (``pairs.gather`` + ``terms.py``). ``stepper.CudaStepper``
-runs it; the per-particle bodies (``per_particle.py``) are plain ``@njit(inline="always")``
-functions, which numba-cuda compiles for the GPU as device functions and the CUDA simulator
-(``NUMBA_ENABLE_CUDASIM=1``) calls as CPU code.
+the same pair terms as the CPU step (``pairs.gather`` + ``terms.py``).
+``cuda_stepper.CudaStepper`` runs it. Its wall and fluid kernels call the CPU's per-particle
+functions ``wcsph.wall_state`` / ``wcsph.fluid_rates``; the other per-particle bodies
+(``per_particle.py``) are plain ``@njit(inline="always")`` functions, which numba-cuda compiles
+for the GPU as device functions and the CUDA simulator (``NUMBA_ENABLE_CUDASIM=1``) calls as CPU
+code.
 """
 
 from __future__ import annotations
@@ -18,6 +20,14 @@ import numpy as np
 # numba-cuda <= 0.30 names np.row_stack, which numpy 2.5 removed (an alias of vstack)
 if not hasattr(np, "row_stack"):
     np.row_stack = np.vstack
+
+# numba reads NUMBA_ENABLE_CUDASIM into its config when numba is imported and again only when it
+# compiles something; numba.cuda picks the simulator or the driver from that config when it is
+# first imported. Read the environment again first, so that a variable set after numba's import
+# (the tests set it when no GPU is present) decides, not whether a compile happened in between.
+from numba.core import config as _numba_config  # noqa: E402
+
+_numba_config.reload_config()
 
 
 def simulated() -> bool:

@@ -22,9 +22,16 @@ from numba import cuda, float64, int64, njit
 
 from ..particles import FLUID, N_SORTED_KDK, WALL
 from ..state import particles_view
-from ..wcsph import ST_DENSITY, ST_LEFT_DOMAIN, ST_NONFINITE, ST_REACHED_T, ST_STEP_LIMIT, stable_dt
+from ..wcsph import (ST_DENSITY, ST_LEFT_DOMAIN, ST_NONFINITE, ST_REACHED_T, ST_STEP_LIMIT,
+                     fluid_rates, stable_dt, wall_state)
+from ..terms import fluid_consts, fluid_i
 from . import simulated
-from .per_particle import cell_of, fluid_particle, kick_drift_particle, kick_particle, wall_particle
+
+# every callee of a kernel is inlined (the form compile_ptx verifies without a GPU): inlined
+# twins of the two plain @njit helpers the fluid pass takes (the same source)
+_fluid_consts = njit(inline="always")(fluid_consts.py_func)
+_fluid_i = njit(inline="always")(fluid_i.py_func)
+from .per_particle import cell_of, kick_drift_particle, kick_particle
 
 T, DT, DTS, T_STOP, V2, A2, RMAX, V2LAST = range(8)
 N_CLK = 8
@@ -263,7 +270,8 @@ def k_wall(buf, n, cells, prm, ctl):
         return
     i = cuda.grid(1)
     if i < n and buf[1][i] == WALL:
-        wall_particle(i, _view(buf), cells, prm)
+        ps = _view(buf)
+        ps.p[i], ps.rho[i], ps.vwx[i], ps.vwz[i] = wall_state(i, ps, cells, prm)
 
 
 @cuda.jit
@@ -273,7 +281,10 @@ def k_fluid(buf, n, cells, prm, ctl):
         return
     i = cuda.grid(1)
     if i < n and buf[1][i] == FLUID:
-        fluid_particle(i, _view(buf), cells, prm)
+        ps = _view(buf)
+        k = _fluid_consts(prm)
+        ps.ax[i], ps.az[i], ps.drho[i], ps.pw[i], ps.dvnx[i], ps.dvnz[i] = fluid_rates(
+            i, ps, cells, prm, None, k, _fluid_i(i, ps, k))
 
 
 @cuda.jit

@@ -14,12 +14,8 @@ import math
 
 from numba import njit
 
-from ..eos import density, pressure
+from ..eos import pressure
 from ..neighbours import cell_at
-from ..pairs import fluidlike, gather, interacting
-from ..terms import (FLUID_SUMS_ZERO, WALL_SUMS_ZERO, adami_pair, fluid_consts, fluid_i,
-                     wcsph_pair)
-from ..wall_contact import approach_speed, no_penetration
 
 
 @njit(cache=True, inline="always")
@@ -29,59 +25,6 @@ def cell_of(i, ps, cells):
     if ps.kind[i] < 0:
         return cells.ncx * cells.ncz
     return cell_at(ps.x[i], ps.z[i], cells)
-
-
-@njit(cache=True, inline="always")
-def wall_particle(i, ps, cells, prm):
-    """``wcsph.wall_pass`` for wall slot i: Adami pressure, density and no-slip velocity, from
-    the shared pair term ``terms.adami_pair``."""
-    h = prm.h
-    ctx = (1.0 / h, prm.alpha_w, prm.gx - ps.ax[i], prm.gz - ps.az[i])
-    s = gather(i, ps.x[i], ps.z[i], ps.cell[i], ps, cells, 4.0 * h * h, fluidlike, adami_pair,
-               ctx, WALL_SUMS_ZERO)
-    if s.sw > 0.0:
-        pi = max(s.sp / s.sw, 0.0)   # no suction (wcsph.wall_pass)
-        ps.p[i] = pi
-        ps.rho[i] = density(pi, prm.rho0, prm.b, prm.gamma)
-        ps.vwx[i] = 2.0 * ps.vx[i] - s.svx / s.sw
-        ps.vwz[i] = 2.0 * ps.vz[i] - s.svz / s.sw
-    else:
-        ps.p[i] = 0.0
-        ps.rho[i] = prm.rho0
-        ps.vwx[i] = ps.vx[i]
-        ps.vwz[i] = ps.vz[i]
-
-
-# terms.fluid_consts / fluid_i are plain (not inlined) @njit functions: their same source,
-# inlined, so every device callee is inlined (the form compile_ptx verifies without a GPU)
-_fluid_consts = njit(inline="always")(fluid_consts.py_func)
-_fluid_i = njit(inline="always")(fluid_i.py_func)
-
-
-@njit(cache=True, inline="always")
-def fluid_particle(i, ps, cells, prm):
-    """``wcsph.fluid_pass`` for fluid slot i in its delta-SPH form (the shared pair term
-    ``terms.wcsph_pair``): writes ax, az, drho, pw and, with the no-penetration correction on,
-    dvnx, dvnz."""
-    k = _fluid_consts(prm)
-    fi = _fluid_i(i, ps, k)
-    a = gather(i, fi.x, fi.z, ps.cell[i], ps, cells, k.s2, interacting, wcsph_pair, (k, fi),
-               FLUID_SUMS_ZERO)
-    fx = a.fx
-    fz = a.fz
-    # the approach-gated wall tension (wcsph.fluid_pass)
-    pwi = fi.p
-    if fi.p < 0.0 and approach_speed(a.gw, a.gnx, a.gnz, a.gvx, a.gvz, fi.vx, fi.vz) < 0.0:
-        fx += a.tx
-        fz += a.tz
-        pwi = 0.0
-    ps.pw[i] = pwi
-    ps.ax[i] = fx + prm.gx
-    ps.az[i] = fz + prm.gz
-    ps.drho[i] = fi.rho * a.cont + k.ddiff * a.diff
-    if prm.wall_g0 > 0.0:
-        ps.dvnx[i], ps.dvnz[i] = no_penetration(a.gw, a.gnx, a.gnz, a.gvx, a.gvz, fi.vx, fi.vz,
-                                                prm.wall_ga, prm.wall_g0, prm.wall_gb)
 
 
 @njit(cache=True, inline="always")

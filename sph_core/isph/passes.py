@@ -14,7 +14,7 @@ from ..particles import FLUID, WALL
 from ..renormalisation import moments, solve
 from ..terms import fluid_consts, fluid_i
 from ..wcsph import FASTMATH
-from .terms import (WALL_ROW_SUMS_ZERO, surface_pair, symmetric_pressure_pair, viscous_pair,
+from .isph_terms import (WALL_ROW_SUMS_ZERO, surface_pair, symmetric_pressure_pair, viscous_pair,
                     wall_pair, wall_stop_pair)
 
 

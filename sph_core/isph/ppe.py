@@ -14,7 +14,7 @@ from numba import njit, prange
 from ..pairs import fluid_only, gather, interacting
 from ..particles import FLUID, WALL
 from ..wcsph import FASTMATH
-from .terms import MAX_ROW, fluid_row_pair, wall_row_pair
+from .isph_terms import MAX_ROW, fluid_row_pair, wall_row_pair
 
 PPE_SOLVERS = ("bicgstab", "amg")
 

@@ -59,7 +59,7 @@ def sim_factory():
 
 
 def _stepper(sim):
-    from sph_core.cuda.stepper import CudaStepper
+    from sph_core.cuda.cuda_stepper import CudaStepper
     return CudaStepper(sim)
 
 
@@ -239,7 +239,7 @@ def test_unsupported_scene_is_refused():
     from sph_core.cuda import unavailable_reason
     if unavailable_reason():
         pytest.skip(unavailable_reason())
-    from sph_core.cuda.stepper import CudaStepper
+    from sph_core.cuda.cuda_stepper import CudaStepper
     from sph_core.simulation import Simulation
 
     sim = Simulation(_dambreak(integrator="symplectic_pc"))

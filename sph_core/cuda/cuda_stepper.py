@@ -37,7 +37,7 @@ def unsupported(sim: Any) -> list[str]:
     """What the scene of ``sim`` uses that the GPU step does not do yet (empty: supported)."""
     prm = sim.prm
     out = []
-    if sim.isph:
+    if sim.scene.scheme.kind == "isph":
         out.append("ISPH")
     if sim.scene.constants.integrator != "kdk":
         out.append(f"integrator {sim.scene.constants.integrator} (only kdk)")
