@@ -67,7 +67,7 @@ PASSES_PER_STEP = {"kdk": 1, "symplectic_pc": 2}
 
 
 @njit(cache=True, inline="always")
-def wall_state(i, ps, cells, prm):
+def adami_state(i, ps, cells, prm):
     """(p, rho, vwx, vwz) of wall particle i: Adami et al. (2012) pressure, density and no-slip
     velocity from its fluid neighbours (terms.adami_pair). One particle's share of
     ``wall_pass``: the CUDA step's kernel calls the same function."""
@@ -95,7 +95,7 @@ def wall_pass(ps, n, cells, prm):
     kind = ps.kind
     for i in prange(n):
         if kind[i] == WALL:
-            p[i], rho[i], vwx[i], vwz[i] = wall_state(i, ps, cells, prm)
+            p[i], rho[i], vwx[i], vwz[i] = adami_state(i, ps, cells, prm)
 
 
 @njit(cache=True, inline="always")

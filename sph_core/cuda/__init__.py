@@ -5,7 +5,7 @@ Scope today: a closed tank (no open ends, no bodies, no shifting), the kdk integ
 approach-gated wall tension (``wcsph.wall_pass`` / ``fluid_pass`` without Riemann SPH), from
 the same pair terms as the CPU step (``pairs.gather`` + ``terms.py``).
 ``cuda_stepper.CudaStepper`` runs it. Its wall and fluid kernels call the CPU's per-particle
-functions ``wcsph.wall_state`` / ``wcsph.fluid_rates``; the other per-particle bodies
+functions ``wcsph.adami_state`` / ``wcsph.fluid_rates``; the other per-particle bodies
 (``per_particle.py``) are plain ``@njit(inline="always")`` functions, which numba-cuda compiles
 for the GPU as device functions and the CUDA simulator (``NUMBA_ENABLE_CUDASIM=1``) calls as CPU
 code.

@@ -23,7 +23,7 @@ from numba import cuda, float64, int64, njit
 from ..particles import FLUID, N_SORTED_KDK, WALL
 from ..state import particles_view
 from ..wcsph import (ST_DENSITY, ST_LEFT_DOMAIN, ST_NONFINITE, ST_REACHED_T, ST_STEP_LIMIT,
-                     fluid_rates, stable_dt, wall_state)
+                     adami_state, fluid_rates, stable_dt)
 from ..terms import fluid_consts, fluid_i
 from . import simulated
 
@@ -271,7 +271,7 @@ def k_wall(buf, n, cells, prm, ctl):
     i = cuda.grid(1)
     if i < n and buf[1][i] == WALL:
         ps = _view(buf)
-        ps.p[i], ps.rho[i], ps.vwx[i], ps.vwz[i] = wall_state(i, ps, cells, prm)
+        ps.p[i], ps.rho[i], ps.vwx[i], ps.vwz[i] = adami_state(i, ps, cells, prm)
 
 
 @cuda.jit
