@@ -51,7 +51,7 @@ import numpy as np
 from numba import njit, prange
 
 from .pairs import fluid_only, gather
-from .particles import WALL, ParticleSet
+from .particles import AX, AZ, VX, VZ, WALL, X, Z, ParticleSet
 from .scene import Body, Scene
 from .terms import body_reaction, fluid_consts
 
@@ -145,14 +145,16 @@ def _set_prescribed(bd, b, t_pos, t_vel):
         bd.acc[b, c] = 0.0
 
 
-# the stages of the integrators a body follows (``_advance``)
+# the stages of the integrators a body follows (``bodies_advance``): kdk's first half (qd +=
+# dt/2 acc, q += dt qd) and second half (qd += dt/2 acc); the symplectic predictor (save q, qd;
+# q += dt/2 qd, qd += dt/2 acc) and corrector (qd = qdn + dt acc, q = qn + dt/2 (qd + qdn))
 KICK_DRIFT, KICK, PREDICT, CORRECT = range(4)
 
 
 @njit(cache=True)
-def _advance(bd, t, dt, stage):
+def bodies_advance(bd, t, dt, stage):
     """One integrator stage of every body (t: the step's start); prescribed bodies take their
-    motion at the stage's time instead."""
+    motion at the stage's time instead (kick-drift: q(t + dt), qd(t + dt/2))."""
     if not bd.active:
         return
     hdt = 0.5 * dt
@@ -186,30 +188,6 @@ def _advance(bd, t, dt, stage):
 
 
 @njit(cache=True)
-def bodies_kick_drift(bd, t, dt):
-    """kdk first half: qd += dt/2 acc, q += dt qd (prescribed: q(t + dt), qd(t + dt/2))."""
-    _advance(bd, t, dt, KICK_DRIFT)
-
-
-@njit(cache=True)
-def bodies_kick(bd, t, dt):
-    """kdk second half: qd += dt/2 acc (prescribed: qd(t + dt)); t is the step's start."""
-    _advance(bd, t, dt, KICK)
-
-
-@njit(cache=True)
-def bodies_predict(bd, t, dt):
-    """Symplectic predictor: save (q, qd); q += dt/2 qd, qd += dt/2 acc."""
-    _advance(bd, t, dt, PREDICT)
-
-
-@njit(cache=True)
-def bodies_correct(bd, t, dt):
-    """Symplectic corrector: qd = qdn + dt acc^{n+1/2}, q = qn + dt/2 (qd + qdn)."""
-    _advance(bd, t, dt, CORRECT)
-
-
-@njit(cache=True)
 def bodies_v2max(bd):
     """Largest squared body-particle speed |V + omega x r|^2 (for the time step's CFL bound)."""
     v2max = 0.0
@@ -234,12 +212,7 @@ def place_bodies(ps, n, bd):
     """Position, velocity (V + omega x r) and acceleration of every body particle from q, qd, acc."""
     if not bd.active:
         return
-    x = ps.x
-    z = ps.z
-    vx = ps.vx
-    vz = ps.vz
-    ax = ps.ax
-    az = ps.az
+    f = ps.f   # writes through the storage: numba drops prange stores made through ps.row[i]
     ids = ps.ids
     id0 = bd.id0
     npart = bd.npart
@@ -254,12 +227,12 @@ def place_bodies(ps, n, bd):
             s = math.sin(th)
             rx = c * bd.rx[k] - s * bd.rz[k]
             rz = s * bd.rx[k] + c * bd.rz[k]
-            x[i] = bd.q[b, 0] + rx
-            z[i] = bd.q[b, 1] + rz
-            vx[i] = bd.qd[b, 0] - om * rz
-            vz[i] = bd.qd[b, 1] + om * rx
-            ax[i] = bd.acc[b, 0] - al * rz - om * om * rx
-            az[i] = bd.acc[b, 1] + al * rx - om * om * rz
+            f[X, i] = bd.q[b, 0] + rx
+            f[Z, i] = bd.q[b, 1] + rz
+            f[VX, i] = bd.qd[b, 0] - om * rz
+            f[VZ, i] = bd.qd[b, 1] + om * rx
+            f[AX, i] = bd.acc[b, 0] - al * rz - om * om * rx
+            f[AZ, i] = bd.acc[b, 1] + al * rx - om * om * rz
 
 
 @njit(parallel=True, cache=True)

@@ -43,7 +43,7 @@ from __future__ import annotations
 
 from numba import njit, prange
 
-from .particles import FLUID, OUTLET
+from .particles import FLUID, GPX, GPZ, GUX, GUZ, GWX, GWZ, OUTLET
 from .renormalisation import moments, solve
 
 # Params.limiter: 0 no reconstruction, 1 MUSCL with van Leer's limiter (the minmod limiter and
@@ -80,21 +80,12 @@ def riemann_gradients(ps, n, cells, prm):
     zero elsewhere, and where the neighbour moment matrix is near singular: first order there),
     from the shared walk renormalisation.moments. (Wall particles, inside the kind range, get
     gradients too; nothing reads them.)"""
-    gpx = ps.gpx
-    gpz = ps.gpz
-    gux = ps.gux
-    guz = ps.guz
-    gwx = ps.gwx
-    gwz = ps.gwz
+    f = ps.f   # writes through the storage: numba drops prange stores made through ps.row[i]
     kind = ps.kind
     for i in prange(n):
         ki = kind[i]
-        gpx[i] = 0.0
-        gpz[i] = 0.0
-        gux[i] = 0.0
-        guz[i] = 0.0
-        gwx[i] = 0.0
-        gwz[i] = 0.0
+        for r in range(GPX, GWZ + 1):
+            f[r, i] = 0.0
         if ki >= FLUID and ki <= OUTLET:
             # moment matrices: all neighbours M (pressure), fluid and buffers Mf (velocity)
             s = moments(i, ps, cells, prm, ps.p, ps.vx, ps.vz, True)
@@ -102,9 +93,9 @@ def riemann_gradients(ps, n, cells, prm):
             det = s.mxx * s.mzz - s.mxz * s.mxz
             tr = s.mxx + s.mzz
             if tr > 0.0 and det > 0.0125 * tr * tr:
-                gpx[i], gpz[i] = solve(s.mxx, s.mxz, s.mzz, det, s.phix, s.phiz)
+                f[GPX, i], f[GPZ, i] = solve(s.mxx, s.mxz, s.mzz, det, s.phix, s.phiz)
             det = s.mfxx * s.mfzz - s.mfxz * s.mfxz
             tr = s.mfxx + s.mfzz
             if tr > 0.0 and det > 0.0125 * tr * tr:
-                gux[i], guz[i] = solve(s.mfxx, s.mfxz, s.mfzz, det, s.ux, s.uz)
-                gwx[i], gwz[i] = solve(s.mfxx, s.mfxz, s.mfzz, det, s.wx, s.wz)
+                f[GUX, i], f[GUZ, i] = solve(s.mfxx, s.mfxz, s.mfzz, det, s.ux, s.uz)
+                f[GWX, i], f[GWZ, i] = solve(s.mfxx, s.mfxz, s.mfzz, det, s.wx, s.wz)

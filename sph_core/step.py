@@ -66,7 +66,7 @@ import math
 
 from numba import njit
 
-from .bodies import (bodies_correct, bodies_kick, bodies_kick_drift, bodies_predict,
+from .bodies import (CORRECT, KICK, KICK_DRIFT, PREDICT, bodies_advance,
                      bodies_v2max, body_loads, place_bodies)
 from .neighbours import sort_by_cell
 from .open_boundary import extrapolate_buffers, measure_boundaries, update_buffers
@@ -144,7 +144,7 @@ def _step_kdk(ps, ps2, cells, prm, ends, bd, riemann, shift, n, t, dt):
     # to the grid); the verdict then reports it and the Simulation excludes it
     n_out = kdk_kick_drift(ps, n, dt, prm)
     if bd is not None:
-        bodies_kick_drift(bd, t, dt)
+        bodies_advance(bd, t, dt, KICK_DRIFT)
     _place(ps, n, bd)
     n_new = n
     if ends is not None:
@@ -157,7 +157,7 @@ def _step_kdk(ps, ps2, cells, prm, ends, bd, riemann, shift, n, t, dt):
     _forces(ps2, n, cells, prm, bd, riemann)
     n_bad, n_band, v2max, a2max, rmax = kdk_kick(ps2, n, dt, prm)
     if bd is not None:
-        bodies_kick(bd, t, dt)
+        bodies_advance(bd, t, dt, KICK)
     _place(ps2, n, bd)
     _shift(ps2, n, cells, prm, dt, v2max, shift)
     if ends is not None:
@@ -176,12 +176,12 @@ def _step_pc(ps, ps2, cells, prm, ends, bd, riemann, shift, n, t, dt):
         measure_boundaries(ps2, cells, ends, prm)
     pc_predict(ps2, n, dt, prm)
     if bd is not None:
-        bodies_predict(bd, t, dt)
+        bodies_advance(bd, t, dt, PREDICT)
     _place(ps2, n, bd)
     _forces(ps2, n, cells, prm, bd, riemann)
     n_bad, n_band, n_out, v2max, a2max, rmax = pc_correct(ps2, n, dt, prm)
     if bd is not None:
-        bodies_correct(bd, t, dt)
+        bodies_advance(bd, t, dt, CORRECT)
     _place(ps2, n, bd)
     _shift(ps2, n, cells, prm, dt, v2max, shift)
     if ends is not None and n_bad == 0 and n_out == 0:

@@ -39,7 +39,8 @@ from numba import njit, prange
 
 from .eos import density, pressure
 from .pairs import fluidlike, gather, interacting
-from .particles import FLUID, WALL
+from .particles import (AX, AZ, DRHO, DVNX, DVNZ, FLUID, P, PW, RHO, RHON, VWX, VWZ, VX, VXN, VZ,
+                        VZN, WALL, XN, ZN, X, Z)
 from .terms import (FLUID_SUMS_ZERO, WALL_SUMS_ZERO, adami_pair, fluid_consts, fluid_i,
                     riemann_pair, wcsph_pair)
 from .wall_contact import approach_speed, no_penetration
@@ -87,15 +88,11 @@ def adami_state(i, ps, cells, prm):
 @njit(parallel=True, cache=True, fastmath=FASTMATH)
 def wall_pass(ps, n, cells, prm):
     """Adami et al. (2012) pressure, density and no-slip velocity of every wall particle."""
-    # only the rows written need locals (numba drops prange stores made through ps.row[i])
-    p = ps.p
-    rho = ps.rho
-    vwx = ps.vwx
-    vwz = ps.vwz
+    f = ps.f   # writes go through the storage (module note on prange stores)
     kind = ps.kind
     for i in prange(n):
         if kind[i] == WALL:
-            p[i], rho[i], vwx[i], vwz[i] = adami_state(i, ps, cells, prm)
+            f[P, i], f[RHO, i], f[VWX, i], f[VWZ, i] = adami_state(i, ps, cells, prm)
 
 
 @njit(cache=True, inline="always")
@@ -140,23 +137,18 @@ def fluid_pass(ps, n, cells, prm, riemann):
     """Rates of every fluid particle (``fluid_rates``): writes ax, az, drho, pw, dvnx, dvnz;
     returns nothing (reductions are in the kicks). A None ``riemann`` compiles the WCSPH pair
     alone (step.py)."""
-    ax = ps.ax
-    az = ps.az
-    drho = ps.drho
-    pw = ps.pw
-    dvnx = ps.dvnx
-    dvnz = ps.dvnz
+    f = ps.f
     kind = ps.kind
     for i in prange(n):
         if kind[i] == FLUID:
             k = fluid_consts(prm)
             fi = fluid_i(i, ps, k)
-            ax[i], az[i], drho[i], pw[i], dvnx[i], dvnz[i] = fluid_rates(i, ps, cells, prm,
-                                                                          riemann, k, fi)
+            f[AX, i], f[AZ, i], f[DRHO, i], f[PW, i], f[DVNX, i], f[DVNZ, i] = fluid_rates(
+                i, ps, cells, prm, riemann, k, fi)
 
 
-# The integrator passes read rows through ``ps.row[i]`` and write through locals: numba drops
-# prange stores made through ``ps.row[i] = ...``.
+# Numba drops stores made inside a prange loop through ``ps.row[i] = ...``: the passes write
+# through the storage array ``f = ps.f`` (rows named by particles.py), and read through either.
 
 @njit(cache=True, inline="always")
 def _outside(xi, zi, prm):
@@ -177,26 +169,21 @@ def _guard(u, w, r, axi, azi, lo, hi):
 @njit(parallel=True, cache=True)
 def kdk_kick_drift(ps, n, dt, prm):
     """First half-kick and drift of the leapfrog; returns the number of fluid particles outside the tank."""
-    x = ps.x
-    z = ps.z
-    vx = ps.vx
-    vz = ps.vz
-    rho = ps.rho
-    p = ps.p
+    f = ps.f
     kind = ps.kind
     hdt = 0.5 * dt
     n_out = 0
     for i in prange(n):
         if kind[i] == FLUID:
-            vx[i] += hdt * ps.ax[i]
-            vz[i] += hdt * ps.az[i]
-            r = rho[i] + hdt * ps.drho[i]
-            rho[i] = r
-            p[i] = pressure(r + hdt * ps.drho[i], prm.rho0, prm.b, prm.gamma)
-            xi = x[i] + dt * vx[i]
-            zi = z[i] + dt * vz[i]
-            x[i] = xi
-            z[i] = zi
+            f[VX, i] += hdt * f[AX, i]
+            f[VZ, i] += hdt * f[AZ, i]
+            r = f[RHO, i] + hdt * f[DRHO, i]
+            f[RHO, i] = r
+            f[P, i] = pressure(r + hdt * f[DRHO, i], prm.rho0, prm.b, prm.gamma)
+            xi = f[X, i] + dt * f[VX, i]
+            zi = f[Z, i] + dt * f[VZ, i]
+            f[X, i] = xi
+            f[Z, i] = zi
             n_out += _outside(xi, zi, prm)
     return n_out
 
@@ -204,9 +191,7 @@ def kdk_kick_drift(ps, n, dt, prm):
 @njit(parallel=True, cache=True)
 def kdk_kick(ps, n, dt, prm):
     """Second half-kick; returns (#non-finite, #outside density band, max |v|^2, max |a|^2, max rho)."""
-    vx = ps.vx
-    vz = ps.vz
-    rho = ps.rho
+    f = ps.f
     kind = ps.kind
     lo = prm.rho_lo * prm.rho0
     hi = prm.rho_hi * prm.rho0
@@ -219,13 +204,13 @@ def kdk_kick(ps, n, dt, prm):
     for i in prange(n):
         if kind[i] == FLUID:
             # dvn: the no-penetration correction of the force pass (wall_contact.py)
-            u = vx[i] + hdt * ps.ax[i] + ps.dvnx[i]
-            w = vz[i] + hdt * ps.az[i] + ps.dvnz[i]
-            r = rho[i] + hdt * ps.drho[i]
-            vx[i] = u
-            vz[i] = w
-            rho[i] = r
-            bad, band, v2, a2 = _guard(u, w, r, ps.ax[i], ps.az[i], lo, hi)
+            u = f[VX, i] + hdt * f[AX, i] + f[DVNX, i]
+            w = f[VZ, i] + hdt * f[AZ, i] + f[DVNZ, i]
+            r = f[RHO, i] + hdt * f[DRHO, i]
+            f[VX, i] = u
+            f[VZ, i] = w
+            f[RHO, i] = r
+            bad, band, v2, a2 = _guard(u, w, r, f[AX, i], f[AZ, i], lo, hi)
             n_bad += bad
             n_band += band
             v2max = max(v2max, v2)
@@ -237,45 +222,30 @@ def kdk_kick(ps, n, dt, prm):
 @njit(parallel=True, cache=True)
 def pc_predict(ps, n, dt, prm):
     """Symplectic predictor: save state n, half-step x, v, rho with a^n; p from rho^{n+1/2}."""
-    x = ps.x
-    z = ps.z
-    vx = ps.vx
-    vz = ps.vz
-    rho = ps.rho
-    p = ps.p
-    xn = ps.xn
-    zn = ps.zn
-    vxn = ps.vxn
-    vzn = ps.vzn
-    rhon = ps.rhon
+    f = ps.f
     kind = ps.kind
     hdt = 0.5 * dt
     for i in prange(n):
         if kind[i] == FLUID:
-            xn[i] = x[i]
-            zn[i] = z[i]
-            vxn[i] = vx[i]
-            vzn[i] = vz[i]
-            rhon[i] = rho[i]
-            x[i] += hdt * vx[i]
-            z[i] += hdt * vz[i]
-            vx[i] += hdt * ps.ax[i]
-            vz[i] += hdt * ps.az[i]
-            r = rho[i] + hdt * ps.drho[i]
-            rho[i] = r
-            p[i] = pressure(r, prm.rho0, prm.b, prm.gamma)
+            f[XN, i] = f[X, i]
+            f[ZN, i] = f[Z, i]
+            f[VXN, i] = f[VX, i]
+            f[VZN, i] = f[VZ, i]
+            f[RHON, i] = f[RHO, i]
+            f[X, i] += hdt * f[VX, i]
+            f[Z, i] += hdt * f[VZ, i]
+            f[VX, i] += hdt * f[AX, i]
+            f[VZ, i] += hdt * f[AZ, i]
+            r = f[RHO, i] + hdt * f[DRHO, i]
+            f[RHO, i] = r
+            f[P, i] = pressure(r, prm.rho0, prm.b, prm.gamma)
 
 
 @njit(parallel=True, cache=True)
 def pc_correct(ps, n, dt, prm):
     """Symplectic corrector from the half-step rates; returns the same tuple as ``kdk_kick``
     plus the count of fluid particles outside the tank."""
-    x = ps.x
-    z = ps.z
-    vx = ps.vx
-    vz = ps.vz
-    rho = ps.rho
-    p = ps.p
+    f = ps.f
     kind = ps.kind
     lo = prm.rho_lo * prm.rho0
     hi = prm.rho_hi * prm.rho0
@@ -287,22 +257,22 @@ def pc_correct(ps, n, dt, prm):
     rmax = 0.0
     for i in prange(n):
         if kind[i] == FLUID:
-            eps = -ps.drho[i] / rho[i] * dt
-            r = ps.rhon[i] * (2.0 - eps) / (2.0 + eps)
-            u0 = ps.vxn[i]
-            w0 = ps.vzn[i]
+            eps = -f[DRHO, i] / f[RHO, i] * dt
+            r = f[RHON, i] * (2.0 - eps) / (2.0 + eps)
+            u0 = f[VXN, i]
+            w0 = f[VZN, i]
             # dvn: the no-penetration correction of the half-step force pass (wall_contact.py)
-            u = u0 + dt * ps.ax[i] + ps.dvnx[i]
-            w = w0 + dt * ps.az[i] + ps.dvnz[i]
-            xi = ps.xn[i] + 0.5 * dt * (u + u0)
-            zi = ps.zn[i] + 0.5 * dt * (w + w0)
-            vx[i] = u
-            vz[i] = w
-            rho[i] = r
-            p[i] = pressure(r, prm.rho0, prm.b, prm.gamma)
-            x[i] = xi
-            z[i] = zi
-            bad, band, v2, a2 = _guard(u, w, r, ps.ax[i], ps.az[i], lo, hi)
+            u = u0 + dt * f[AX, i] + f[DVNX, i]
+            w = w0 + dt * f[AZ, i] + f[DVNZ, i]
+            xi = f[XN, i] + 0.5 * dt * (u + u0)
+            zi = f[ZN, i] + 0.5 * dt * (w + w0)
+            f[VX, i] = u
+            f[VZ, i] = w
+            f[RHO, i] = r
+            f[P, i] = pressure(r, prm.rho0, prm.b, prm.gamma)
+            f[X, i] = xi
+            f[Z, i] = zi
+            bad, band, v2, a2 = _guard(u, w, r, f[AX, i], f[AZ, i], lo, hi)
             n_bad += bad
             n_band += band
             n_out += _outside(xi, zi, prm)
@@ -315,11 +285,11 @@ def pc_correct(ps, n, dt, prm):
 @njit(parallel=True, cache=True)
 def update_pressure(ps, n, prm):
     """p = EOS(rho) for every fluid particle."""
-    p = ps.p
+    f = ps.f
     kind = ps.kind
     for i in prange(n):
         if kind[i] == FLUID:
-            p[i] = pressure(ps.rho[i], prm.rho0, prm.b, prm.gamma)
+            f[P, i] = pressure(f[RHO, i], prm.rho0, prm.b, prm.gamma)
 
 
 @njit(cache=True)

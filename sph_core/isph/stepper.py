@@ -9,7 +9,7 @@ from typing import Any
 
 import numpy as np
 
-from ..bodies import bodies_kick, bodies_kick_drift, bodies_v2max, body_loads, place_bodies
+from ..bodies import KICK, KICK_DRIFT, bodies_advance, bodies_v2max, body_loads, place_bodies
 from ..neighbours import sort_by_cell
 from ..open_boundary import extrapolate_buffers, measure_boundaries, update_buffers
 from ..particles import FLUID, N_SORTED_KDK, WALL
@@ -191,8 +191,8 @@ class IsphStepper:
             # they advance over the step with that acceleration (the kdk stages back to back)
             np.maximum(ps.p[:n], 0.0, out=ps.pw[:n])   # no tension across a body's face
             body_loads(ps, n, cells, prm, bd)
-            bodies_kick_drift(bd, t, dt)
-            bodies_kick(bd, t, dt)
+            bodies_advance(bd, t, dt, KICK_DRIFT)
+            bodies_advance(bd, t, dt, KICK)
         n_bad, n_out, v2 = correct(ps, n, cells, prm, dt)
         place_bodies(ps, n, bd)
         v2 = max(v2, bodies_v2max(bd))   # a fast body bounds dt as fluid does
