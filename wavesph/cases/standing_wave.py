@@ -19,7 +19,6 @@ the same fit from the surface: its amplitude over the velocity field's is the ga
 from __future__ import annotations
 
 import math
-import time
 from dataclasses import dataclass
 from typing import Any
 
