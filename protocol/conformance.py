@@ -29,7 +29,6 @@ from __future__ import annotations
 import argparse
 import math
 import socket
-import struct
 import sys
 from dataclasses import dataclass, field
 from typing import Callable

@@ -15,7 +15,7 @@ from __future__ import annotations
 import logging
 from pathlib import Path
 
-from protocol import MAX_PAYLOAD, Bye, Error, Message, Nodes, Result, Welcome, Working, decode_frame
+from protocol import MAX_PAYLOAD, Bye, Error, Message, Nodes, Result, Welcome, decode_frame
 from protocol.session import HELLO_LIMIT
 from wave_client.coupling import CouplingCore, CouplingOptions, GaugeLog
 

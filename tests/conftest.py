@@ -35,6 +35,7 @@ NOT_UNIT: frozenset[str] = frozenset({  # "path" or "path::test_name" (any param
     "test_server/test_server_bodies.py::test_standalone_run_serves_its_body_series",
     "test_server/test_server_c_client.py::test_c_client_drives_the_sph_flume",
     "test_cli.py::test_run_options_are_honoured",
+    "test_cli.py::test_python_api_runs_a_scene_as_the_command_does",
     "test_cli.py::test_demo_dambreak_honours_dp_and_t_end",
     "test_wave_client/test_client.py::test_cli_couples_the_boussinesq_model",
     "test_server/test_server_faults.py::test_waiting_coupled_runs_do_not_hold_the_stepping_slots",

@@ -9,7 +9,7 @@ import socket
 import numpy as np
 
 from protocol import (Capability, ClientSession, FrameDecoder, Hello, Result, Set, Solve, Welcome,
-                      Working, encode_frame)
+                      Working)
 from server_harness import live_server
 from sph_engine_double import EngineDouble
 from wave_client.coupling import CouplingOptions, couple

@@ -11,7 +11,7 @@ import pytest
 from cell_sorted import sort_into_cells
 
 from sph_core.kernels import w_of_q, wendland_alpha
-from sph_core.particles import FLUID, GUZ, INLET, M, N_FIELDS, RHO, VX, VZ, WALL, X, Z
+from sph_core.particles import FLUID, GUZ, INLET, M, N_FIELDS, RHO, VX, WALL, X, Z
 from sph_core.scene import SceneError, make_scene
 from sph_core.shifting import (FS_SURFACE, SHIFT_OPEN_END, shift_particles,
                                shift_particles_dplus)
