@@ -1,7 +1,7 @@
 """The fluid-wall pair's tension (wcsph.fluid_pass): a fluid particle in tension (p < 0) feels
 no tension across a wall while it approaches the wall, and keeps it while it moves away.
 
-Why both (docs/studies/wall_pressure.md, session 7): without the clamp a dry-bed front's particles in
+Why both (docs/studies/wall_pressure.md): without the clamp a dry-bed front's particles in
 tension are pulled into the bed and sink through it; with it everywhere, a thin swash film on a
 beach loses the bed's pull and tears (the coupled flume at dp 0.01 went unstable)."""
 
