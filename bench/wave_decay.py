@@ -109,7 +109,7 @@ def main(argv: list[str] | None = None) -> int:
                           "inlet_pressure": a.inlet_pressure, "settle_periods": a.settle_periods,
                           "outlet_absorb": not a.no_outlet_absorb,
                           "flume_wavelengths": a.flume_wavelengths,
-                          "gauge_wavelengths": a.gauge_wavelengths, "long": a.long, **ends,
+                          "gauge_wavelengths": a.gauge_wavelengths, "long": a.long,
                           "wavelength_m": round(length, 4),
                           "x": prof.x.tolist(),
                           "amplitude_ratio": [round(float(r), 4) for r in prof.ratio],

@@ -1,5 +1,6 @@
-"""Riemann SPH (seed 003, SPH-flow style): the pair terms of ``wcsph.fluid_pass`` when
-``prm.riemann``, and the MUSCL gradient pass that runs before it.
+"""Riemann SPH (seed 003, SPH-flow style): the interface state and limiter of the pair term
+``terms.riemann_pair`` (``wcsph.fluid_pass`` with ``prm.riemann``), and the MUSCL gradient pass
+that runs before it.
 
 Each pair (i, j) solves a one-dimensional Riemann problem along e = (r_j - r_i)/|r_j - r_i| at
 its mid-point (Vila 1999; Zhang, Hu & Adams 2017, J. Comput. Phys. 335, 605-620):

@@ -43,14 +43,14 @@ from .probes import (fluid_neighbour_counts, interpolate_points, line_mass_densi
 from .shifting import SHIFT_OPEN_END
 from .scene import ElevationProbe, FrontProbe, PointProbe, Scene
 from .state import Params
-from .steppers import Stepper, WcsphStepper, make_stepper, scheme_params
+from .steppers import Stepper, WcsphStepper, make_stepper
 
 STEPS_PER_CALL = 200  # steps per jitted call between progress callbacks
 # cells per kernel support radius 2h (neighbours.py): 2 = cells of side h, a 5 x 5 search block
 CELLS_PER_SUPPORT = 2
 
 
-__all__ = ["Simulation", "UnstableError", "scheme_params"]
+__all__ = ["Simulation", "UnstableError"]
 
 
 class UnstableError(RuntimeError):

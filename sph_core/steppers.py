@@ -81,7 +81,6 @@ class WcsphStepper:
     def __init__(self, scene: Scene) -> None:
         c = scene.constants
         self.integrator = c.integrator
-        self.riemann = scene.scheme.kind == "riemann"
         self.passes_per_step = wcsph.PASSES_PER_STEP[c.integrator]
         self.rho0 = c.rho0
         self.g = c.g
@@ -108,7 +107,7 @@ class WcsphStepper:
         return self.prm
 
     def _parts(self, ends: Any, bd: Any) -> tuple:
-        return step.step_parts(ends, bd, self.integrator, self.riemann, self.prm.shift_a > 0.0)
+        return step.step_parts(ends, bd, self.integrator, self.prm.riemann, self.prm.shift_a > 0.0)
 
     def initialise(self, ps: Any, ps2: Any, cells: Any, ends: Any, bd: Any,
                    n: int) -> tuple[float, int]:

@@ -150,6 +150,20 @@ def k_kick_drift_bin(buf, n, prm, cells, count, clk, ctl):
         cuda.atomic.add(count, c, 1)
 
 
+@cuda.jit(device=True)
+def _block_scan(s, t, v):
+    """Inclusive prefix sum (Hillis-Steele) of the block's shared array s, thread t's entry v."""
+    s[t] = v
+    cuda.syncthreads()
+    off = 1
+    while off < SCAN_B:
+        a = s[t - off] if t >= off else 0
+        cuda.syncthreads()
+        s[t] += a
+        cuda.syncthreads()
+        off *= 2
+
+
 @cuda.jit
 def k_scan_blocks(count, start, bsum, m, ctl):
     """Exclusive prefix sum of count[0:m] within blocks of SCAN_B (Hillis-Steele in shared
@@ -160,15 +174,7 @@ def k_scan_blocks(count, start, bsum, m, ctl):
     t = cuda.threadIdx.x
     g = cuda.blockIdx.x * SCAN_B + t
     v = count[g] if g < m else 0
-    s[t] = v
-    cuda.syncthreads()
-    off = 1
-    while off < SCAN_B:
-        a = s[t - off] if t >= off else 0
-        cuda.syncthreads()
-        s[t] += a
-        cuda.syncthreads()
-        off *= 2
+    _block_scan(s, t, v)
     if g < m:
         start[g] = s[t] - v
     if t == SCAN_B - 1:
@@ -187,15 +193,7 @@ def k_scan_sums(bsum, nb, ctl):
     while base < nb:
         g = base + t
         v = bsum[g] if g < nb else 0
-        s[t] = v
-        cuda.syncthreads()
-        off = 1
-        while off < SCAN_B:
-            a = s[t - off] if t >= off else 0
-            cuda.syncthreads()
-            s[t] += a
-            cuda.syncthreads()
-            off *= 2
+        _block_scan(s, t, v)
         if g < nb:
             bsum[g] = carry + s[t] - v
         carry += s[SCAN_B - 1]

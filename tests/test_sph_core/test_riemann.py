@@ -109,7 +109,7 @@ def test_muscl_removes_the_hydrostatic_pressure_jump():
 
 def test_scene_scheme_selects_the_riemann_params():
     from sph_core.scene import Scheme, SceneError, make_scene
-    from sph_core.simulation import scheme_params
+    from sph_core.steppers import scheme_params
 
     assert scheme_params(Scheme()) == {"riemann": False, "limiter": NO_RECONSTRUCTION}
     assert scheme_params(Scheme(kind="riemann")) == {"riemann": True, "limiter": VANLEER}
