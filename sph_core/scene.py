@@ -429,6 +429,18 @@ class Output(_Model):
     snapshot_every: float = Field(0.0, ge=0)
 
 
+DEVICES = ("cpu", "cuda")   # RunSettings.device's values
+
+
+class RunSettings(_Model):
+    """How the scene is run (not what is simulated): the device that takes the SPH steps."""
+
+    device: Literal["cpu", "cuda"] = Field(
+        "cpu", description="cpu: the numba step on the CPU cores; cuda: the step on an NVIDIA GPU "
+                           "(numba-cuda; closed tanks with the kdk integrator and delta-SPH, "
+                           "docs/developer/gpu.md); `wavesph run --device` overrides it")
+
+
 class Scene(_Model):
     """A complete SPH tank scene."""
 
@@ -446,6 +458,7 @@ class Scene(_Model):
     constants: Constants = Constants()
     scheme: Scheme = Scheme()
     output: Output = Output()
+    run: RunSettings = RunSettings()
     probes: list[Probe] = []
     open_boundaries: list[OpenBoundary] = []
     bodies: list[Body] = []
@@ -558,7 +571,8 @@ def _format_errors(exc: ValidationError) -> str:
 
 # A scene file may also say how a server runs it (`wavesph submit`, `wavesph couple --scene`,
 # POST /runs with a TOML body): `mode`, `[coupling]` (window_max, z_ref), `[source]` (a built-in
-# theory). They are not part of the Scene; `wavesph run` ignores them.
+# theory). They are not part of the Scene; `wavesph run` ignores them. (The scene's own `[run]`
+# table, RunSettings, is part of it: the device its steps take.)
 RUN_TABLES = ("mode", "coupling", "source")
 
 

@@ -4,6 +4,7 @@
     sim = Simulation(scene, sources={"left": src}, window=0.02)   # a scene with open ends
     sim.advance_to(t_end, progress=None)    # raises UnstableError(step, t, cause)
     sim.advance_window(t1, left=sample, right=sample)   # open ends driven from outside
+    sim = Simulation(scene, device="cuda")  # the step on a GPU (default: the scene's [run] device)
     sim.checkpoint() -> Checkpoint; sim.restore(c)   # exact state copy (protocol `goback`)
     sim.probe_values() -> dict[str, float | None]    # configured probes at the current state
     sim.boundary_gauges(); sim.boundary_counts()     # open ends (empty for a closed tank)
@@ -15,6 +16,15 @@ jitted ``step.run``; ``isph.IsphStepper`` a Python loop over jitted passes aroun
 pressure solve, with the same returns and the same open-end hooks) up to the next output time
 (and, with open ends, the next window end); the stepper also makes the run's Params and initial
 state. Python only handles boundary data, probes, snapshots, metadata and the progress callback.
+
+With ``device = "cuda"`` the time loop is ``sph_core.cuda.cuda_stepper.CudaStepper``'s instead:
+the particles stay on the GPU while it steps and come back to the host (``to_host``: the live
+buffer, the cell starts, the clock) after every call of the loop, i.e. at each output time and
+before control returns to the caller, so the probes, writers, guards and checkpoints below run
+unchanged on host arrays; what the host changes (particles excluded after a guard, a restored
+checkpoint, new gravity) goes back with ``from_host``. A device that cannot take the run (no
+GPU, a feature the GPU step lacks: ``cuda_stepper.unsupported``) raises ``DeviceError`` (one
+line) before the run directory is written.
 """
 
 from __future__ import annotations
@@ -41,7 +51,7 @@ from .particles import FLUID, INACTIVE, M, P, RHO, VX, VZ, WALL, X, Z, Checkpoin
 from .probes import (fluid_neighbour_counts, interpolate_points, line_mass_density,
                      surface_from_line)
 from .shifting import SHIFT_OPEN_END
-from .scene import ElevationProbe, FrontProbe, PointProbe, Scene
+from .scene import DEVICES, ElevationProbe, FrontProbe, PointProbe, Scene
 from .state import Params
 from .steppers import Stepper, WcsphStepper, make_stepper
 
@@ -50,7 +60,12 @@ STEPS_PER_CALL = 200  # steps per jitted call between progress callbacks
 CELLS_PER_SUPPORT = 2
 
 
-__all__ = ["Simulation", "UnstableError"]
+__all__ = ["DeviceError", "Simulation", "UnstableError"]
+
+
+class DeviceError(ValueError):
+    """The chosen device cannot run this scene here (no GPU, or a feature its step lacks); the
+    message is one line that names the reason."""
 
 
 class UnstableError(RuntimeError):
@@ -69,11 +84,24 @@ class Simulation:
 
     ``sources`` (side -> BoundaryData) and ``window`` [s] apply to scenes with open ends;
     ``spare`` is the spare particle capacity (default 0.1, 0.3 with open ends: inflow);
-    ``cells_per_support`` sets the neighbour cells' side, 2h / cells_per_support."""
+    ``cells_per_support`` sets the neighbour cells' side, 2h / cells_per_support;
+    ``device`` ("cpu" or "cuda", default the scene's ``[run] device``) where the steps run."""
 
     def __init__(self, scene: Scene, run_dir: str | Path | None = None,
                  spare: float | None = None, sources: Mapping[str, BoundaryData] | None = None,
-                 window: float = 0.02, cells_per_support: int = CELLS_PER_SUPPORT) -> None:
+                 window: float = 0.02, cells_per_support: int = CELLS_PER_SUPPORT,
+                 device: str | None = None) -> None:
+        if device is not None and device != scene.run.device:
+            if device not in DEVICES:
+                raise DeviceError(f"device: {device!r} is not one of {', '.join(DEVICES)}")
+            # the scene records the device the run used (meta.json)
+            scene = scene.model_copy(update={"run": scene.run.model_copy(update={"device": device})})
+        self.device = scene.run.device
+        if self.device == "cuda":   # before anything is built: the cheap refusal first
+            from .cuda import unavailable_reason
+            reason = unavailable_reason()
+            if reason is not None:
+                raise DeviceError(f"device cuda: {reason}")
         self.scene = scene
         c = scene.constants
         layout = build_layout(scene)
@@ -139,6 +167,9 @@ class Simulation:
         self.fluid_mass0 = self.fluid_mass()
         self.n_fluid0 = self.n_fluid
         self.excluded: list[dict[str, Any]] = []  # particles removed: density band, left the tank
+        self._gpu: Any = None   # the CudaStepper of device "cuda"
+        if self.device == "cuda":
+            self._gpu = self._cuda_stepper()
         # probes
         self._points = [p for p in scene.probes if isinstance(p, PointProbe)]
         self._elev = [p for p in scene.probes if isinstance(p, ElevationProbe)]
@@ -164,6 +195,34 @@ class Simulation:
                 self.bodies.log = BodyLog(run_dir, self.bodies.columns())
                 self.writer.update_meta(bodies=self.bodies.properties)
         self._record_outputs()
+
+    def _cuda_stepper(self) -> Any:
+        """The GPU step for this run, or DeviceError naming what stops it."""
+        from .cuda import device_name, simulated
+        from .cuda.cuda_stepper import CudaStepper, unsupported
+
+        missing = unsupported(self)
+        if missing:
+            raise DeviceError("device cuda: not supported yet: " + ", ".join(missing)
+                              + " (run it with device cpu)")
+        try:
+            gpu = CudaStepper(self)
+        except Exception as exc:   # device memory, a driver error: one line, no run directory
+            raise DeviceError(f"device cuda: {str(exc).splitlines()[0] if str(exc) else repr(exc)}") from exc
+        self._gpu_name = device_name()
+        # two-step CUDA graphs, captured after the first call compiled the kernels (a GPU only)
+        self._gpu_graphs = not simulated()
+        return gpu
+
+    def _pull(self) -> None:
+        """The device's state into the host arrays (after each call of the GPU's loop)."""
+        if self._gpu is not None:
+            self._gpu.to_host()
+
+    def _push(self) -> None:
+        """The host's state onto the device (after the host changed it)."""
+        if self._gpu is not None:
+            self._gpu.from_host()
 
     # ---------------------------------------------------------------- state access
     @property
@@ -271,6 +330,9 @@ class Simulation:
                 "scheme": self.scene.scheme.kind,
                 **self.stepper.stats(),
                 "passes_per_step": self.passes_per_step, "threads": numba.get_num_threads(),
+                "device": self.device,
+                **({"gpu": self._gpu_name, "cuda_graphs": self._gpu._graph is not None}
+                   if self._gpu is not None else {}),
                 "particle_steps_per_s": (self.n_particles * self.steps / self.wall_time
                                          if self.wall_time > 0 else None),
                 **({"open_boundaries": self.boundary_counts()} if self.open.active else {})}
@@ -390,6 +452,9 @@ class Simulation:
 
     def _run(self, t_stop: float, max_steps: int) -> None:
         """One call of the stepper's loop up to ``t_stop`` or ``max_steps`` steps."""
+        if self._gpu is not None:
+            self._run_gpu(t_stop, max_steps)
+            return
         ps = self.particles
         ends = self.open.ends
         ends.next_id[0] = ps.next_id
@@ -415,6 +480,20 @@ class Simulation:
         if status not in (wcsph.ST_REACHED_T, wcsph.ST_STEP_LIMIT):
             self._stopped(status, n_flag)
 
+    def _run_gpu(self, t_stop: float, max_steps: int) -> None:
+        """``_run`` on the GPU: the device steps, then its state comes back to the host (a closed
+        tank: no capacity status, no open-end state)."""
+        gpu = self._gpu
+        tic = time.perf_counter()
+        t, dt, steps, status, n_flag, vmax = gpu.run(t_stop, max_steps)
+        self.wall_time += time.perf_counter() - tic
+        self._pull()
+        self.t, self.dt, self.v_max = float(t), float(dt), float(vmax)
+        if self._gpu_graphs and steps > 0 and gpu._graph is None and gpu.graph_error is None:
+            gpu.enable_graphs()   # False (reason in graph_error): the plain launches stay
+        if status not in (wcsph.ST_REACHED_T, wcsph.ST_STEP_LIMIT):
+            self._stopped(status, n_flag)
+
     # ---------------------------------------------------------------- open ends
     def boundary_gauges(self) -> dict[str, float | None]:
         """Elevation [m above still water] at each open end's gauge, from the last step; None if
@@ -435,6 +514,7 @@ class Simulation:
             return False
         slots = np.nonzero(self.particles.mask(FLUID))[0][bad]
         self.particles.kind[slots] = INACTIVE  # skipped by every pass, sorted to the end
+        self._push()
         self.excluded += [{"id": int(ids[k]), "t": self.t, "step": self.steps, "x": float(x[k]),
                            "z": float(z[k]), "rho": float(rho[k]), "reason": reason} for k in bad]
         if self.writer:
@@ -502,6 +582,7 @@ class Simulation:
         self.open.set_state(c.open_state)
         self.loads.reset_sides()
         self.bodies.set_state(c.body_state)
+        self._push()
         self.status = "paused"
         o = self.scene.output
         self._k_probe = int(math.floor(self.t / o.probe_every + 1e-9)) + 1 if o.probe_every else 0
@@ -538,3 +619,4 @@ class Simulation:
         ps.swap()
         ps.n = int(n)
         self.dt = float(dt)
+        self._push()

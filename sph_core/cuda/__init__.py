@@ -49,3 +49,12 @@ def unavailable_reason() -> str | None:
     except Exception as exc:  # a broken driver or toolkit
         return f"CUDA unusable: {exc}"
     return None
+
+
+def device_name() -> str:
+    """The GPU the kernels run on (for meta.json and benchmarks), or the simulator."""
+    if simulated():
+        return "numba-cuda simulator"
+    from numba import cuda
+    name = cuda.get_current_device().name
+    return name.decode() if isinstance(name, bytes) else str(name)

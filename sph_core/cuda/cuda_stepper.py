@@ -4,6 +4,10 @@ stepped there, and copied back on request.
     stepper = CudaStepper(sim)            # raises RuntimeError (no GPU) / ValueError (scope)
     stepper.advance_steps(100)            # or stepper.advance_to(t_end)
     stepper.to_host()                     # particles, cells and clock back into ``sim``
+    stepper.from_host()                   # after the host changed ``sim``'s state: to the device
+
+``Simulation(scene, device="cuda")`` drives one of these (simulation.py); this interface serves
+the tests and benchmarks.
 
 One step is 11 kernel launches, all queued without a host wait (``gpu_kernels.py``): kick + drift
 + binning, the cell count's prefix sum (3), scatter, per-cell ordering, permute into the twin,
@@ -49,8 +53,6 @@ def unsupported(sim: Any) -> list[str]:
         out.append("particle shifting")
     if prm.riemann:
         out.append("Riemann SPH")
-    if np.any(sim.particles.kind[: sim.particles.n] < 0):
-        out.append("inactive (excluded) particles")
     return out
 
 
@@ -97,7 +99,8 @@ class CudaStepper:
         self.prm = sim.prm
         self.t = float(sim.t)
         self.dt = float(sim.dt)
-        self.steps = 0                     # steps taken on the device
+        self.steps = 0                     # steps taken on the device since steps0
+        self.steps0 = int(sim.steps)       # the Simulation's step count when the state came
         self.v_max = float(sim.v_max)
         self.launches = 0
         self._grid_n = (self.n + K.TPB - 1) // K.TPB
@@ -278,17 +281,37 @@ class CudaStepper:
                 self._graph[1].synchronize()
 
     def to_host(self) -> None:
-        """Copy the device state into the Simulation: particles (live and twin), cell lists,
-        clock and step count."""
+        """Copy the device state into the Simulation: the live particle buffer (f, kind, ids,
+        cell; not the twin, which the next step's permute rebuilds), the cell starts (the live
+        buffer is in cell order: the host's probes walk it), clock and step count."""
         sim = self.sim
         ps = sim.particles
-        for host, dev in zip((ps.f, ps.kind, ps.ids, ps.cell, ps.f2, ps.kind2, ps.ids2, ps.cell2),
-                             self.bufs[self.cur] + self.bufs[1 - self.cur]):
+        for host, dev in zip((ps.f, ps.kind, ps.ids, ps.cell), self.bufs[self.cur]):
             host[:] = self._to_host(dev)
         sim.cells.start[:] = self._to_host(self.start)
-        sim.cells.order[:] = self._to_host(self.order)
         sim.t, sim.dt, sim.v_max = self.t, self.dt, self.v_max
-        sim.steps += self.steps
+        sim.steps = self.steps0 + self.steps
+
+    def from_host(self) -> None:
+        """Copy the Simulation's state to the device after the host changed it (particles
+        excluded by a guard, a restored checkpoint, new Params): its live buffer and cell starts
+        into the device's first buffer, its clock, count and Params. Graphs captured for another
+        count or other Params are dropped (``enable_graphs`` captures them again)."""
+        sim = self.sim
+        ps = sim.particles
+        for dev, host in zip(self.bufs[0], (ps.f, ps.kind, ps.ids, ps.cell)):
+            self._put(dev, host)
+        self._put(self.start, sim.cells.start)
+        self.cur = 0
+        if int(ps.n) != self.n or sim.prm != self.prm:
+            self.n = int(ps.n)
+            self.prm = sim.prm
+            self._grid_n = (self.n + K.TPB - 1) // K.TPB
+            self._plan = [self._launches(0), self._launches(1)]
+            self._graph = None
+            self.graph_error = None
+        self.t, self.dt, self.v_max = float(sim.t), float(sim.dt), float(sim.v_max)
+        self.steps0 = int(sim.steps)
         self.steps = 0
 
     def device_bytes(self) -> int:
