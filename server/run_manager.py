@@ -218,8 +218,8 @@ class RunManager:
         scene_bytes = canonical_scene(request.scene)
         from protocol import scene_hash
 
-        info = RunInfo(id=run_id, mode=request.mode, state=QUEUED, status=QUEUED, created=time.time(),
-                       t_end=request.scene.t_end, scene_hash=scene_hash(scene_bytes).hex(),
+        info = RunInfo(id=run_id, mode=request.mode, device=request.scene.run.device, state=QUEUED,
+                       status=QUEUED, created=time.time(), t_end=request.scene.t_end, scene_hash=scene_hash(scene_bytes).hex(),
                        gauges_file="gauges.csv" if _windowed(request) else "sph/probes.csv")
         run_dir = self.store.create(run_id, request.model_dump(mode="json"), scene_bytes)
         run = Run(info, request, run_dir)
@@ -352,9 +352,12 @@ class RunManager:
             sim.close()
 
     def _fail(self, run: Run, exc: BaseException) -> None:
-        from sph_core.simulation import UnstableError
+        from sph_core.simulation import DeviceError, UnstableError
 
-        if isinstance(exc, UnstableError):
+        if isinstance(exc, DeviceError):   # one line, no traceback: the scene, not the server
+            log.info("run %s: %s", run.info.id, exc)
+            self._set_state(run, FAILED, str(exc))
+        elif isinstance(exc, UnstableError):
             run.info.stability = {**run.info.stability, "unstable_step": exc.step, "unstable_t": exc.t}
             self._set_state(run, UNSTABLE, str(exc))
         else:

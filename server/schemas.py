@@ -50,6 +50,7 @@ class RunInfo(BaseModel):
 
     id: str
     mode: str
+    device: str = "cpu"         # where the SPH steps run (the scene's [run] device)
     state: str
     status: str
     reason: str | None = None

@@ -5,6 +5,7 @@ from __future__ import annotations
 import ipaddress
 import os
 from pathlib import Path
+from typing import Literal
 
 from pydantic import BaseModel, Field, ValidationError, model_validator
 
@@ -25,6 +26,8 @@ class Settings(BaseModel):
                                                   "(each holds its particles in memory)")
     max_queued: int = Field(32, ge=0, description="runs in the queue; beyond: HTTP 429")
     max_particles: int = Field(2_000_000, ge=1, description="particle-count cap per run")
+    device: Literal["cpu", "cuda"] = Field("cpu", description="where a run's SPH steps run when "
+                                           "its scene does not say ([run] device)")
     max_probes: int = Field(1000, ge=0, description="probes of one scene")
     max_body: int = Field(1024 * 1024, ge=1024, description="largest POST /runs body [bytes]")
     max_frame: int = Field(16 * 1024 * 1024, ge=4104, le=16 * 1024 * 1024,

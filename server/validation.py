@@ -91,10 +91,21 @@ def parse_run_request(raw: bytes, settings: Settings, toml: bool = False) -> Run
     except ValidationError as exc:
         raise RequestInvalid(clean_errors(exc.errors(include_url=False, include_context=False,
                                                      include_input=False), ("body",))) from None
+    body = with_device(body, settings)
     errors = run_errors(body, settings)
     if errors:
         raise RequestInvalid(errors)
     return body
+
+
+def with_device(body: RunRequest, settings: Settings) -> RunRequest:
+    """The request with the server's default device where its scene names none ([run] device),
+    so the run record and the Simulation see the device the run uses."""
+    run = body.scene.run
+    if "device" in run.model_fields_set or run.device == settings.device:
+        return body
+    scene = body.scene.model_copy(update={"run": run.model_copy(update={"device": settings.device})})
+    return body.model_copy(update={"scene": scene})
 
 
 def run_errors(body: RunRequest, settings: Settings) -> list[dict[str, Any]]:
@@ -108,8 +119,14 @@ def run_errors(body: RunRequest, settings: Settings) -> list[dict[str, Any]]:
     if body.mode == "coupled" and not scene.open_boundaries:
         return [error(["scene", "open_boundaries"],
                       "a coupled run needs at least one open end for the client to drive")]
-    duration = scene.t_end - scene.t_start
     errors = []
+    if scene.run.device == "cuda":
+        from sph_core.cuda import unavailable_reason
+
+        reason = unavailable_reason()
+        if reason is not None:
+            errors.append(error(["scene", "run", "device"], f"device cuda: {reason}"))
+    duration = scene.t_end - scene.t_start
     windows = [(["coupling", "window_max"], coupling.window_max)]
     if body.source is not None and body.source.window is not None:
         windows.append((["source", "window"], body.source.window))

@@ -183,3 +183,32 @@ def test_serve_on_a_busy_port_is_one_line(tmp_path, capsys):
     err = capsys.readouterr().err
     assert code == 1 and f"--port {port}" in err and "not free" in err
     assert len(err.strip().splitlines()) == 1 and "Traceback" not in err
+
+
+def test_device_cuda_without_a_gpu_is_one_line_before_any_output(tmp_path, capsys, monkeypatch):
+    import sph_core.cuda
+
+    monkeypatch.setattr(sph_core.cuda, "unavailable_reason",
+                        lambda: "no CUDA GPU or driver found (test)")
+    out = tmp_path / "run"
+    assert wavesph.cli.main(["run", str(TANK), "--device", "cuda", "-o", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.splitlines()[-1] == "wavesph run: device cuda: no CUDA GPU or driver found (test)"
+    assert "Traceback" not in err and not out.exists()
+    for argv in (["demo", "--dambreak", "--device", "cuda", "-o", str(tmp_path / "demo")],
+                 ["serve", "--device", "cuda", "--port", "0", "--tcp-port", "0"]):
+        assert wavesph.cli.main(argv) == 2
+        err = capsys.readouterr().err
+        assert err == f"wavesph {argv[0]}: device cuda: no CUDA GPU or driver found (test)\n"
+    assert not (tmp_path / "demo").exists()
+
+
+def test_an_unknown_device_is_refused(tmp_path, capsys):
+    with pytest.raises(SystemExit) as exc:
+        wavesph.cli.main(["run", str(TANK), "--device", "tpu"])
+    assert exc.value.code == 2 and "invalid choice: 'tpu'" in capsys.readouterr().err
+    scene = tmp_path / "tank.toml"
+    scene.write_text(TANK.read_text() + '\n[run]\ndevice = "tpu"\n')
+    assert wavesph.cli.main(["run", str(scene), "-o", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err
+    assert "run.device" in err and "'cpu' or 'cuda'" in err and len(err.splitlines()) == 1

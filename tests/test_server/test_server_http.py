@@ -215,3 +215,35 @@ def test_run_interrupted_by_a_server_stop_resumes_after_restart(tmp_path, factor
         run_windows(c, welcome, nodes, 1, t0=0.1)
         bye(c)
         assert srv.wait_state(run["id"], "finished")["windows"] == 3
+
+
+def test_device_cuda_without_a_gpu_is_a_422_naming_it(srv, monkeypatch):
+    import sph_core.cuda
+
+    monkeypatch.setattr(sph_core.cuda, "unavailable_reason",
+                        lambda: "no CUDA GPU or driver found (test)")
+    r = srv.http.post("/runs", json={"scene": scene(run={"device": "cuda"}), "mode": "standalone"})
+    assert r.status_code == 422
+    (err,) = r.json()["detail"]
+    assert err["loc"] == ["body", "scene", "run", "device"]
+    assert err["msg"] == "device cuda: no CUDA GPU or driver found (test)"
+    r = srv.http.post("/runs", json={"scene": scene(run={"device": "tpu"}), "mode": "standalone"})
+    assert r.status_code == 422 and r.json()["detail"][0]["loc"] == ["body", "scene", "run", "device"]
+    assert srv.http.get("/runs").json() == []  # nothing was created
+
+
+def test_the_servers_default_device_is_each_runs_unless_its_scene_says(tmp_path, factory,
+                                                                        monkeypatch):
+    import sph_core.cuda
+
+    monkeypatch.setattr(sph_core.cuda, "unavailable_reason", lambda: None)
+    with live_server(tmp_path, factory, device="cuda") as srv:
+        default, own = srv.create(), srv.create(run={"device": "cpu"})
+        assert default["device"] == "cuda" and own["device"] == "cpu"
+        info = srv.http.get(f"/runs/{default['id']}").json()
+        assert info["device"] == "cuda"
+        # the run's stored request carries the device its scene runs on
+        stored = json.loads((tmp_path / "runs" / default["id"] / "request.json").read_text())
+        assert stored["scene"]["run"]["device"] == "cuda"
+    with live_server(tmp_path / "cpu", factory) as srv:
+        assert srv.create()["device"] == "cpu"

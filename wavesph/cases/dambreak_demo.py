@@ -14,7 +14,7 @@ import numpy as np
 
 from sph_core.particles import FLUID, VX, VZ, X, Z
 from sph_core.progress import advance_with_progress
-from sph_core.simulation import Simulation
+from sph_core.simulation import DeviceError, Simulation
 
 from .dambreak import dambreak_scene, front_errors, martin_moyce_table
 
@@ -23,17 +23,22 @@ DAMBREAK_A = 0.1  # column width [m] of the demo (height 2a)
 
 
 def run_dambreak_demo(out: Path | None = None, a: float = DAMBREAK_A, resolution: int = 40,
-                      T_end: float = 3.3, make_plot: bool = True) -> int:
+                      T_end: float = 3.3, make_plot: bool = True, device: str | None = None) -> int:
     """Run the dam break of column width ``a`` [m] (height 2a) at ``resolution`` particles
     across it to ``T_end`` in Martin & Moyce units T = t sqrt(2g/a); outputs in ``out`` (default
-    runs/demo-<UTC time>), with the figure dambreak.png. Returns a process exit code."""
+    runs/demo-<UTC time>), with the figure dambreak.png, the steps on ``device`` ("cpu" or
+    "cuda"; default cpu). Returns a process exit code."""
     if a <= 0 or resolution < 4 or T_end <= 0:
         raise ValueError("dam-break demo: a must be > 0, resolution >= 4, T_end > 0")
     t_end = T_end / math.sqrt(2 * 9.81 / a)
     scene = dambreak_scene(a=a, dp=a / resolution, t_end=t_end, tank_length=5 * a,
                            snapshot_every=t_end / 10)
     out = out or Path("runs") / f"demo-{time.strftime('%Y%m%dT%H%M%SZ', time.gmtime())}"
-    sim = Simulation(scene, run_dir=out)
+    try:
+        sim = Simulation(scene, run_dir=out, device=device)
+    except DeviceError as exc:   # one line, before the run directory is written
+        print(f"wavesph demo: {exc}", file=sys.stderr)
+        return 2
     print(f"dam break: column {a:g} m x {2 * a:g} m, {sim.n_fluid} fluid particles, "
           f"c0 = {sim.c0:.1f} m/s; output in {out}", file=sys.stderr)
     code = advance_with_progress(sim, t_end, "dam break")

@@ -97,11 +97,12 @@ def demo_scene(dp: float, t_end: float, body: str | None = None) -> dict[str, An
 
 
 def run_demo(dp: float, t_end: float, transport: str, out: Path,
-             body: str | None = None) -> tuple[dict, Any]:
+             body: str | None = None, device: str | None = None) -> tuple[dict, Any]:
     """The demo flume at spacing ``dp`` [m] to ``t_end`` [s], coupled over ``transport`` ("ws" or
     "tcp") to a server in this process storing its runs in ``out``, with an optional ``body``
-    in the SPH zone: (final run record, client report or None)."""
-    with InProcessServer(out) as srv:
+    in the SPH zone, the steps on ``device`` (the server's default device; None: cpu): (final
+    run record, client report or None)."""
+    with InProcessServer(out, **({"device": device} if device else {})) as srv:
         return _couple(srv, demo_scene(dp, t_end, body), transport, out)
 
 

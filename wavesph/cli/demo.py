@@ -19,7 +19,7 @@ import sys
 import time
 from pathlib import Path
 
-from ._common import refuse_non_empty
+from ._common import add_device_argument, device_problem, refuse_non_empty
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -43,6 +43,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--dambreak", action="store_true",
                         help="run the standalone dam break (Martin & Moyce) instead, as "
                              "`wavesph run examples/scenes/dambreak_martin_moyce.toml` does")
+    add_device_argument(parser, "")
     parser.epilog = ("Coupled flume: open inlet, 1:10 beach, Stokes-2 wave H = 0.04 m, T = 1.4 s, "
                      "depth 0.24 m, coupled over a real socket to an in-process server.")
 
@@ -59,7 +60,7 @@ def main(args: argparse.Namespace) -> int:
         print("wavesph demo: --t-end must be > 0 s and --dp within [0.002, 0.05] m", file=sys.stderr)
         return 2
     out = args.out or Path("runs") / f"demo-{time.strftime('%Y%m%dT%H%M%SZ', time.gmtime())}"
-    if refuse_non_empty("demo", out):
+    if refuse_non_empty("demo", out) or device_problem("demo", args.device):
         return 2
     if args.dambreak:
         from wavesph.cases.dambreak_demo import DAMBREAK_A, run_dambreak_demo
@@ -73,7 +74,7 @@ def main(args: argparse.Namespace) -> int:
         T_end = 3.3 if args.t_end is None else t_end * math.sqrt(2 * 9.81 / DAMBREAK_A)
         try:
             return run_dambreak_demo(out, a=DAMBREAK_A, resolution=resolution, T_end=T_end,
-                                     make_plot=not args.no_plot)
+                                     make_plot=not args.no_plot, device=args.device)
         except KeyboardInterrupt:
             print(f"\nwavesph demo: interrupted; partial results in {out}", file=sys.stderr)
             return 130
@@ -86,7 +87,8 @@ def main(args: argparse.Namespace) -> int:
     out.mkdir(parents=True, exist_ok=True)
     tic = time.perf_counter()
     try:
-        info, report = run_demo(dp, t_end, args.transport, out, body=args.body)
+        info, report = run_demo(dp, t_end, args.transport, out, body=args.body,
+                                device=args.device)
     except KeyboardInterrupt:
         print(f"\nwavesph demo: interrupted; partial results in {out}", file=sys.stderr)
         return 130

@@ -9,9 +9,9 @@ from pathlib import Path
 
 from sph_core.progress import advance_with_progress
 from sph_core.scene import SceneError, load_scene, make_scene
-from sph_core.simulation import Simulation
+from sph_core.simulation import DeviceError, Simulation
 
-from ._common import positive_float, refuse_non_empty
+from ._common import add_device_argument, positive_float, refuse_non_empty
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -27,6 +27,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "output.snapshot_every)")
     parser.add_argument("--threads", type=int, default=None,
                         help="numba threads (default: NUMBA_NUM_THREADS or all cores)")
+    add_device_argument(parser, "")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar or lines")
     parser.add_argument("--preview", action="store_true",
                         help="write the initial particles (snapshots/particles_00000.vtu) and the "
@@ -44,6 +45,8 @@ def main(args: argparse.Namespace) -> int:
             data["t_end"] = args.t_end      # meta.json records the real end
         if args.dp is not None:
             data["dp"] = args.dp
+        if args.device is not None:
+            data["run"] = {**data["run"], "device": args.device}
         length = data["t_end"] - data["t_start"]
         if args.snapshot_every is not None:
             data["output"] = {**data["output"], "snapshot_every": args.snapshot_every}
@@ -70,9 +73,13 @@ def main(args: argparse.Namespace) -> int:
     if refuse_non_empty("run", out):
         return 2
     print(f"building particles for '{scene.name}' (dp = {scene.dp} m) ...", file=sys.stderr)
-    sim = Simulation(scene, run_dir=out)
+    try:
+        sim = Simulation(scene, run_dir=out)
+    except DeviceError as exc:   # raised before the run directory is written
+        print(f"wavesph run: {exc}", file=sys.stderr)
+        return 2
     print(f"{sim.n_fluid} fluid + {sim.n_particles - sim.n_fluid} wall particles, c0 = {sim.c0:.2f} m/s, "
-          f"h = {sim.h:.4g} m; output in {out}", file=sys.stderr)
+          f"h = {sim.h:.4g} m, device {sim.device}; output in {out}", file=sys.stderr)
     if args.preview:
         return _preview(sim, out)
     try:

@@ -12,6 +12,8 @@ from pydantic import ValidationError
 
 from server.settings import Settings
 
+from ._common import add_device_argument, device_problem
+
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--host", help="HTTP/WebSocket bind address (default 127.0.0.1; "
@@ -22,6 +24,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--max-runs", type=int, help="runs stepping at once; more are queued (default 2)")
     parser.add_argument("--max-particles", type=int, help="particle cap per run (default 2e6)")
     parser.add_argument("--token", help="API token (or WAVESPH_TOKEN); required off loopback")
+    add_device_argument(parser, " for runs whose scene names no [run] device")
     parser.epilog = "Every option can also be set as WAVESPH_<OPTION> in the environment."
 
 
@@ -46,11 +49,14 @@ def main(args: argparse.Namespace) -> int:
     try:
         settings = Settings.from_env(host=args.host, port=args.port, tcp_port=args.tcp_port,
                                      runs_dir=args.runs_dir, max_runs=args.max_runs,
-                                     max_particles=args.max_particles, token=args.token)
+                                     max_particles=args.max_particles, token=args.token,
+                                     device=args.device)
     except ValidationError as exc:
         for err in exc.errors():
             field = ".".join(str(p) for p in err["loc"]) or "settings"
             print(f"wavesph serve: {field}: {err['msg'].removeprefix('Value error, ')}", file=sys.stderr)
+        return 2
+    if device_problem("serve", settings.device):
         return 2
     tcp_host = settings.tcp_host or settings.host
     for what, host, port in (("--port", settings.host, settings.port),
