@@ -3,11 +3,12 @@
 #   1. installs what the machine lacks from the carried wheels in .whl/ (bench/gpu_wheels.sh)
 #   2. prints the versions and the GPU
 #   3. runs the CUDA tests on the real GPU (pytest -m cuda)
-#   4. GPU throughput of the 2D dam break at ~25.6k, ~340k, ~1.4M particles (dp 0.01/0.0025/0.00125)
-#   5. the CPU step at ~91k particles (dp 0.005) on 1, 2, 4, 8, 16 threads
+#   4. GPU throughput of the 2D dam break at ~25.6k, ~340k, ~1.4M particles (dp 0.01/0.0025/0.00125),
+#      through Simulation(device="cuda") (bench/sph_throughput.py --device cuda)
+#   5. the CPU step at ~91k particles (dp 0.005) on 1, 2, 4, 8, 16 threads (bench/sph_throughput.py)
 # JSON lines go to stdout and $OUT/gpu.jsonl, the whole log to $OUT/gpu_check.log.
 # Every phase runs under `timeout`, capped by what is left of TOTAL_S, so the script ends in time.
-# Overrides (a rerun, or a dry run here): GPU_DPS, CPU_DP, THREADS (empty: no CPU runs),
+# Overrides (a rerun, or a dry run here): GPU_DPS, CPU_DP, CPU_STEPS, THREADS (empty: no CPU runs),
 # HOST_THREADS (16: pytest and the GPU runs' host side), TOTAL_S, PYTHON, SKIP_WHEELS, SKIP_TESTS,
 # NUMBA_ENABLE_CUDASIM.
 set -u
@@ -58,14 +59,15 @@ fi
 
 if [ -n "$GPU_DPS" ]; then
     say "GPU throughput, dp = $GPU_DPS"
-    NUMBA_NUM_THREADS=$HT timeout "$(left 150)" $PY bench/gpu_throughput.py --device cuda \
-        --dps $GPU_DPS --budget 4 --out "$JSONL" 2>&1 | tee -a "$LOG"
+    NUMBA_NUM_THREADS=$HT timeout "$(left 150)" $PY bench/sph_throughput.py --device cuda \
+        --dps $GPU_DPS --budget 4 2>&1 | tee -a "$LOG" | tee >(grep '^{' >> "$JSONL")
     say "GPU bench exit ${PIPESTATUS[0]}"
 fi
 
 for t in $THREADS; do
     say "CPU throughput, dp = $CPU_DP, $t thread(s)"
-    NUMBA_NUM_THREADS=$t timeout "$(left 45)" $PY bench/gpu_throughput.py --device cpu \
-        --dps "$CPU_DP" --budget 3 --out "$JSONL" 2>&1 | tee -a "$LOG"
+    NUMBA_NUM_THREADS=$t timeout "$(left 45)" $PY bench/sph_throughput.py --device cpu \
+        --dps "$CPU_DP" --steps "${CPU_STEPS:-100}" --no-compile 2>&1 | tee -a "$LOG" \
+        | tee >(grep '^{' >> "$JSONL")
 done
 say "done: $(wc -l < "$JSONL") JSON lines in $JSONL"

@@ -11,6 +11,14 @@ anchors do. Also measures the one-off numba compile time, cold (empty cache) and
 Output: one JSON object per line.
     python bench/sph_throughput.py [--steps 400] [--dps 0.01 0.005] [--integrator kdk]
         [--cells-per-support 2] [--diagnostics]
+
+``--device cuda``: the same case stepped on the GPU through ``Simulation(device="cuda")``
+(sph_core/cuda), timed with plain kernel launches and/or two-step CUDA graph replays
+(``--graphs``), each for about ``--budget`` seconds: one line per size and mode with device,
+gpu, particles, particle_steps_per_s, wall_s_per_sim_s, ms_per_step, launches_per_step (host
+calls per step) and the per-kernel milliseconds of one step (CUDA events). dp 0.01 / 0.0025 /
+0.00125 m give ~25.6k / ~340k / ~1.4M particles.
+    python bench/sph_throughput.py --device cuda --dps 0.01 0.0025 0.00125 [--graphs both]
 """
 
 from __future__ import annotations
@@ -117,6 +125,64 @@ def run_size(dp: float, steps: int, integrator: str, diagnostics: bool,
     return out
 
 
+def _steps_for(n: int, budget: float, rate: float) -> int:
+    """Steps that take about ``budget`` seconds at ``rate`` particle-steps/s (20..5000)."""
+    return int(min(5000, max(20, budget * rate / n)))
+
+
+def run_size_cuda(dp: float, budget: float, modes: list[bool]) -> list[dict]:
+    """One Simulation on the GPU per size, timed with plain launches and/or graphs (``modes``:
+    False plain, True graphs, in that order)."""
+    import numba
+
+    from sph_core.cuda.cuda_stepper import LAUNCHES_PER_STEP
+    from sph_core.simulation import Simulation
+    from wavesph.cases.dambreak import dambreak_scene
+
+    t0 = time.perf_counter()
+    sim = Simulation(dambreak_scene(a=1.0, dp=dp, t_end=1.0), device="cuda")
+    t_build = time.perf_counter() - t0
+    st = sim._gpu
+    sim._gpu_graphs = False               # plain launches first; graphs when asked
+    t0 = time.perf_counter()
+    sim.advance_steps(10)                 # compiles on first use; touches every buffer
+    t_warm = time.perf_counter() - t0
+    n = sim.n_particles
+    kt = st.kernel_times(5)               # 5 steps (the next call's copy-back follows them)
+    out = []
+    for graphs in modes:
+        if graphs:
+            sim._gpu_graphs = True
+            sim.advance_steps(2)          # captures the graphs after this call
+            if st._graph is None:
+                out.append({"bench": "sph_throughput", "device": "cuda", "dp": dp,
+                            "graphs": True, "error": st.graph_error})
+                continue
+        t0 = time.perf_counter()
+        sim.advance_steps(20)             # a short timed run, then one sized to the budget
+        steps = _steps_for(n, budget, n * 20 / (time.perf_counter() - t0))
+        ts, s0 = sim.t, sim.steps
+        t0 = time.perf_counter()
+        sim.advance_steps(steps)          # ends with one copy of the state to the host
+        wall = time.perf_counter() - t0
+        done = sim.steps - s0
+        out.append({
+            "bench": "sph_throughput", "case": "dambreak_2d_1x2m_tank4m", "device": "cuda",
+            "gpu": sim._gpu_name, "graphs": graphs, "batch": st.batch, "dp": dp,
+            "particles": n, "fluid_particles": sim.n_fluid, "steps": done,
+            "wall_s": round(wall, 4), "particle_steps_per_s": round(n * done / wall),
+            "wall_s_per_sim_s": round(wall / (sim.t - ts), 3) if sim.t > ts else None,
+            "ms_per_step": round(1e3 * wall / done, 4),
+            # host calls per step: the kernels' launches, or one graph replay per two steps
+            "launches_per_step": 0.5 if graphs else LAUNCHES_PER_STEP,
+            "kernels_per_step": LAUNCHES_PER_STEP,
+            "kernel_ms": kt, "kernel_ms_sum": round(sum(kt.values()), 4),
+            "build_s": round(t_build, 2), "compile_and_warm_s": round(t_warm, 2),
+            "simulated_t_s": round(sim.t, 5), "dt_s": sim.dt, "numba": numba.__version__,
+            "host_threads": numba.get_num_threads()})
+    return out
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--steps", type=int, default=400)
@@ -126,7 +192,19 @@ def main() -> None:
                     help="neighbour cells of side 2h / this (default: the Simulation's)")
     ap.add_argument("--diagnostics", action="store_true", help="print numba parallel diagnostics")
     ap.add_argument("--no-compile", action="store_true", help="skip the compile-time measurement")
+    ap.add_argument("--device", choices=["cpu", "cuda"], default="cpu",
+                    help="where the steps run (cuda: module docstring)")
+    ap.add_argument("--budget", type=float, default=8.0,
+                    help="cuda: seconds of timed stepping per size and mode")
+    ap.add_argument("--graphs", choices=["off", "on", "both"], default="both",
+                    help="cuda: plain launches (off), two-step CUDA graph replays (on), or both")
     args = ap.parse_args()
+    if args.device == "cuda":
+        modes = {"off": [False], "on": [True], "both": [False, True]}[args.graphs]
+        for dp in args.dps:
+            for res in run_size_cuda(dp, args.budget, modes):
+                print(json.dumps(res), flush=True)
+        return
     if not args.no_compile:
         print(json.dumps(compile_times(args.integrator)), flush=True)
     for dp in args.dps:
