@@ -104,7 +104,8 @@ def with_device(body: RunRequest, settings: Settings) -> RunRequest:
     run = body.scene.run
     if "device" in run.model_fields_set or run.device == settings.device:
         return body
-    scene = body.scene.model_copy(update={"run": run.model_copy(update={"device": settings.device})})
+    own = run.model_copy(update={"device": settings.device})
+    scene = body.scene.model_copy(update={"run": own})
     return body.model_copy(update={"scene": scene})
 
 

@@ -95,7 +95,8 @@ class Simulation:
             if device not in DEVICES:
                 raise DeviceError(f"device: {device!r} is not one of {', '.join(DEVICES)}")
             # the scene records the device the run used (meta.json)
-            scene = scene.model_copy(update={"run": scene.run.model_copy(update={"device": device})})
+            run = scene.run.model_copy(update={"device": device})
+            scene = scene.model_copy(update={"run": run})
         self.device = scene.run.device
         if self.device == "cuda":   # before anything is built: the cheap refusal first
             from .cuda import unavailable_reason
@@ -208,7 +209,8 @@ class Simulation:
         try:
             gpu = CudaStepper(self)
         except Exception as exc:   # device memory, a driver error: one line, no run directory
-            raise DeviceError(f"device cuda: {str(exc).splitlines()[0] if str(exc) else repr(exc)}") from exc
+            first = str(exc).splitlines()[0] if str(exc) else repr(exc)
+            raise DeviceError(f"device cuda: {first}") from exc
         self._gpu_name = device_name()
         # two-step CUDA graphs, captured after the first call compiled the kernels (a GPU only)
         self._gpu_graphs = not simulated()

@@ -101,14 +101,14 @@ def k_begin(clk, ctl):
 @cuda.jit
 def k_finish(prm, clk, ctl):
     """End of a step (one thread): the clock, the verdict (step._verdict), the next dt
-    (wcsph.stable_dt), the reductions cleared, the next step scheduled."""
+    (wcsph.stable_dt; unchanged after a tripped guard, as in step.run), the reductions cleared,
+    the next step scheduled."""
     if cuda.grid(1) != 0 or ctl[STOP] != 0:
         return
     clk[T] = clk[T_STOP] if ctl[LAST] != 0 else clk[T] + clk[DTS]
     ctl[STEPS] += 1
     v2 = clk[V2]
     clk[V2LAST] = v2
-    clk[DT] = _stable_dt(v2, clk[A2], clk[RMAX], prm)
     status = ST_REACHED_T
     flag = 0
     if ctl[N_BAD] > 0:
@@ -120,6 +120,10 @@ def k_finish(prm, clk, ctl):
     elif ctl[N_BAND] > 0:
         status = ST_DENSITY
         flag = ctl[N_BAND]
+    if status == ST_REACHED_T:
+        # a step whose guard trips keeps its dt for the next, as step.run does (the host may
+        # exclude particles and go on)
+        clk[DT] = _stable_dt(v2, clk[A2], clk[RMAX], prm)
     ctl[N_BAD] = 0
     ctl[N_BAND] = 0
     ctl[N_OUT] = 0

@@ -228,7 +228,8 @@ def test_device_cuda_without_a_gpu_is_a_422_naming_it(srv, monkeypatch):
     assert err["loc"] == ["body", "scene", "run", "device"]
     assert err["msg"] == "device cuda: no CUDA GPU or driver found (test)"
     r = srv.http.post("/runs", json={"scene": scene(run={"device": "tpu"}), "mode": "standalone"})
-    assert r.status_code == 422 and r.json()["detail"][0]["loc"] == ["body", "scene", "run", "device"]
+    assert r.status_code == 422
+    assert r.json()["detail"][0]["loc"] == ["body", "scene", "run", "device"]
     assert srv.http.get("/runs").json() == []  # nothing was created
 
 

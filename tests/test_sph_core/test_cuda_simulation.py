@@ -30,8 +30,9 @@ A, DP, WARM_STEPS = 0.05, 0.01, 15
 
 def _scene(**kw):
     from wavesph.cases.dambreak import dambreak_scene
-    # exclude_limit 0.1: the test excludes one of the 50 fluid particles as a guard would
-    return dambreak_scene(a=A, dp=DP, t_end=1.0, tank_length=2.0 * A, exclude_limit=0.1, **kw)
+    # exclude_limit 0.1: the tests exclude one of the 50 fluid particles as a guard would
+    kw.setdefault("exclude_limit", 0.1)
+    return dambreak_scene(a=A, dp=DP, t_end=1.0, tank_length=2.0 * A, **kw)
 
 
 @pytest.fixture(scope="module")
@@ -110,6 +111,49 @@ def test_simulation_on_cuda_matches_the_cpu_run(gpu_here, tmp_path):
     assert meta["device"] == "cuda" and meta["gpu"] and meta["config"]["run"]["device"] == "cuda"
     assert meta["steps"] == gpu.steps and meta["excluded"] == 1
     assert json.loads((tmp_path / "cpu" / "meta.json").read_text())["device"] == "cpu"
+
+
+@needs_cuda
+@pytest.mark.parametrize("limit", [0.1, 0.0])
+def test_a_guard_on_cuda_excludes_or_stops_as_on_the_cpu(gpu_here, tmp_path, limit):
+    """One fluid particle put below the density band (0.65 rho0): with room under
+    exclude_limit both devices exclude it after the first step and go on; without, both stop
+    with the same UnstableError and meta.json says unstable. Same tolerance as above."""
+    from sph_core.particles import FLUID, RHO
+    from sph_core.simulation import Simulation, UnstableError
+
+    base = Simulation(_scene())
+    base.advance_steps(WARM_STEPS)
+    ck = base.checkpoint()
+    victim = np.nonzero(ck.kind == FLUID)[0][10]
+    ck.f[RHO, victim] = 0.65 * base.scene.constants.rho0
+    runs = {}
+    for device in ("cpu", "cuda"):
+        sim = Simulation(_scene(exclude_limit=limit), run_dir=tmp_path / device, device=device)
+        sim.restore(ck)
+        try:
+            sim.advance_to(ck.t + 3.0 * ck.dt)
+            runs[device] = (sim, None)
+        except UnstableError as exc:
+            runs[device] = (sim, exc)
+    (cpu, cpu_exc), (gpu, gpu_exc) = runs["cpu"], runs["cuda"]
+    assert gpu.steps == cpu.steps and gpu.t == cpu.t
+    assert [(e["id"], e["step"]) for e in gpu.excluded] == [(e["id"], e["step"]) for e in cpu.excluded]
+    meta = json.loads((tmp_path / "cuda" / "meta.json").read_text())
+    if limit:
+        assert cpu_exc is None and gpu_exc is None and len(gpu.excluded) == 1
+        assert gpu.excluded[0]["id"] == ck.ids[victim] and gpu.t == pytest.approx(ck.t + 3.0 * ck.dt)
+        a, b = cpu.fluid_state(), gpu.fluid_state()
+        np.testing.assert_array_equal(a["id"], b["id"])
+        diffs = {k: _scaled_diff(a[k], b[k]) for k in ("x", "z", "vx", "vz", "rho", "p")}
+        assert all(d <= 1e-10 for d in diffs.values()), diffs
+        assert meta["excluded"] == 1
+    else:
+        assert cpu_exc is not None and gpu_exc is not None and gpu.steps == ck.steps + 1
+        assert (gpu_exc.step, gpu_exc.t) == (cpu_exc.step, cpu_exc.t)
+        assert gpu_exc.cause.split(", e.g.")[0] == cpu_exc.cause.split(", e.g.")[0]
+        assert f"id {ck.ids[victim]} " in gpu_exc.cause
+        assert meta["status"] == "unstable" and meta["unstable_step"] == gpu.steps
 
 
 @needs_cuda
