@@ -172,11 +172,11 @@ class CudaStepper:
         return head + sort + update + [("finish", K.k_finish[1, 1, stream], (prm, clk, ctl))]
 
     def enable_graphs(self) -> bool:
-        """Capture two steps (even + odd buffer parity, 22 launches) into a CUDA graph per
-        starting parity, so ``run`` replays a pair of steps with one host call instead of 22
-        launches. Call after the kernels have been compiled (a step taken). Returns False, with
-        the reason in ``graph_error``, where it fails (and under the simulator); the plain
-        launches then stay in use."""
+        """Capture two steps (even + odd buffer parity) into a CUDA graph per starting parity,
+        so ``run`` replays a pair of steps with one host call instead of 2 x
+        ``launches_per_step`` launches. Call after the kernels have been compiled (a step
+        taken). Returns False, with the reason in ``graph_error``, where it fails (and under
+        the simulator); the plain launches then stay in use."""
         if simulated():
             self.graph_error = "the simulator has no CUDA graphs"
             return False
