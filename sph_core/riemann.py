@@ -75,28 +75,36 @@ def interface_state(ul, ur, pl, pr, zc, wall_factor):
     return ustar, 0.5 * (pl + pr) + 0.5 * wall_factor * zc * du
 
 
+@njit(cache=True, inline="always")
+def muscl_gradients(i, ps, cells, prm):
+    """(gpx, gpz, gux, guz, gwx, gwz): the kernel-corrected gradients of p, vx, vz of slot i
+    (zero outside the fluid..buffer kinds, and where the moment matrix is near singular); one
+    particle's share of ``riemann_gradients``: the CUDA step's kernel calls the same function."""
+    ki = ps.kind[i]
+    gpx = gpz = gux = guz = gwx = gwz = 0.0
+    if ki >= FLUID and ki <= OUTLET:
+        # moment matrices: all neighbours M (pressure), fluid and buffers Mf (velocity)
+        s = moments(i, ps, cells, prm, ps.p, ps.vx, ps.vz, True)
+        # invert where well conditioned: det relative to the isotropic (tr/2)^2 above 5 %
+        det = s.mxx * s.mzz - s.mxz * s.mxz
+        tr = s.mxx + s.mzz
+        if tr > 0.0 and det > 0.0125 * tr * tr:
+            gpx, gpz = solve(s.mxx, s.mxz, s.mzz, det, s.phix, s.phiz)
+        det = s.mfxx * s.mfzz - s.mfxz * s.mfxz
+        tr = s.mfxx + s.mfzz
+        if tr > 0.0 and det > 0.0125 * tr * tr:
+            gux, guz = solve(s.mfxx, s.mfxz, s.mfzz, det, s.ux, s.uz)
+            gwx, gwz = solve(s.mfxx, s.mfxz, s.mfzz, det, s.wx, s.wz)
+    return gpx, gpz, gux, guz, gwx, gwz
+
+
 @njit(parallel=True, cache=True, fastmath=_FASTMATH)
 def riemann_gradients(ps, n, cells, prm):
     """Kernel-corrected gradients of p, vx, vz of every fluid and buffer particle (rows gpx..gwz;
     zero elsewhere, and where the neighbour moment matrix is near singular: first order there),
-    from the shared walk renormalisation.moments. (Wall particles, inside the kind range, get
-    gradients too; nothing reads them.)"""
+    from the shared walk renormalisation.moments (``muscl_gradients``). (Wall particles, inside
+    the kind range, get gradients too; nothing reads them.)"""
     f = ps.f   # writes through the storage: numba drops prange stores made through ps.row[i]
-    kind = ps.kind
     for i in prange(n):
-        ki = kind[i]
-        for r in range(GPX, GWZ + 1):
-            f[r, i] = 0.0
-        if ki >= FLUID and ki <= OUTLET:
-            # moment matrices: all neighbours M (pressure), fluid and buffers Mf (velocity)
-            s = moments(i, ps, cells, prm, ps.p, ps.vx, ps.vz, True)
-            # invert where well conditioned: det relative to the isotropic (tr/2)^2 above 5 %
-            det = s.mxx * s.mzz - s.mxz * s.mxz
-            tr = s.mxx + s.mzz
-            if tr > 0.0 and det > 0.0125 * tr * tr:
-                f[GPX, i], f[GPZ, i] = solve(s.mxx, s.mxz, s.mzz, det, s.phix, s.phiz)
-            det = s.mfxx * s.mfzz - s.mfxz * s.mfxz
-            tr = s.mfxx + s.mfzz
-            if tr > 0.0 and det > 0.0125 * tr * tr:
-                f[GUX, i], f[GUZ, i] = solve(s.mfxx, s.mfxz, s.mfzz, det, s.ux, s.uz)
-                f[GWX, i], f[GWZ, i] = solve(s.mfxx, s.mfxz, s.mfzz, det, s.wx, s.wz)
+        (f[GPX, i], f[GPZ, i], f[GUX, i], f[GUZ, i], f[GWX, i],
+         f[GWZ, i]) = muscl_gradients(i, ps, cells, prm)

@@ -115,6 +115,15 @@ def _open_end_limited(i, ps, cells, prm, sx, sz, tangential, nx, nz, max_shift):
     return _limited(sx, sz, tangential, nx, nz, max_shift)
 
 
+@njit(cache=True, inline="always")
+def move_particle(f, i):
+    """x, z, vx, vz += xn, zn, vxn, vzn (rows X..VZ and XN..VZN), rho += rhon of slot i of the
+    storage ``f``: ``_move``'s body, which the CUDA step's kernel calls too."""
+    for r in range(4):
+        f[X + r, i] += f[XN + r, i]
+    f[RHO, i] += f[RHON, i]
+
+
 @njit(parallel=True, cache=True)
 def _move(ps, n):
     """Apply the gathered shifts and carries (rows xn, zn and rhon, vxn, vzn) to every fluid
@@ -124,17 +133,39 @@ def _move(ps, n):
     f = ps.f
     for i in prange(n):
         if ps.kind[i] == FLUID:
-            for r in range(4):
-                f[X + r, i] += f[XN + r, i]
-            f[RHO, i] += f[RHON, i]
+            move_particle(f, i)
+
+
+@njit(cache=True, inline="always")
+def fickian_shift(i, ps, cells, prm, dt):
+    """(dx, dz, drho, dvx, dvz) of fluid particle i: its Fickian shift and the first-order
+    carries of rho and v (zero without ``prm.shift_carry``). One particle's share of
+    ``shift_particles``: the CUDA step's kernel calls the same function."""
+    h = prm.h
+    max_shift = 0.05 * h
+    # B, grad C and the (unrenormalised) gradients of rho and v for the first-order carry
+    s = moments(i, ps, cells, prm, ps.rho, ps.vx, ps.vz, True)
+    vxi = ps.vx[i]
+    vzi = ps.vz[i]
+    dcoef = prm.shift_a * h * math.sqrt(vxi * vxi + vzi * vzi) * dt
+    sx = -dcoef * s.gx
+    sz = -dcoef * s.gz
+    nx = nz = 0.0
+    tangential = s.mxx + s.mzz < prm.shift_fs_div  # div r = trace B
+    if tangential:
+        # renormalised normal: grad C itself is parallel to the shift and cannot split it
+        nx, nz = _surface_normal(s, s.mxx * s.mzz - s.mxz * s.mxz)
+    sx, sz = _open_end_limited(i, ps, cells, prm, sx, sz, tangential, nx, nz, max_shift)
+    # first-order carry of rho and v to the new position
+    if prm.shift_carry:
+        return sx, sz, sx * s.phix + sz * s.phiz, sx * s.ux + sz * s.uz, sx * s.wx + sz * s.wz
+    return sx, sz, 0.0, 0.0, 0.0
 
 
 @njit(parallel=True, cache=True)
 def shift_particles(ps, n, cells, prm, dt):
     """Shift every fluid particle of the sorted state ``ps`` by A = ``prm.shift_a`` (see the
     module docstring); |dr| <= 0.05 h << the cell size, so the cell lists stay valid."""
-    h = prm.h
-    max_shift = 0.05 * h
     sxr = ps.xn    # scratch rows (see the module docstring), zeroed: non-fluid slots stay put
     szr = ps.zn
     srho = ps.rhon
@@ -144,26 +175,7 @@ def shift_particles(ps, n, cells, prm, dt):
     for i in prange(n):
         if ps.kind[i] != FLUID:
             continue
-        # B, grad C and the (unrenormalised) gradients of rho and v for the first-order carry
-        s = moments(i, ps, cells, prm, ps.rho, ps.vx, ps.vz, True)
-        vxi = ps.vx[i]
-        vzi = ps.vz[i]
-        dcoef = prm.shift_a * h * math.sqrt(vxi * vxi + vzi * vzi) * dt
-        sx = -dcoef * s.gx
-        sz = -dcoef * s.gz
-        nx = nz = 0.0
-        tangential = s.mxx + s.mzz < prm.shift_fs_div  # div r = trace B
-        if tangential:
-            # renormalised normal: grad C itself is parallel to the shift and cannot split it
-            nx, nz = _surface_normal(s, s.mxx * s.mzz - s.mxz * s.mxz)
-        sx, sz = _open_end_limited(i, ps, cells, prm, sx, sz, tangential, nx, nz, max_shift)
-        sxr[i] = sx
-        szr[i] = sz
-        # first-order carry of rho and v to the new position
-        if prm.shift_carry:
-            srho[i] = sx * s.phix + sz * s.phiz
-            svx[i] = sx * s.ux + sz * s.uz
-            svz[i] = sx * s.wx + sz * s.wz
+        sxr[i], szr[i], srho[i], svx[i], svz[i] = fickian_shift(i, ps, cells, prm, dt)
     _move(ps, n)
 
 
@@ -198,6 +210,62 @@ def _surface_pair(i, j, dx, dz, r2, ps, ctx, near):
     return near or ps.guz[j] == FS_SURFACE
 
 
+@njit(cache=True, inline="always")
+def dplus_surface(i, ps, cells, prm, coef):
+    """Pass 1 of ``shift_particles_dplus`` for fluid particle i, coef = A h U dt: returns (flag,
+    grad rho (x, z), grad vx (x, z), grad vz (x, z), dr (x, z), n (x, z)), zeros where not set
+    (an isolated particle: its flag alone). The CUDA step's kernel calls the same function."""
+    h = prm.h
+    s2 = 4.0 * h * h
+    scan2 = 2.0 * h * h       # |r_ji| < sqrt(2) h: the umbrella test, else the circle
+    s = moments(i, ps, cells, prm, ps.rho, ps.vx, ps.vz, True)
+    bxx = s.mxx
+    bxz = s.mxz
+    bzz = s.mzz
+    lam = smallest_eigenvalue(bxx, bxz, bzz)
+    det = bxx * bzz - bxz * bxz
+    if lam <= LAMBDA_ISOLATED or det <= 1e-6:
+        return FS_ISOLATED, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+    flag = FS_INTERIOR
+    # renormalised gradients (first-order consistent up to the surface)
+    grx, grz = solve(bxx, bxz, bzz, det, s.phix, s.phiz)
+    gux, guz = solve(bxx, bxz, bzz, det, s.ux, s.uz)
+    gwx, gwz = solve(bxx, bxz, bzz, det, s.wx, s.wz)
+    sx = -coef * s.acx
+    sz = -coef * s.acz
+    nx, nz = _surface_normal(s, det)
+    if (nx != 0.0 or nz != 0.0) and lam <= LAMBDA_INTERIOR:
+        # scan: is any neighbour in the region around T = r_i + h n?
+        xi = ps.x[i]
+        zi = ps.z[i]
+        occupied = gather(i, xi, zi, ps.cell[i], ps, cells, s2, interacting, _scan_pair,
+                          (xi + h * nx, zi + h * nz, nx, nz, h, scan2), False)
+        if not occupied:
+            flag = FS_SURFACE
+    return flag, grx, grz, gux, guz, gwx, gwz, sx, sz, nx, nz
+
+
+@njit(cache=True, inline="always")
+def dplus_tangential(i, ps, cells, prm):
+    """Pass 2 of ``shift_particles_dplus`` for fluid particle i that is not isolated, from pass
+    1's rows: (dx, dz, drho, dvx, dvz), the shift (tangential at the surface and within 2h of
+    it) and the carries. The CUDA step's kernel calls the same function."""
+    h = prm.h
+    near = ps.guz[i] == FS_SURFACE
+    if not near:
+        near = gather(i, ps.x[i], ps.z[i], ps.cell[i], ps, cells, 4.0 * h * h, fluid_only,
+                      _surface_pair, 0, False)
+    sx, sz = _open_end_limited(i, ps, cells, prm, ps.xn[i], ps.zn[i], near, ps.gpx[i], ps.gpz[i],
+                               0.05 * h)
+    crho = cu = cw = 0.0
+    if prm.shift_carry:
+        # gradients of rho (vxn, vzn), vx (rhon, gux), vz (gwx, gwz): pass 1's rows
+        crho = sx * ps.vxn[i] + sz * ps.vzn[i]
+        cu = sx * ps.rhon[i] + sz * ps.gux[i]
+        cw = sx * ps.gwx[i] + sz * ps.gwz[i]
+    return sx, sz, crho, cu, cw
+
+
 @njit(parallel=True, cache=True)
 def shift_particles_dplus(ps, n, cells, prm, dt, umax):
     """delta-plus shifting of every fluid particle of the sorted state ``ps``:
@@ -210,12 +278,7 @@ def shift_particles_dplus(ps, n, cells, prm, dt, umax):
     surface particles and those within 2h of one keep only dr - (dr . n) n. With
     ``prm.shift_carry`` the shifted particle's rho and v are carried to the new position by
     their renormalised gradients (first-order Taylor). See the module docstring for the rows."""
-    h = prm.h
-    coef = prm.shift_a * h * umax * dt
-    carry = prm.shift_carry
-    max_shift = 0.05 * h
-    s2 = 4.0 * h * h
-    scan2 = 2.0 * h * h       # |r_ji| < sqrt(2) h: the umbrella test, else the circle
+    coef = prm.shift_a * prm.h * umax * dt
     # scratch rows: dr (xn, zn), n (gpx, gpz), flag (guz), the gradients of rho (vxn, vzn),
     # of vx (rhon, gux), of vz (gwx, gwz); pass 2 overwrites dr and puts the carries in
     # _move's rows rhon (rho), vxn (vx), vzn (vz)
@@ -236,51 +299,11 @@ def shift_particles_dplus(ps, n, cells, prm, dt, umax):
     # pass 1: B, lambda, the normal, the shift, the gradients; the surface scan
     for i in prange(n):
         if ps.kind[i] == FLUID:
-            s = moments(i, ps, cells, prm, ps.rho, ps.vx, ps.vz, True)
-            bxx = s.mxx
-            bxz = s.mxz
-            bzz = s.mzz
-            lam = smallest_eigenvalue(bxx, bxz, bzz)
-            det = bxx * bzz - bxz * bxz
-            if lam <= LAMBDA_ISOLATED or det <= 1e-6:
-                flag[i] = FS_ISOLATED
-            else:
-                # renormalised gradients (first-order consistent up to the surface)
-                grx[i], grz[i] = solve(bxx, bxz, bzz, det, s.phix, s.phiz)
-                gux[i], guz[i] = solve(bxx, bxz, bzz, det, s.ux, s.uz)
-                gwx[i], gwz[i] = solve(bxx, bxz, bzz, det, s.wx, s.wz)
-                sxr[i] = -coef * s.acx
-                szr[i] = -coef * s.acz
-                nx, nz = _surface_normal(s, det)
-                snx[i] = nx
-                snz[i] = nz
-                if (nx != 0.0 or nz != 0.0) and lam <= LAMBDA_INTERIOR:
-                    # scan: is any neighbour in the region around T = r_i + h n?
-                    xi = ps.x[i]
-                    zi = ps.z[i]
-                    occupied = gather(i, xi, zi, ps.cell[i], ps, cells, s2, interacting,
-                                      _scan_pair, (xi + h * nx, zi + h * nz, nx, nz, h, scan2),
-                                      False)
-                    if not occupied:
-                        flag[i] = FS_SURFACE
-    # pass 2: the surface and its vicinity (within 2h of a surface particle) shift tangentially
+            (flag[i], grx[i], grz[i], gux[i], guz[i], gwx[i], gwz[i], sxr[i], szr[i], snx[i],
+             snz[i]) = dplus_surface(i, ps, cells, prm, coef)
+    # pass 2: the surface and its vicinity (within 2h of a surface particle) shift tangentially;
+    # the carries go to _move's rows rhon, vxn, vzn (this particle's gradients are read first)
     for i in prange(n):
         if ps.kind[i] == FLUID and flag[i] != FS_ISOLATED:
-            near = flag[i] == FS_SURFACE
-            if not near:
-                near = gather(i, ps.x[i], ps.z[i], ps.cell[i], ps, cells, s2, fluid_only,
-                              _surface_pair, 0, False)
-            sx, sz = _open_end_limited(i, ps, cells, prm, sxr[i], szr[i], near, snx[i], snz[i],
-                                       max_shift)
-            sxr[i] = sx
-            szr[i] = sz
-            crho = cu = cw = 0.0
-            if carry:
-                crho = sx * grx[i] + sz * grz[i]
-                cu = sx * gux[i] + sz * guz[i]
-                cw = sx * gwx[i] + sz * gwz[i]
-            # the carries in _move's rows rhon, vxn, vzn (this particle's gradients are read)
-            gux[i] = crho
-            grx[i] = cu
-            grz[i] = cw
+            sxr[i], szr[i], gux[i], grx[i], grz[i] = dplus_tangential(i, ps, cells, prm)
     _move(ps, n)

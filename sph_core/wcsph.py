@@ -34,7 +34,6 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
 from numba import njit, prange
 
 from .eos import density, pressure
@@ -161,7 +160,7 @@ def _guard(u, w, r, axi, azi, lo, hi):
     """(non-finite, outside the density band, |v|^2, |a|^2) of a particle after its update."""
     v2 = u * u + w * w
     a2 = axi * axi + azi * azi
-    if not (np.isfinite(v2) and np.isfinite(r) and np.isfinite(a2)):
+    if not (math.isfinite(v2) and math.isfinite(r) and math.isfinite(a2)):   # (CUDA has math's)
         return 1, 0, v2, a2
     return 0, 1 if (r < lo or r > hi) else 0, v2, a2
 
@@ -219,26 +218,59 @@ def kdk_kick(ps, n, dt, prm):
     return n_bad, n_band, v2max, a2max, rmax
 
 
+@njit(cache=True, inline="always")
+def pc_predict_particle(f, i, dt, prm):
+    """Symplectic predictor of fluid slot i of the storage ``f``: state n saved, x, v, rho
+    half-stepped with a^n, p from rho^{n+1/2}. One particle's share of ``pc_predict``: the CUDA
+    step's kernel calls the same function."""
+    hdt = 0.5 * dt
+    f[XN, i] = f[X, i]
+    f[ZN, i] = f[Z, i]
+    f[VXN, i] = f[VX, i]
+    f[VZN, i] = f[VZ, i]
+    f[RHON, i] = f[RHO, i]
+    f[X, i] += hdt * f[VX, i]
+    f[Z, i] += hdt * f[VZ, i]
+    f[VX, i] += hdt * f[AX, i]
+    f[VZ, i] += hdt * f[AZ, i]
+    r = f[RHO, i] + hdt * f[DRHO, i]
+    f[RHO, i] = r
+    f[P, i] = pressure(r, prm.rho0, prm.b, prm.gamma)
+
+
 @njit(parallel=True, cache=True)
 def pc_predict(ps, n, dt, prm):
     """Symplectic predictor: save state n, half-step x, v, rho with a^n; p from rho^{n+1/2}."""
     f = ps.f
     kind = ps.kind
-    hdt = 0.5 * dt
     for i in prange(n):
         if kind[i] == FLUID:
-            f[XN, i] = f[X, i]
-            f[ZN, i] = f[Z, i]
-            f[VXN, i] = f[VX, i]
-            f[VZN, i] = f[VZ, i]
-            f[RHON, i] = f[RHO, i]
-            f[X, i] += hdt * f[VX, i]
-            f[Z, i] += hdt * f[VZ, i]
-            f[VX, i] += hdt * f[AX, i]
-            f[VZ, i] += hdt * f[AZ, i]
-            r = f[RHO, i] + hdt * f[DRHO, i]
-            f[RHO, i] = r
-            f[P, i] = pressure(r, prm.rho0, prm.b, prm.gamma)
+            pc_predict_particle(f, i, dt, prm)
+
+
+@njit(cache=True, inline="always")
+def pc_correct_particle(f, i, dt, prm):
+    """Symplectic corrector of fluid slot i of the storage ``f`` from the half-step rates;
+    returns (non-finite, outside the density band, outside the tank, |v|^2, |a|^2, rho). One
+    particle's share of ``pc_correct``: the CUDA step's kernel calls the same function."""
+    eps = -f[DRHO, i] / f[RHO, i] * dt
+    r = f[RHON, i] * (2.0 - eps) / (2.0 + eps)
+    u0 = f[VXN, i]
+    w0 = f[VZN, i]
+    # dvn: the no-penetration correction of the half-step force pass (wall_contact.py)
+    u = u0 + dt * f[AX, i] + f[DVNX, i]
+    w = w0 + dt * f[AZ, i] + f[DVNZ, i]
+    xi = f[XN, i] + 0.5 * dt * (u + u0)
+    zi = f[ZN, i] + 0.5 * dt * (w + w0)
+    f[VX, i] = u
+    f[VZ, i] = w
+    f[RHO, i] = r
+    f[P, i] = pressure(r, prm.rho0, prm.b, prm.gamma)
+    f[X, i] = xi
+    f[Z, i] = zi
+    bad, band, v2, a2 = _guard(u, w, r, f[AX, i], f[AZ, i], prm.rho_lo * prm.rho0,
+                               prm.rho_hi * prm.rho0)
+    return bad, band, _outside(xi, zi, prm), v2, a2, r
 
 
 @njit(parallel=True, cache=True)
@@ -247,8 +279,6 @@ def pc_correct(ps, n, dt, prm):
     plus the count of fluid particles outside the tank."""
     f = ps.f
     kind = ps.kind
-    lo = prm.rho_lo * prm.rho0
-    hi = prm.rho_hi * prm.rho0
     n_bad = 0
     n_band = 0
     n_out = 0
@@ -257,25 +287,10 @@ def pc_correct(ps, n, dt, prm):
     rmax = 0.0
     for i in prange(n):
         if kind[i] == FLUID:
-            eps = -f[DRHO, i] / f[RHO, i] * dt
-            r = f[RHON, i] * (2.0 - eps) / (2.0 + eps)
-            u0 = f[VXN, i]
-            w0 = f[VZN, i]
-            # dvn: the no-penetration correction of the half-step force pass (wall_contact.py)
-            u = u0 + dt * f[AX, i] + f[DVNX, i]
-            w = w0 + dt * f[AZ, i] + f[DVNZ, i]
-            xi = f[XN, i] + 0.5 * dt * (u + u0)
-            zi = f[ZN, i] + 0.5 * dt * (w + w0)
-            f[VX, i] = u
-            f[VZ, i] = w
-            f[RHO, i] = r
-            f[P, i] = pressure(r, prm.rho0, prm.b, prm.gamma)
-            f[X, i] = xi
-            f[Z, i] = zi
-            bad, band, v2, a2 = _guard(u, w, r, f[AX, i], f[AZ, i], lo, hi)
+            bad, band, out, v2, a2, r = pc_correct_particle(f, i, dt, prm)
             n_bad += bad
             n_band += band
-            n_out += _outside(xi, zi, prm)
+            n_out += out
             v2max = max(v2max, v2)
             a2max = max(a2max, a2)
             rmax = max(rmax, r)

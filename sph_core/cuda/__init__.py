@@ -1,12 +1,12 @@
 """The WCSPH step on an NVIDIA GPU (numba-cuda): see docs/developer/gpu.md.
 
-Scope today: a closed tank (no open ends, no bodies, no shifting), the kdk integrator, delta-SPH
-+ Monaghan AV + Lo & Shao viscosity, Adami walls, the no-penetration correction and the
-approach-gated wall tension (``wcsph.wall_pass`` / ``fluid_pass`` without Riemann SPH), from
-the same pair terms as the CPU step (``pairs.gather`` + ``terms.py``).
-``cuda_stepper.CudaStepper`` runs it. Its wall and fluid kernels call the CPU's per-particle
-functions ``wcsph.adami_state`` / ``wcsph.fluid_rates``; the other per-particle bodies
-(``per_particle.py``) are plain ``@njit(inline="always")`` functions, which numba-cuda compiles
+Scope today: a closed tank (no open ends, no bodies), the kdk or symplectic_pc integrator,
+delta-SPH + Monaghan AV or Riemann SPH (with or without MUSCL), Lo & Shao viscosity, gravity,
+Adami walls, the no-penetration correction, the approach-gated wall tension, and Fickian or
+delta-plus shifting, from the same pair terms as the CPU step (``pairs.gather`` + ``terms.py``).
+``cuda_stepper.CudaStepper`` runs it. Its kernels call the CPU passes' per-particle
+functions (``wcsph.adami_state``, ``wcsph.fluid_rates`` and those ``gpu_schemes.py`` lists);
+the other per-particle bodies (``per_particle.py``) are plain ``@njit(inline="always")`` functions, which numba-cuda compiles
 for the GPU as device functions and the CUDA simulator (``NUMBA_ENABLE_CUDASIM=1``) calls as CPU
 code.
 """

@@ -1,5 +1,5 @@
-"""The kdk step on the GPU for a built ``Simulation``: its state is copied to the device once,
-stepped there, and copied back on request.
+"""The step (kdk or symplectic_pc) on the GPU for a built ``Simulation``: its state is copied
+to the device once, stepped there, and copied back on request.
 
     stepper = CudaStepper(sim)            # raises RuntimeError (no GPU) / ValueError (scope)
     stepper.advance_steps(100)            # or stepper.advance_to(t_end)
@@ -9,17 +9,18 @@ stepped there, and copied back on request.
 ``Simulation(scene, device="cuda")`` drives one of these (simulation.py); this interface serves
 the tests and benchmarks.
 
-One step is 11 kernel launches, all queued without a host wait (``gpu_kernels.py``): kick + drift
-+ binning, the cell count's prefix sum (3), scatter, per-cell ordering, permute into the twin,
-wall pass, fluid pass, kick with the guards and reductions, and a one-thread kernel that
-computes the next dt on the device. The host reads two small arrays (clock and guards) every
-``batch`` steps to learn whether the device stopped (t_stop, max_steps or a guard).
+A kdk WCSPH step is 11 kernel launches, all queued without a host wait (``gpu_kernels.py``):
+kick + drift + binning, the cell count's prefix sum (3), scatter, per-cell ordering, permute
+into the twin, wall pass, fluid pass, kick with the guards and reductions, and a one-thread
+kernel that computes the next dt on the device. symplectic_pc, particle shifting and Riemann SPH
+add or swap kernels of ``gpu_schemes.py`` (``_launches`` is the plan). The host reads two small
+arrays (clock and guards) every ``batch`` steps to learn whether the device stopped (t_stop, max_steps or a guard).
 ``enable_graphs()`` captures two steps into a CUDA graph, replayed with one host call per pair
 of steps (the kernels' launch cost in Python is what bounds small cases).
 
-Scope: closed tanks with the kdk integrator and the delta-SPH scheme (no open ends, bodies,
-shifting, Riemann SPH or ISPH: ``unsupported`` names what a scene
-uses that this step lacks).
+Scope: closed tanks; kdk or symplectic_pc; delta-SPH or Riemann SPH (with or without MUSCL);
+Fickian or delta-plus shifting (no open ends, bodies or ISPH: ``unsupported`` names what a
+scene uses that this step lacks).
 """
 
 from __future__ import annotations
@@ -31,33 +32,28 @@ import numpy as np
 
 from ..particles import N_FIELDS
 from ..state import Cells
+from ..riemann import NO_RECONSTRUCTION
 from . import gpu_kernels as K
+from . import gpu_schemes as S
 from . import simulated, unavailable_reason
 
-LAUNCHES_PER_STEP = 11
+LAUNCHES_PER_STEP = 11   # kdk WCSPH; a scene's own count: CudaStepper.launches_per_step
 
 
 def unsupported(sim: Any) -> list[str]:
     """What the scene of ``sim`` uses that the GPU step does not do yet (empty: supported)."""
-    prm = sim.prm
     out = []
     if sim.scene.scheme.kind == "isph":
         out.append("ISPH")
-    if sim.scene.constants.integrator != "kdk":
-        out.append(f"integrator {sim.scene.constants.integrator} (only kdk)")
     if sim.open.active:
         out.append("open ends")
     if sim.bodies.active:
         out.append("rigid bodies")
-    if prm.shift_a > 0.0:
-        out.append("particle shifting")
-    if prm.riemann:
-        out.append("Riemann SPH")
     return out
 
 
 class CudaStepper:
-    """The GPU twin of ``step.run`` (kdk) for one Simulation; see the module docstring."""
+    """The GPU twin of ``step.run`` for one Simulation; see the module docstring."""
 
     def __init__(self, sim: Any, batch: int | None = None) -> None:
         reason = unavailable_reason()
@@ -105,8 +101,14 @@ class CudaStepper:
         self.launches = 0
         self._grid_n = (self.n + K.TPB - 1) // K.TPB
         self._grid_c = (self.ncell + 1 + K.TPB - 1) // K.TPB
+        # (symplectic_pc, shifting, Riemann SPH, MUSCL gradients, delta-plus law): the step plan
+        prm = sim.prm
+        self._scheme = (sim.scene.constants.integrator == "symplectic_pc", prm.shift_a > 0.0,
+                        bool(prm.riemann), bool(prm.riemann) and prm.limiter != NO_RECONSTRUCTION,
+                        bool(prm.shift_dplus))
         # the launches of an even and an odd step, configured once (their arguments never change)
         self._plan = [self._launches(0), self._launches(1)]
+        self.launches_per_step = len(self._plan[0])
         self._graph = None                 # (enable_graphs) two-step CUDA graphs, if captured
         self.graph_error: str | None = None
 
@@ -132,27 +134,52 @@ class CudaStepper:
         gn, tpb, nb, sb, gc = self._grid_n, K.TPB, self.nb, K.SCAN_B, self._grid_c
         count, start, bsum = self.count, self.start, self.bsum
         cursor, order = self.cursor, self.order
-        return [
-            ("kick_drift_bin", K.k_kick_drift_bin[gn, tpb, stream],
-             (ps, n, prm, cells, count, clk, ctl)),
+        pc, shift, riemann, muscl, dplus = self._scheme
+        if pc:   # symplectic_pc sorts first (x^n), then two force passes
+            head = [("bin", S.k_bin[gn, tpb, stream], (ps, n, cells, count, ctl))]
+        else:
+            head = [("kick_drift_bin", K.k_kick_drift_bin[gn, tpb, stream],
+                     (ps, n, prm, cells, count, clk, ctl))]
+        sort = [
             ("scan_blocks", K.k_scan_blocks[nb, sb, stream], (count, start, bsum, self.m, ctl)),
             ("scan_sums", K.k_scan_sums[1, sb, stream], (bsum, nb, ctl)),
             ("scan_add", K.k_scan_add[nb, sb, stream], (start, bsum, cursor, count, self.m, ctl)),
             ("scatter", K.k_scatter[gn, tpb, stream], (ps, n, cursor, order, ctl)),
             ("cell_order", K.k_cell_order[gc, tpb, stream], (start, order, self.ncell + 1, ctl)),
-            ("permute", K.k_permute[gn, tpb, stream], (ps, ps2, order, n, ctl)),
-            ("wall", K.k_wall[gn, tpb, stream], (ps2, n, cells, prm, ctl)),
-            ("fluid", K.k_fluid[gn, tpb, stream], (ps2, n, cells, prm, ctl)),
-            ("kick", K.k_kick[gn, tpb, stream], (ps2, n, prm, clk, ctl)),
-            ("finish", K.k_finish[1, 1, stream], (prm, clk, ctl)),
+            ("permute", (S.k_permute_pc if pc else K.k_permute)[gn, tpb, stream],
+             (ps, ps2, order, n, ctl)),
         ]
+        # step._forces: walls, (MUSCL gradients), fluid
+        forces = [("wall", K.k_wall[gn, tpb, stream], (ps2, n, cells, prm, ctl))]
+        if muscl:
+            forces.append(("muscl_gradients", S.k_muscl_gradients[gn, tpb, stream],
+                           (ps2, n, cells, prm, ctl)))
+        forces.append(("fluid", (S.k_fluid_riemann if riemann else K.k_fluid)[gn, tpb, stream],
+                       (ps2, n, cells, prm, ctl)))
+        if pc:
+            update = forces + [("predict", S.k_predict[gn, tpb, stream], (ps2, n, prm, clk, ctl))]
+            update += forces + [("correct", S.k_correct[gn, tpb, stream], (ps2, n, prm, clk, ctl))]
+        else:
+            update = forces + [("kick", K.k_kick[gn, tpb, stream], (ps2, n, prm, clk, ctl))]
+        # step._shift: after the kick / corrector, on the sorted state
+        if shift and dplus:
+            update += [("dplus_surface", S.k_dplus_surface[gn, tpb, stream],
+                        (ps2, n, cells, prm, clk, ctl)),
+                       ("dplus_tangential", S.k_dplus_tangential[gn, tpb, stream],
+                        (ps2, n, cells, prm, ctl))]
+        elif shift:
+            update.append(("shift_fickian", S.k_shift_fickian[gn, tpb, stream],
+                           (ps2, n, cells, prm, clk, ctl)))
+        if shift:
+            update.append(("shift_move", S.k_shift_move[gn, tpb, stream], (ps2, n, ctl)))
+        return head + sort + update + [("finish", K.k_finish[1, 1, stream], (prm, clk, ctl))]
 
     def enable_graphs(self) -> bool:
-        """Capture two steps (even + odd buffer parity, 22 launches) into a CUDA graph per
-        starting parity, so ``run`` replays a pair of steps with one host call instead of 22
-        launches. Call after the kernels have been compiled (a step taken). Returns False, with
-        the reason in ``graph_error``, where it fails (and under the simulator); the plain
-        launches then stay in use."""
+        """Capture two steps (even + odd buffer parity) into a CUDA graph per starting parity,
+        so ``run`` replays a pair of steps with one host call instead of 2 x
+        ``launches_per_step`` launches. Call after the kernels have been compiled (a step
+        taken). Returns False, with the reason in ``graph_error``, where it fails (and under
+        the simulator); the plain launches then stay in use."""
         if simulated():
             self.graph_error = "the simulator has no CUDA graphs"
             return False
@@ -200,7 +227,7 @@ class CudaStepper:
     def _launch_step(self, parity: int) -> None:
         for _, kernel, args in self._plan[parity]:
             kernel(*args)
-        self.launches += LAUNCHES_PER_STEP
+        self.launches += self.launches_per_step
 
     def kernel_times(self, steps: int = 5) -> dict[str, float]:
         """Milliseconds per kernel (CUDA events around each launch), mean over ``steps`` real

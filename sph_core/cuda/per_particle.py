@@ -2,8 +2,9 @@
 
 Each is the loop body of its CPU twin in ``sph_core/wcsph.py`` / ``neighbours.py`` for one
 particle slot ``i``; the passes' pairs are the CPU's own: ``pairs.gather`` folding the pair
-terms of ``terms.py`` (``adami_pair``, ``wcsph_pair``), so a term changed there changes on
-both devices. Riemann SPH is not carried yet (the GPU step refuses such scenes). numba
+terms of ``terms.py`` (``adami_pair``, ``wcsph_pair``, ``riemann_pair``), so a term changed
+there changes on both devices. The schemes' bodies (predictor, corrector, shifting, MUSCL
+gradients) live beside their CPU passes (``gpu_schemes.py`` lists them). numba
 compiles these for whichever target calls them: as device functions inside the CUDA kernels
 of ``gpu_kernels.py`` and as ordinary CPU code under the CUDA simulator (compiled speed).
 """
@@ -64,3 +65,16 @@ def kick_particle(i, ps, dt, prm):
     elif r < prm.rho_lo * prm.rho0 or r > prm.rho_hi * prm.rho0:
         guard = 2
     return v2, a2, r, guard
+
+
+@njit(cache=True, inline="always")
+def permute_slot(buf, buf2, i, k, nrows):
+    """``neighbours.permute`` for sorted position k: the first ``nrows`` rows, kind, ids and cell
+    of slot i of buffer ``buf`` into position k of its twin (buffers as (f, kind, ids, cell))."""
+    f = buf[0]
+    f2 = buf2[0]
+    for r in range(nrows):
+        f2[r, k] = f[r, i]
+    buf2[1][k] = buf[1][i]
+    buf2[2][k] = buf[2][i]
+    buf2[3][k] = buf[3][i]

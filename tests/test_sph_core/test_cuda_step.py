@@ -242,8 +242,8 @@ def test_unsupported_scene_is_refused():
     from sph_core.cuda.cuda_stepper import CudaStepper
     from sph_core.simulation import Simulation
 
-    sim = Simulation(_dambreak(integrator="symplectic_pc"))
-    with pytest.raises(ValueError, match="symplectic_pc"):
+    sim = Simulation(_dambreak(scheme={"kind": "isph"}))
+    with pytest.raises(ValueError, match="ISPH"):
         CudaStepper(sim)
 
 

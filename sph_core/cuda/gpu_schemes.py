@@ -1,0 +1,197 @@
+"""CUDA kernels of the GPU step's schemes beyond the kdk WCSPH of ``gpu_kernels.py``: the
+symplectic predictor-corrector, particle shifting (both laws) and Riemann SPH.
+
+Each kernel is a thin shell around the per-particle function that its CPU pass's prange loop
+calls too (one source for both devices):
+
+    kernel                   per-particle function               CPU pass
+    k_bin                    per_particle.cell_of                neighbours.compute_cells
+    k_permute_pc             per_particle.permute_slot           neighbours.permute (14 rows)
+    k_predict                wcsph.pc_predict_particle           wcsph.pc_predict
+    k_correct                wcsph.pc_correct_particle           wcsph.pc_correct
+    k_shift_fickian          shifting.fickian_shift              shifting.shift_particles
+    k_dplus_surface          shifting.dplus_surface              shift_particles_dplus, pass 1
+    k_dplus_tangential       shifting.dplus_tangential           shift_particles_dplus, pass 2
+    k_shift_move             shifting.move_particle              shifting._move
+    k_muscl_gradients        riemann.muscl_gradients             riemann.riemann_gradients
+    k_fluid_riemann          wcsph.fluid_rates (riemann True)    wcsph.fluid_pass
+
+Every kernel returns at once when the device's stop flag is set (gpu_kernels.py). Passes that
+read a neighbour's result of an earlier pass (the shift's move, delta-plus's surface flags,
+the MUSCL gradients) are separate launches: a launch boundary is the only grid-wide barrier.
+"""
+
+from __future__ import annotations
+
+import math
+
+from numba import cuda, float64
+
+from ..particles import FLUID, GPX, GPZ, GUX, GUZ, GWX, GWZ, N_SORTED_PC, RHON, XN
+from ..riemann import muscl_gradients
+from ..shifting import FS_ISOLATED, dplus_surface, dplus_tangential, fickian_shift, move_particle
+from ..wcsph import fluid_rates, pc_correct_particle, pc_predict_particle
+from .gpu_kernels import (A2, DTS, N_BAD, N_BAND, N_OUT, RMAX, STOP, TPB, V2, _fluid_consts,
+                          _fluid_i, _view)
+from .per_particle import cell_of, permute_slot
+
+
+@cuda.jit
+def k_bin(buf, n, cells, count, ctl):
+    """The cell of every slot and its count (the symplectic step sorts before it moves)."""
+    if ctl[STOP] != 0:
+        return
+    i = cuda.grid(1)
+    if i < n:
+        ps = _view(buf)
+        c = cell_of(i, ps, cells)
+        ps.cell[i] = c
+        cuda.atomic.add(count, c, 1)
+
+
+@cuda.jit
+def k_permute_pc(buf, buf2, order, n, ctl):
+    """neighbours.permute with the symplectic step's rows (N_SORTED_PC: x..m and xn..rhon)."""
+    if ctl[STOP] != 0:
+        return
+    k = cuda.grid(1)
+    if k < n:
+        permute_slot(buf, buf2, order[k], k, N_SORTED_PC)
+
+
+@cuda.jit
+def k_predict(buf, n, prm, clk, ctl):
+    """wcsph.pc_predict: state n saved, half step of x, v, rho with the rates at x^n."""
+    if ctl[STOP] != 0:
+        return
+    i = cuda.grid(1)
+    if i < n and buf[1][i] == FLUID:
+        pc_predict_particle(buf[0], i, clk[DTS], prm)
+
+
+@cuda.jit
+def k_correct(buf, n, prm, clk, ctl):
+    """wcsph.pc_correct: the corrector, guard counts, block-reduced max |v|^2, |a|^2, rho."""
+    if ctl[STOP] != 0:
+        return
+    sv = cuda.shared.array(TPB, float64)
+    sa = cuda.shared.array(TPB, float64)
+    sr = cuda.shared.array(TPB, float64)
+    t = cuda.threadIdx.x
+    i = cuda.grid(1)
+    v2 = 0.0
+    a2 = 0.0
+    r = 0.0
+    if i < n and buf[1][i] == FLUID:
+        bad, band, out, v2, a2, r = pc_correct_particle(buf[0], i, clk[DTS], prm)
+        if bad != 0:
+            cuda.atomic.add(ctl, N_BAD, 1)
+        if band != 0:
+            cuda.atomic.add(ctl, N_BAND, 1)
+        if out != 0:
+            cuda.atomic.add(ctl, N_OUT, 1)
+    sv[t] = v2
+    sa[t] = a2
+    sr[t] = r
+    cuda.syncthreads()
+    half = TPB // 2
+    while half > 0:
+        if t < half:
+            sv[t] = max(sv[t], sv[t + half])
+            sa[t] = max(sa[t], sa[t + half])
+            sr[t] = max(sr[t], sr[t + half])
+        cuda.syncthreads()
+        half //= 2
+    if t == 0:
+        cuda.atomic.max(clk, V2, sv[0])
+        cuda.atomic.max(clk, A2, sa[0])
+        cuda.atomic.max(clk, RMAX, sr[0])
+
+
+@cuda.jit
+def k_shift_fickian(buf, n, cells, prm, clk, ctl):
+    """shifting.shift_particles' first loop: the Fickian shift and carries of every fluid
+    particle into the scratch rows xn, zn, rhon, vxn, vzn (zero for the other slots)."""
+    if ctl[STOP] != 0:
+        return
+    i = cuda.grid(1)
+    if i < n:
+        f = buf[0]
+        for r in range(XN, RHON + 1):
+            f[r, i] = 0.0
+        if buf[1][i] == FLUID:
+            ps = _view(buf)
+            ps.xn[i], ps.zn[i], ps.rhon[i], ps.vxn[i], ps.vzn[i] = fickian_shift(
+                i, ps, cells, prm, clk[DTS])
+
+
+@cuda.jit
+def k_dplus_surface(buf, n, cells, prm, clk, ctl):
+    """shift_particles_dplus' pass 1 (scratch rows zeroed first): B, lambda, the normal, the
+    shift, the renormalised gradients and the surface flag; U = max |v| of this step (clk[V2],
+    reduced by the kick or the corrector)."""
+    if ctl[STOP] != 0:
+        return
+    i = cuda.grid(1)
+    if i < n:
+        f = buf[0]
+        for r in range(XN, RHON + 1):
+            f[r, i] = 0.0
+        for r in range(GPX, GWZ + 1):
+            f[r, i] = 0.0
+        if buf[1][i] == FLUID:
+            ps = _view(buf)
+            coef = prm.shift_a * prm.h * math.sqrt(clk[V2]) * clk[DTS]
+            # rows as shift_particles_dplus names them: flag guz, grad rho (vxn, vzn), grad vx
+            # (rhon, gux), grad vz (gwx, gwz), dr (xn, zn), n (gpx, gpz)
+            (ps.guz[i], ps.vxn[i], ps.vzn[i], ps.rhon[i], ps.gux[i], ps.gwx[i], ps.gwz[i],
+             ps.xn[i], ps.zn[i], ps.gpx[i], ps.gpz[i]) = dplus_surface(i, ps, cells, prm, coef)
+
+
+@cuda.jit
+def k_dplus_tangential(buf, n, cells, prm, ctl):
+    """shift_particles_dplus' pass 2: surface particles and their vicinity shift tangentially;
+    the carries into _move's rows."""
+    if ctl[STOP] != 0:
+        return
+    i = cuda.grid(1)
+    if i < n and buf[1][i] == FLUID:
+        ps = _view(buf)
+        if ps.guz[i] != FS_ISOLATED:
+            ps.xn[i], ps.zn[i], ps.rhon[i], ps.vxn[i], ps.vzn[i] = dplus_tangential(
+                i, ps, cells, prm)
+
+
+@cuda.jit
+def k_shift_move(buf, n, ctl):
+    """shifting._move: apply the gathered shifts and carries (after every particle's sums)."""
+    if ctl[STOP] != 0:
+        return
+    i = cuda.grid(1)
+    if i < n and buf[1][i] == FLUID:
+        move_particle(buf[0], i)
+
+
+@cuda.jit
+def k_muscl_gradients(buf, n, cells, prm, ctl):
+    """riemann.riemann_gradients: the MUSCL gradients of p, vx, vz (rows gpx..gwz)."""
+    if ctl[STOP] != 0:
+        return
+    i = cuda.grid(1)
+    if i < n:
+        f = buf[0]
+        (f[GPX, i], f[GPZ, i], f[GUX, i], f[GUZ, i], f[GWX, i],
+         f[GWZ, i]) = muscl_gradients(i, _view(buf), cells, prm)
+
+
+@cuda.jit
+def k_fluid_riemann(buf, n, cells, prm, ctl):
+    """wcsph.fluid_pass with Riemann SPH's flux (terms.riemann_pair)."""
+    if ctl[STOP] != 0:
+        return
+    i = cuda.grid(1)
+    if i < n and buf[1][i] == FLUID:
+        ps = _view(buf)
+        k = _fluid_consts(prm)
+        ps.ax[i], ps.az[i], ps.drho[i], ps.pw[i], ps.dvnx[i], ps.dvnz[i] = fluid_rates(
+            i, ps, cells, prm, True, k, _fluid_i(i, ps, k))
