@@ -13,9 +13,11 @@ computes the next dt on the device. The host reads two small arrays (clock and g
 ``enable_graphs()`` captures two steps into a CUDA graph, replayed with one host call per pair
 of steps (the kernels' launch cost in Python is what bounds small cases).
 
-Scope: closed tanks with the kdk integrator and the delta-SPH scheme (no open ends, bodies,
-shifting, Riemann SPH or ISPH: ``unsupported`` names what a scene
-uses that this step lacks).
+Scope: the kdk integrator and the delta-SPH scheme, closed tanks and open ends (the open-end
+kernels and launches are ``gpu_open_ends.py``; per coupling window ``load_window`` moves the
+boundary data in and ``read_boundaries`` the gauges and counters out), rigid bodies
+(``gpu_bodies.py``; the launch list with either is ``gpu_step_plan.py``). No shifting, Riemann
+SPH or ISPH: ``unsupported`` names what a scene uses that this step lacks.
 """
 
 from __future__ import annotations
@@ -28,6 +30,9 @@ import numpy as np
 from ..particles import N_FIELDS
 from ..state import Cells
 from . import gpu_kernels as K
+from . import gpu_step_plan
+from .gpu_bodies import BodiesDevice
+from .gpu_open_ends import OpenEndsDevice
 from . import simulated, unavailable_reason
 
 LAUNCHES_PER_STEP = 11
@@ -41,10 +46,6 @@ def unsupported(sim: Any) -> list[str]:
         out.append("ISPH")
     if sim.scene.constants.integrator != "kdk":
         out.append(f"integrator {sim.scene.constants.integrator} (only kdk)")
-    if sim.open.active:
-        out.append("open ends")
-    if sim.bodies.active:
-        out.append("rigid bodies")
     if prm.shift_a > 0.0:
         out.append("particle shifting")
     if prm.riemann:
@@ -72,7 +73,8 @@ class CudaStepper:
         # thread by thread: one at a time there)
         self.batch = int(batch) if batch else (1 if simulated() else 64)
         ps = sim.particles
-        self.n = int(ps.n)
+        # with open ends the kernels run over every slot (gpu_open_ends.py): the count changes
+        self.n = int(ps.capacity) if sim.open.active else int(ps.n)
         grid = sim.grid
         self.ncell = grid.ncx * grid.ncz
         self.m = self.ncell + 2            # cells, the inactive bin, and the total
@@ -102,6 +104,9 @@ class CudaStepper:
         self.launches = 0
         self._grid_n = (self.n + K.TPB - 1) // K.TPB
         self._grid_c = (self.ncell + 1 + K.TPB - 1) // K.TPB
+        self.open = (OpenEndsDevice(self, sim.open.ends, int(ps.n), int(ps.next_id))
+                     if sim.open.active else None)
+        self.bodies = BodiesDevice(self, sim.bodies.state) if sim.bodies.active else None
         # the launches of an even and an odd step, configured once (their arguments never change)
         self._plan = [self._launches(0), self._launches(1)]
         self._graph = None                 # (enable_graphs) two-step CUDA graphs, if captured
@@ -124,6 +129,8 @@ class CudaStepper:
     # ------------------------------------------------------------------ stepping
     def _launches(self, parity: int, stream: Any = 0) -> list:
         """The step's kernel launches in order, as (name, configured kernel, args)."""
+        if self.open is not None or self.bodies is not None:
+            return gpu_step_plan.launches(self, parity, stream)
         ps, ps2 = self.bufs[parity], self.bufs[1 - parity]
         n, prm, cells, clk, ctl = self.n, self.prm, self.cells, self.clk, self.ctl
         gn, tpb, nb, sb, gc = self._grid_n, K.TPB, self.nb, K.SCAN_B, self._grid_c
@@ -197,7 +204,7 @@ class CudaStepper:
     def _launch_step(self, parity: int) -> None:
         for _, kernel, args in self._plan[parity]:
             kernel(*args)
-        self.launches += LAUNCHES_PER_STEP
+        self.launches += len(self._plan[parity])
 
     def kernel_times(self, steps: int = 5) -> dict[str, float]:
         """Milliseconds per kernel (CUDA events around each launch), mean over ``steps`` real
@@ -287,9 +294,28 @@ class CudaStepper:
             host[:] = self._to_host(dev)
         sim.cells.start[:] = self._to_host(self.start)
         sim.cells.order[:] = self._to_host(self.order)
+        if self.open is not None:
+            ps.n = self.open.n_live()
+            ps.next_id = int(self.open.read()["next_id"][0])
+        if self.bodies is not None:
+            self.bodies.read()
         sim.t, sim.dt, sim.v_max = self.t, self.dt, self.v_max
         sim.steps += self.steps
         self.steps = 0
+
+    # ------------------------------------------------------------------ open ends
+    def load_window(self) -> None:
+        """Copy the window's boundary data to the device after ``sim.open.load_window`` filled
+        them (``Simulation.advance_window`` does; a few small arrays per window)."""
+        if self.open is not None:
+            self.open.load_window()
+
+    def read_boundaries(self) -> None:
+        """Copy the boundary gauges, surfaces, counters and filter state from the device into
+        ``sim.open`` (small arrays), so ``sim.boundary_gauges()`` / ``boundary_counts()`` read
+        the device's; the particles stay there."""
+        if self.open is not None:
+            self.sim.particles.next_id = int(self.open.read()["next_id"][0])
 
     def device_bytes(self) -> int:
         """Bytes of the particle buffers on the device."""
