@@ -264,3 +264,50 @@ def test_windows_match_cpu(flume_factory):
           cpu.boundary_counts())
     for key in ("x", "z", "vx", "vz", "rho", "p"):
         _close(b[key], a[key], rel=1e-10)
+
+
+def test_open_ends_with_a_floating_body_match_cpu():
+    """Open ends and a rigid body in one step (the launch list of gpu_step_plan with both):
+    a few steps from rest with a box released 1 cm below its equilibrium."""
+    from sph_core.cuda import simulated, unavailable_reason
+    from sph_core.open_ends import flume_nodes
+    from sph_core.scene import make_scene
+    from sph_core.simulation import Simulation
+    from sph_core.wcsph import ST_STEP_LIMIT
+
+    if unavailable_reason():
+        pytest.skip(unavailable_reason())
+
+    def make():
+        sc = make_scene({
+            "dp": DP, "t_end": 10.0, "still_water_level": D,
+            "tank": {"x0": 0.0, "x1": 0.32, "z0": 0.0, "z1": D + 0.06},
+            "water_blocks": [{"x0": 0.0, "x1": 0.32, "z0": 0.0, "z1": D}],
+            "constants": {"c0": 10.0 * math.sqrt(9.81 * D)},
+            "open_boundaries": [{"side": "left", "elevation": "imposed"},
+                                {"side": "right", "elevation": "extrapolated"}],
+            "bodies": [{"name": "box", "shape": "box", "x0": 0.12, "x1": 0.20, "z0": 0.05,
+                        "z1": 0.13, "density": 500.0, "motion": "free", "dofs": ["heave"]}]})
+        return Simulation(sc, sources={s: Oscillating(n) for s, n in flume_nodes(sc).items()},
+                          window=0.02)
+
+    steps = 4 if simulated() else 100
+    cpu, gsim = make(), make()
+    st = _stepper(gsim)
+    assert st.open is not None and st.bodies is not None
+    assert st.advance_steps(steps) == ST_STEP_LIMIT
+    st.to_host()
+    st.read_boundaries()
+    cpu.advance_steps(steps)
+    assert gsim.steps == cpu.steps and gsim.particles.n == cpu.particles.n
+    assert gsim.boundary_counts() == cpu.boundary_counts()
+    for side in ("left", "right"):
+        assert gsim.boundary_gauges()[side] == pytest.approx(cpu.boundary_gauges()[side],
+                                                             abs=1e-12)
+    _close(gsim.bodies.state.q, cpu.bodies.state.q, rel=1e-12)
+    _close(gsim.bodies.state.qd, cpu.bodies.state.qd, rel=1e-9)
+    assert abs(cpu.bodies.state.qd[0, 1]) > 0.0
+    a, b = cpu.fluid_state(), gsim.fluid_state()
+    np.testing.assert_array_equal(a["id"], b["id"])
+    for key in ("x", "z", "vx", "vz", "rho", "p"):
+        _close(b[key], a[key], rel=1e-10)
