@@ -110,38 +110,46 @@ def no_bodies() -> Bodies:
 
 
 # ------------------------------------------------------------------------------ kernels
-@njit(cache=True)
+# _prescribed and _set_prescribed are inline="always" and allocate nothing, so that the GPU
+# step's one-thread kernel compiles bodies_advance (sph_core/cuda/gpu_bodies.py)
+@njit(cache=True, inline="always")
 def _prescribed(bd, b, t):
-    """Displacement (3) and its slope at time t of prescribed body b (linear between rows)."""
+    """Displacement (3) and its slope (3) at time t of prescribed body b (linear between rows),
+    as six scalars."""
     m = bd.series_n[b]
     ts = bd.series_t[b]
-    d = np.zeros(3)
-    v = np.zeros(3)
+    sq = bd.series_q[b]
     if t <= ts[0]:
-        for c in range(3):
-            d[c] = bd.series_q[b, 0, c]
-        return d, v
+        return sq[0, 0], sq[0, 1], sq[0, 2], 0.0, 0.0, 0.0
     if t >= ts[m - 1]:
-        for c in range(3):
-            d[c] = bd.series_q[b, m - 1, c]
-        return d, v
-    k = np.searchsorted(ts[:m], t, side="right") - 1
-    s = (t - ts[k]) / (ts[k + 1] - ts[k])
-    for c in range(3):
-        a = bd.series_q[b, k, c]
-        e = bd.series_q[b, k + 1, c]
-        d[c] = a + s * (e - a)
-        v[c] = (e - a) / (ts[k + 1] - ts[k])
-    return d, v
+        return sq[m - 1, 0], sq[m - 1, 1], sq[m - 1, 2], 0.0, 0.0, 0.0
+    lo = 0   # np.searchsorted(ts[:m], t, side="right") by bisection
+    hi = m
+    while lo < hi:
+        mid = (lo + hi) // 2
+        if ts[mid] <= t:
+            lo = mid + 1
+        else:
+            hi = mid
+    k = lo - 1
+    span = ts[k + 1] - ts[k]
+    s = (t - ts[k]) / span
+    return (sq[k, 0] + s * (sq[k + 1, 0] - sq[k, 0]), sq[k, 1] + s * (sq[k + 1, 1] - sq[k, 1]),
+            sq[k, 2] + s * (sq[k + 1, 2] - sq[k, 2]), (sq[k + 1, 0] - sq[k, 0]) / span,
+            (sq[k + 1, 1] - sq[k, 1]) / span, (sq[k + 1, 2] - sq[k, 2]) / span)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _set_prescribed(bd, b, t_pos, t_vel):
-    d, v = _prescribed(bd, b, t_pos)
-    _, v2 = _prescribed(bd, b, t_vel)
+    d0, d1, d2, _, _, _ = _prescribed(bd, b, t_pos)
+    _, _, _, v0, v1, v2 = _prescribed(bd, b, t_vel)
+    bd.q[b, 0] = bd.q0[b, 0] + d0
+    bd.q[b, 1] = bd.q0[b, 1] + d1
+    bd.q[b, 2] = bd.q0[b, 2] + d2
+    bd.qd[b, 0] = v0
+    bd.qd[b, 1] = v1
+    bd.qd[b, 2] = v2
     for c in range(3):
-        bd.q[b, c] = bd.q0[b, c] + d[c]
-        bd.qd[b, c] = v2[c]
         bd.acc[b, c] = 0.0
 
 
@@ -207,32 +215,40 @@ def bodies_v2max(bd):
     return v2max
 
 
+@njit(cache=True, inline="always")
+def body_particle(i, ps, bd):
+    """(is a body particle, x, z, vx, vz, ax, az) of slot i from its body's q, qd, acc
+    (``place_bodies``' body)."""
+    k = ps.ids[i] - bd.id0
+    if k < 0 or k >= bd.npart:
+        return False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+    b = bd.owner[k]
+    th = bd.q[b, 2]
+    om = bd.qd[b, 2]
+    al = bd.acc[b, 2]
+    c = math.cos(th)
+    s = math.sin(th)
+    rx = c * bd.rx[k] - s * bd.rz[k]
+    rz = s * bd.rx[k] + c * bd.rz[k]
+    return (True, bd.q[b, 0] + rx, bd.q[b, 1] + rz, bd.qd[b, 0] - om * rz, bd.qd[b, 1] + om * rx,
+            bd.acc[b, 0] - al * rz - om * om * rx, bd.acc[b, 1] + al * rx - om * om * rz)
+
+
 @njit(parallel=True, cache=True)
 def place_bodies(ps, n, bd):
     """Position, velocity (V + omega x r) and acceleration of every body particle from q, qd, acc."""
     if not bd.active:
         return
     f = ps.f   # writes through the storage: numba drops prange stores made through ps.row[i]
-    ids = ps.ids
-    id0 = bd.id0
-    npart = bd.npart
     for i in prange(n):
-        k = ids[i] - id0
-        if k >= 0 and k < npart:
-            b = bd.owner[k]
-            th = bd.q[b, 2]
-            om = bd.qd[b, 2]
-            al = bd.acc[b, 2]
-            c = math.cos(th)
-            s = math.sin(th)
-            rx = c * bd.rx[k] - s * bd.rz[k]
-            rz = s * bd.rx[k] + c * bd.rz[k]
-            f[X, i] = bd.q[b, 0] + rx
-            f[Z, i] = bd.q[b, 1] + rz
-            f[VX, i] = bd.qd[b, 0] - om * rz
-            f[VZ, i] = bd.qd[b, 1] + om * rx
-            f[AX, i] = bd.acc[b, 0] - al * rz - om * om * rx
-            f[AZ, i] = bd.acc[b, 1] + al * rx - om * om * rz
+        ok, x, z, vx, vz, ax, az = body_particle(i, ps, bd)
+        if ok:
+            f[X, i] = x
+            f[Z, i] = z
+            f[VX, i] = vx
+            f[VZ, i] = vz
+            f[AX, i] = ax
+            f[AZ, i] = az
 
 
 @njit(parallel=True, cache=True)
@@ -240,25 +256,29 @@ def _particle_loads(ps, n, cells, prm, bd):
     """Per body particle k: minus the pair forces it exerts on its fluid neighbours (the
     fluid-wall pair of the fluid pass, terms.body_reaction), and its moment about the body's
     reference point."""
-    kind = ps.kind
     ids = ps.ids
     fk_x = bd.fk_x
     fk_z = bd.fk_z
     fk_m = bd.fk_m
     for j in prange(n):
         kb = ids[j] - bd.id0
-        if kb >= 0 and kb < bd.npart and kind[j] == WALL:
-            k = fluid_consts(prm)   # per particle: see wcsph.fluid_pass
-            xj = ps.x[j]
-            zj = ps.z[j]
-            fx, fz = gather(j, xj, zj, ps.cell[j], ps, cells, k.s2, fluid_only, body_reaction, k,
-                            (0.0, 0.0))
-            b = bd.owner[kb]
-            rx = xj - bd.q[b, 0]
-            rz = zj - bd.q[b, 1]
-            fk_x[kb] = fx
-            fk_z[kb] = fz
-            fk_m[kb] = rx * fz - rz * fx
+        if kb >= 0 and kb < bd.npart and ps.kind[j] == WALL:
+            # fluid_consts per particle: see wcsph.fluid_pass
+            fk_x[kb], fk_z[kb], fk_m[kb] = particle_load(j, kb, ps, cells, bd, fluid_consts(prm))
+
+
+@njit(cache=True, inline="always")
+def particle_load(j, kb, ps, cells, bd, k):
+    """(F_x, F_z, M) of body particle kb in slot j (``_particle_loads``' body); k the fluid
+    pass's constants (terms.fluid_consts)."""
+    xj = ps.x[j]
+    zj = ps.z[j]
+    fx, fz = gather(j, xj, zj, ps.cell[j], ps, cells, k.s2, fluid_only, body_reaction, k,
+                    (0.0, 0.0))
+    b = bd.owner[kb]
+    rx = xj - bd.q[b, 0]
+    rz = zj - bd.q[b, 1]
+    return fx, fz, rx * fz - rz * fx
 
 
 @njit(cache=True)
@@ -267,6 +287,13 @@ def body_loads(ps, n, cells, prm, bd):
     if not bd.active:
         return
     _particle_loads(ps, n, cells, prm, bd)
+    body_accelerations(bd, prm)
+
+
+@njit(cache=True, inline="always")
+def body_accelerations(bd, prm):
+    """Sum the per-particle loads per body (in particle order) and set each body's
+    accelerations (``body_loads``' second half; one thread on the GPU)."""
     for b in range(bd.nb):
         for c in range(3):
             bd.load[b, c] = 0.0

@@ -84,18 +84,36 @@ C_IN, C_OUT, C_CREATED, C_REMOVED = range(4)
 N_COUNTERS = 4
 
 
-@njit(cache=True)
+# The helpers below are inline="always": the CPU loops and the CUDA kernels
+# (sph_core/cuda/gpu_open_ends.py) call the same per-particle functions, and numba-cuda compiles
+# only inlined callees without a device (docs/developer/gpu.md).
+@njit(cache=True, inline="always")
+def node_index(zn, z):
+    """np.searchsorted(zn, z) (side left) for finite z, by bisection (numba-cuda has no
+    searchsorted)."""
+    lo = 0
+    hi = zn.size
+    while lo < hi:
+        mid = (lo + hi) // 2
+        if zn[mid] < z:
+            lo = mid + 1
+        else:
+            hi = mid
+    return lo
+
+
+@njit(cache=True, inline="always")
 def _blend(a, k, r):
     """(1 - r) a[lv=0, k] + r a[lv=1, k] for a window array a[level, node]."""
     return (1.0 - r) * a[0, k] + r * a[1, k]
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def profile_value(zn, a, r, z):
     """Profile a[level, node] at height z: linear in z between nodes zn (clamped at the ends),
     linear in time with weight r of level 1."""
     nn = zn.size
-    k = np.searchsorted(zn, z)
+    k = node_index(zn, z)
     if k <= 0:
         return _blend(a, 0, r)
     if k >= nn:
@@ -104,11 +122,11 @@ def profile_value(zn, a, r, z):
     return (1.0 - s) * _blend(a, k - 1, r) + s * _blend(a, k, r)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def node_value(zn, a, z):
     """Profile a[node] at height z: linear in z between nodes zn (clamped at the ends)."""
     nn = zn.size
-    k = np.searchsorted(zn, z)
+    k = node_index(zn, z)
     if k <= 0:
         return a[0]
     if k >= nn:
@@ -117,7 +135,7 @@ def node_value(zn, a, z):
     return (1.0 - s) * a[k - 1] + s * a[k]
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def window_weight(t, win_t):
     """Weight r of the window end in the linear time interpolation, clamped to [0, 1]."""
     span = win_t[1] - win_t[0]
@@ -126,7 +144,7 @@ def window_weight(t, win_t):
     return min(max((t - win_t[0]) / span, 0.0), 1.0)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def boundary_state(b, r, dt, ends):
     """(z_s, du) of end b: the surface the buffer uses and the absorption velocity correction
     du = n_x [D e + sum_j c_j x_j], e = eta_meas - eta_gauge, each x_j the mismatch low-passed
@@ -165,6 +183,27 @@ def _end_of(k):
     return -1
 
 
+@njit(cache=True, inline="always")
+def buffer_particle(i, ps, dt, r, zs0, du0, zs1, du1, ends, prm):
+    """Buffer slot i imposed and moved (``buffer_update``'s body): returns (b, u, w, x, kind,
+    rho, p) with b = -1 (nothing to write) when slot i is not a buffer particle."""
+    b = _end_of(ps.kind[i])
+    if b < 0:
+        return -1, 0.0, 0.0, 0.0, 0, 0.0, 0.0
+    zi = ps.z[i]
+    zs = zs0 if b == 0 else zs1
+    du = du0 if b == 0 else du1
+    zn = ends.zn[b]
+    u = profile_value(zn, ends.win_u[b], r, zi) + du * node_value(zn, ends.corr_prof[b], zi)
+    w = profile_value(zn, ends.win_w[b], r, zi)
+    xi = ps.x[i] + dt * u
+    if zi < zs:
+        rho0 = prm.rho0
+        rho = rho0 * (1.0 + rho0 * (-prm.gz) * (zs - zi) / prm.b) ** (1.0 / prm.gamma)
+        return b, u, w, xi, INLET + b, rho, pressure(rho, rho0, prm.b, prm.gamma)
+    return b, u, w, xi, INLET_IDLE + b, prm.rho0, 0.0
+
+
 @njit(parallel=True, cache=True)
 def buffer_update(ps, n, dt, r, zs0, du0, zs1, du1, ends, prm):
     """Impose velocity, move, (de)activate and set hydrostatic density of every buffer particle."""
@@ -178,45 +217,68 @@ def buffer_update(ps, n, dt, r, zs0, du0, zs1, du1, ends, prm):
     ax = ps.ax
     az = ps.az
     kind = ps.kind
-    rho0 = prm.rho0
-    bb = prm.b
-    gam = prm.gamma
-    g = -prm.gz
     for i in prange(n):
-        b = _end_of(kind[i])
+        b, u, w, xi, k, rho, pi = buffer_particle(i, ps, dt, r, zs0, du0, zs1, du1, ends, prm)
         if b < 0:
             continue
-        zi = ps.z[i]
-        zs = zs0 if b == 0 else zs1
-        du = du0 if b == 0 else du1
-        zn = ends.zn[b]
-        u = profile_value(zn, ends.win_u[b], r, zi) + du * node_value(zn, ends.corr_prof[b], zi)
-        w = profile_value(zn, ends.win_w[b], r, zi)
         vx[i] = u
         vz[i] = w
-        x[i] += dt * u
-        if zi < zs:
-            kind[i] = INLET + b
-            rho = rho0 * (1.0 + rho0 * g * (zs - zi) / bb) ** (1.0 / gam)
-            rho_[i] = rho
-            p[i] = pressure(rho, rho0, bb, gam)
-        else:
-            kind[i] = INLET_IDLE + b
-            rho_[i] = rho0
-            p[i] = 0.0
+        x[i] = xi
+        kind[i] = k
+        rho_[i] = rho
+        p[i] = pi
         drho[i] = 0.0
         ax[i] = 0.0
         az[i] = 0.0
 
 
+# what a slot does at the face crossings (transition_of)
+T_NONE, T_TO_BUFFER, T_TO_FLUID, T_IDLE_OUT, T_FAR_OUT = range(5)
+
+
+@njit(cache=True, inline="always")
+def transition_of(i, ps, ends, r, zs0, du0, zs1, du1):
+    """The crossing of slot i (``buffer_transitions``' body, after buffer_update): returns
+    (action, b, kind): T_TO_BUFFER fluid becomes a buffer particle of end b with that kind
+    (counter OUT); T_TO_FLUID an active buffer particle becomes fluid and T_IDLE_OUT an idle
+    one is removed, both cloned at x + n_x L with their old kind (IN or REMOVED, CREATED);
+    T_FAR_OUT removed past the buffer's far side (REMOVED); T_NONE nothing."""
+    k = int(ps.kind[i])
+    x = ps.x
+    z = ps.z
+    if k == FLUID:
+        for b in range(2):
+            nx = ends.nx[b]
+            d = (x[i] - ends.x_face[b]) * nx
+            if ends.on[b] and d >= 0.0:
+                u = (profile_value(ends.zn[b], ends.win_u[b], r, z[i])
+                     + (du0 if b == 0 else du1) * node_value(ends.zn[b], ends.corr_prof[b], z[i]))
+                if u * nx > 0.0 or d >= ends.dp:
+                    zs = zs0 if b == 0 else zs1
+                    return T_TO_BUFFER, b, INLET + b if z[i] < zs else INLET_IDLE + b
+                return T_NONE, b, k
+        return T_NONE, -1, k
+    b = _end_of(k)
+    if b < 0:
+        return T_NONE, b, k
+    d = (x[i] - ends.x_face[b]) * ends.nx[b]
+    if d < 0.0:
+        if k == INLET + b:
+            return T_TO_FLUID, b, FLUID
+        return T_IDLE_OUT, b, INACTIVE
+    if d >= ends.length[b]:
+        return T_FAR_OUT, b, INACTIVE
+    return T_NONE, b, k
+
+
 @njit(cache=True)
 def buffer_transitions(ps, n, ends, r, zs0, du0, zs1, du1):
-    """Convert particles crossing a face, spawn and remove buffer particles (serial: appends).
+    """Convert particles crossing a face, spawn and remove buffer particles (serial: appends in
+    slot order; the GPU's prefix sum over the clones gives the same slots).
 
     Returns the new slot count, or -1 if the capacity is exhausted."""
     f = ps.f
     x = ps.x
-    z = ps.z
     kind = ps.kind
     ids = ps.ids
     counters = ends.counters
@@ -224,45 +286,26 @@ def buffer_transitions(ps, n, ends, r, zs0, du0, zs1, du1):
     nrows = f.shape[0]
     for i in range(n0):
         k = kind[i]
-        if k == FLUID:
-            for b in range(2):
-                nx = ends.nx[b]
-                d = (x[i] - ends.x_face[b]) * nx
-                if ends.on[b] and d >= 0.0:
-                    u = (profile_value(ends.zn[b], ends.win_u[b], r, z[i])
-                         + (du0 if b == 0 else du1) * node_value(ends.zn[b], ends.corr_prof[b], z[i]))
-                    if u * nx > 0.0 or d >= ends.dp:
-                        zs = zs0 if b == 0 else zs1
-                        kind[i] = INLET + b if z[i] < zs else INLET_IDLE + b
-                        counters[b, C_OUT] += 1
-                    break
+        act, b, knew = transition_of(i, ps, ends, r, zs0, du0, zs1, du1)
+        if act == T_NONE:
             continue
-        b = _end_of(k)
-        if b < 0:
-            continue
-        nx = ends.nx[b]
-        length = ends.length[b]
-        d = (x[i] - ends.x_face[b]) * nx
-        if d < 0.0:
+        if act == T_TO_BUFFER:
+            counters[b, C_OUT] += 1
+        elif act == T_FAR_OUT:
+            counters[b, C_REMOVED] += 1
+        else:
             if n >= ends.capacity:
                 return -1
             for row in range(nrows):
                 f[row, n] = f[row, i]
-            x[n] = x[i] + nx * length
+            x[n] = x[i] + ends.nx[b] * ends.length[b]
             kind[n] = k
             ids[n] = ends.next_id[0]
             ends.next_id[0] += 1
             n += 1
             counters[b, C_CREATED] += 1
-            if k == INLET + b:
-                kind[i] = FLUID
-                counters[b, C_IN] += 1
-            else:
-                kind[i] = INACTIVE
-                counters[b, C_REMOVED] += 1
-        elif d >= length:
-            kind[i] = INACTIVE
-            counters[b, C_REMOVED] += 1
+            counters[b, C_IN if act == T_TO_FLUID else C_REMOVED] += 1
+        kind[i] = knew
     return n
 
 
@@ -301,7 +344,7 @@ def _ghost_pair(i, j, dx, dz, r2, ps, ctx, a):
             a[9] + w * pj, a[10] + fv * rx * pj, a[11] + fv * rz * pj)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def ghost_pressure(ps, cells, xg, zg, prm):
     """First-order consistent SPH interpolation of the fluid pressure at a ghost node (xg, zg)
     (Liu & Liu 2006; Tafuni et al. 2018, eq. 13): with r_j = (x_j - xg, z_j - zg), V_j = m_j/rho_j,
@@ -345,26 +388,32 @@ def buffer_extrapolate(ps, n, cells, ends, prm):
     there the SPH fluid's equilibrium is not the continuum rho0 g (z_s - z) (module docstring)."""
     p_ = ps.p  # the rows written as locals (see buffer_update)
     rho = ps.rho
-    band = SURFACE_BAND_H * prm.h
-    rho0 = prm.rho0
-    bb = prm.b
-    gam = prm.gamma
     for i in prange(n):
-        k = ps.kind[i]
-        if k != INLET and k != OUTLET:
-            continue
-        b = 0 if k == INLET else 1
-        zi = ps.z[i]
-        if not ends.ghost[b] and zi < ends.zs[b] - band:
-            continue
-        xi = ps.x[i]
-        xg = 2.0 * ends.x_face[b] - xi
-        pg, px, pz, order = ghost_pressure(ps, cells, xg, zi, prm)
-        if order < 0:
-            continue
-        p = max(pg + (xi - xg) * px, 0.0)
-        p_[i] = p
-        rho[i] = density(p, rho0, bb, gam)
+        ok, p, r = extrapolated_state(i, ps, cells, ends, prm)
+        if ok:
+            p_[i] = p
+            rho[i] = r
+
+
+@njit(cache=True, inline="always")
+def extrapolated_state(i, ps, cells, ends, prm):
+    """(written, p, rho) of slot i (``buffer_extrapolate``'s body): written False where slot i
+    keeps its pressure (not an active buffer particle, below a hydrostatic end's band, or a
+    ghost node without fluid)."""
+    k = ps.kind[i]
+    if k != INLET and k != OUTLET:
+        return False, 0.0, 0.0
+    b = 0 if k == INLET else 1
+    zi = ps.z[i]
+    if not ends.ghost[b] and zi < ends.zs[b] - SURFACE_BAND_H * prm.h:
+        return False, 0.0, 0.0
+    xi = ps.x[i]
+    xg = 2.0 * ends.x_face[b] - xi
+    pg, px, pz, order = ghost_pressure(ps, cells, xg, zi, prm)
+    if order < 0:
+        return False, 0.0, 0.0
+    p = max(pg + (xi - xg) * px, 0.0)
+    return True, p, density(p, prm.rho0, prm.b, prm.gamma)
 
 
 @njit(cache=True)
@@ -375,25 +424,43 @@ def extrapolate_buffers(ps, n, cells, ends, prm):
         buffer_extrapolate(ps, n, cells, ends, prm)
 
 
+@njit(cache=True, inline="always")
+def line_density(ps, cells, xp, zk, prm):
+    """sum_j m_j W(x - x_j) at (xp, zk) over fluid and active buffer particles (a gauge point)."""
+    h = prm.h
+    return gather(-1, xp, zk, cell_at(xp, zk, cells), ps, cells, 4.0 * h * h, fluidlike,
+                  mass_pair, (h, prm.alpha_w), 0.0)
+
+
+@njit(cache=True, inline="always")
+def gauge_points(ends, b):
+    """Points of end b's gauge line (``surface_z``'s): z_bed + k dz_gauge, k < this count."""
+    return int((ends.z_top[b] - ends.z_bed[b]) / ends.dz_gauge) + 1
+
+
+@njit(cache=True, inline="always")
+def crossing(k, nz, zk, s, prev, dz, level):
+    """Surface height where the line density falls through ``level`` between point k (density
+    s >= level, height zk) and the point above (density prev)."""
+    if k == nz - 1:
+        return zk
+    return zk + (s - level) / (s - prev) * dz
+
+
 @njit(cache=True)
 def surface_z(ps, cells, xp, z_lo, z_hi, dz, prm):
     """Free-surface height at x = xp by the vertical-line method (seed 004, eq. 23):
     rho_f(z) = sum_j m_j W(x - x_j) over fluid and active buffer particles on points z_lo + k dz;
     the surface is the highest z where rho_f falls through rho0/2 (linear between points).
     Returns NaN when no point reaches rho0/2 (dry)."""
-    h = prm.h
     level = 0.5 * prm.rho0
-    s2 = 4.0 * h * h
     nz = int((z_hi - z_lo) / dz) + 1
     prev = 0.0
     for k in range(nz - 1, -1, -1):
         zk = z_lo + k * dz
-        s = gather(-1, xp, zk, cell_at(xp, zk, cells), ps, cells, s2, fluidlike, mass_pair,
-                   (h, prm.alpha_w), 0.0)
+        s = line_density(ps, cells, xp, zk, prm)
         if s >= level:
-            if k == nz - 1:
-                return zk
-            return zk + (s - level) / (s - prev) * dz
+            return crossing(k, nz, zk, s, prev, dz, level)
         prev = s
     return np.nan
 

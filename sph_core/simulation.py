@@ -423,6 +423,8 @@ class Simulation:
                 self.writer.update_meta(**self._meta_fields(), cause=f"boundary data: {exc}")
             raise
         self.open.load_window(self.t, t1, end)
+        if self._gpu is not None:
+            self._gpu.load_window()     # the window's boundary data to the device
         self._advance_recording(t1, progress)
         self.open.samples = end
 
@@ -471,6 +473,12 @@ class Simulation:
         if self.open.active:
             ps.next_id = int(ends.next_id[0])
         self.t, self.dt, self.steps, self.v_max = float(t), float(dt), self.steps + steps, vmax
+        self._verdict(status, n_flag)
+
+    def _verdict(self, status: int, n_flag: int) -> None:
+        """After a call of either device's loop: fail on a full particle store, exclude or fail
+        on a guard (``_stopped``), else carry on."""
+        ps = self.particles
         if status == wcsph.ST_CAPACITY:
             self.status = "unstable"
             cause = (f"{wcsph.STATUS_TEXT[status]}: {ps.capacity} slots; more fluid entered than "
@@ -483,8 +491,8 @@ class Simulation:
             self._stopped(status, n_flag)
 
     def _run_gpu(self, t_stop: float, max_steps: int) -> None:
-        """``_run`` on the GPU: the device steps, then its state comes back to the host (a closed
-        tank: no capacity status, no open-end state)."""
+        """``_run`` on the GPU: the device steps, then its state comes back to the host (with
+        open ends: the live count, next id, gauges and counters too)."""
         gpu = self._gpu
         tic = time.perf_counter()
         t, dt, steps, status, n_flag, vmax = gpu.run(t_stop, max_steps)
@@ -493,8 +501,7 @@ class Simulation:
         self.t, self.dt, self.v_max = float(t), float(dt), float(vmax)
         if self._gpu_graphs and steps > 0 and gpu._graph is None and gpu.graph_error is None:
             gpu.enable_graphs()   # False (reason in graph_error): the plain launches stay
-        if status not in (wcsph.ST_REACHED_T, wcsph.ST_STEP_LIMIT):
-            self._stopped(status, n_flag)
+        self._verdict(status, n_flag)
 
     # ---------------------------------------------------------------- open ends
     def boundary_gauges(self) -> dict[str, float | None]:

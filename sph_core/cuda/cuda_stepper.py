@@ -18,9 +18,12 @@ arrays (clock and guards) every ``batch`` steps to learn whether the device stop
 ``enable_graphs()`` captures two steps into a CUDA graph, replayed with one host call per pair
 of steps (the kernels' launch cost in Python is what bounds small cases).
 
-Scope: closed tanks; kdk or symplectic_pc; delta-SPH or Riemann SPH (with or without MUSCL);
-Fickian or delta-plus shifting (no open ends, bodies or ISPH: ``unsupported`` names what a
-scene uses that this step lacks).
+Scope: closed tanks with kdk or symplectic_pc, delta-SPH or Riemann SPH (with or without
+MUSCL), Fickian or delta-plus shifting; and, with the kdk delta-SPH step, open ends (the open-end
+kernels and launches are ``gpu_open_ends.py``; per coupling window ``load_window`` moves the
+boundary data in and ``read_boundaries`` the gauges and counters out) and rigid bodies
+(``gpu_bodies.py``; the launch list with either is ``gpu_step_plan.py``). No ISPH:
+``unsupported`` names what a scene uses that this step lacks.
 """
 
 from __future__ import annotations
@@ -35,6 +38,9 @@ from ..state import Cells
 from ..riemann import NO_RECONSTRUCTION
 from . import gpu_kernels as K
 from . import gpu_schemes as S
+from . import gpu_step_plan
+from .gpu_bodies import BodiesDevice
+from .gpu_open_ends import OpenEndsDevice
 from . import simulated, unavailable_reason
 
 LAUNCHES_PER_STEP = 11   # kdk WCSPH; a scene's own count: CudaStepper.launches_per_step
@@ -45,10 +51,16 @@ def unsupported(sim: Any) -> list[str]:
     out = []
     if sim.scene.scheme.kind == "isph":
         out.append("ISPH")
-    if sim.open.active:
-        out.append("open ends")
-    if sim.bodies.active:
-        out.append("rigid bodies")
+    if sim.open.active or sim.bodies.active:
+        # open ends and bodies have the kdk delta-SPH step's plan only (gpu_step_plan.py)
+        what = "open ends" if sim.open.active else "rigid bodies"
+        prm = sim.prm
+        if sim.scene.constants.integrator != "kdk":
+            out.append(f"integrator {sim.scene.constants.integrator} with {what} (only kdk)")
+        if prm.shift_a > 0.0:
+            out.append(f"particle shifting with {what}")
+        if prm.riemann:
+            out.append(f"Riemann SPH with {what}")
     return out
 
 
@@ -70,7 +82,8 @@ class CudaStepper:
         # thread by thread: one at a time there)
         self.batch = int(batch) if batch else (1 if simulated() else 64)
         ps = sim.particles
-        self.n = int(ps.n)
+        # with open ends the kernels run over every slot (gpu_open_ends.py): the count changes
+        self.n = int(ps.capacity) if sim.open.active else int(ps.n)
         grid = sim.grid
         self.ncell = grid.ncx * grid.ncz
         self.m = self.ncell + 2            # cells, the inactive bin, and the total
@@ -106,6 +119,9 @@ class CudaStepper:
         self._scheme = (sim.scene.constants.integrator == "symplectic_pc", prm.shift_a > 0.0,
                         bool(prm.riemann), bool(prm.riemann) and prm.limiter != NO_RECONSTRUCTION,
                         bool(prm.shift_dplus))
+        self.open = (OpenEndsDevice(self, sim.open.ends, int(ps.n), int(ps.next_id))
+                     if sim.open.active else None)
+        self.bodies = BodiesDevice(self, sim.bodies.state) if sim.bodies.active else None
         # the launches of an even and an odd step, configured once (their arguments never change)
         self._plan = [self._launches(0), self._launches(1)]
         self.launches_per_step = len(self._plan[0])
@@ -129,6 +145,8 @@ class CudaStepper:
     # ------------------------------------------------------------------ stepping
     def _launches(self, parity: int, stream: Any = 0) -> list:
         """The step's kernel launches in order, as (name, configured kernel, args)."""
+        if self.open is not None or self.bodies is not None:
+            return gpu_step_plan.launches(self, parity, stream)
         ps, ps2 = self.bufs[parity], self.bufs[1 - parity]
         n, prm, cells, clk, ctl = self.n, self.prm, self.cells, self.clk, self.ctl
         gn, tpb, nb, sb, gc = self._grid_n, K.TPB, self.nb, K.SCAN_B, self._grid_c
@@ -227,7 +245,7 @@ class CudaStepper:
     def _launch_step(self, parity: int) -> None:
         for _, kernel, args in self._plan[parity]:
             kernel(*args)
-        self.launches += self.launches_per_step
+        self.launches += len(self._plan[parity])
 
     def kernel_times(self, steps: int = 5) -> dict[str, float]:
         """Milliseconds per kernel (CUDA events around each launch), mean over ``steps`` real
@@ -316,6 +334,11 @@ class CudaStepper:
         for host, dev in zip((ps.f, ps.kind, ps.ids, ps.cell), self.bufs[self.cur]):
             host[:] = self._to_host(dev)
         sim.cells.start[:] = self._to_host(self.start)
+        if self.open is not None:
+            ps.n = self.open.n_live()
+            ps.next_id = int(self.open.read()["next_id"][0])
+        if self.bodies is not None:
+            self.bodies.read()
         sim.t, sim.dt, sim.v_max = self.t, self.dt, self.v_max
         sim.steps = self.steps0 + self.steps
 
@@ -330,7 +353,17 @@ class CudaStepper:
             self._put(dev, host)
         self._put(self.start, sim.cells.start)
         self.cur = 0
-        if int(ps.n) != self.n or sim.prm != self.prm:
+        if self.open is not None or self.bodies is not None:
+            # their device state is rebuilt from the host's (which to_host kept current); the
+            # kernels of a scene with open ends run over every slot, so the count stays capacity
+            self.open = (OpenEndsDevice(self, sim.open.ends, int(ps.n), int(ps.next_id))
+                         if self.open is not None else None)
+            self.bodies = BodiesDevice(self, sim.bodies.state) if self.bodies is not None else None
+            self.prm = sim.prm
+            self._plan = [self._launches(0), self._launches(1)]
+            self._graph = None
+            self.graph_error = None
+        elif int(ps.n) != self.n or sim.prm != self.prm:
             self.n = int(ps.n)
             self.prm = sim.prm
             self._grid_n = (self.n + K.TPB - 1) // K.TPB
@@ -340,6 +373,20 @@ class CudaStepper:
         self.t, self.dt, self.v_max = float(sim.t), float(sim.dt), float(sim.v_max)
         self.steps0 = int(sim.steps)
         self.steps = 0
+
+    # ------------------------------------------------------------------ open ends
+    def load_window(self) -> None:
+        """Copy the window's boundary data to the device after ``sim.open.load_window`` filled
+        them (``Simulation.advance_window`` does; a few small arrays per window)."""
+        if self.open is not None:
+            self.open.load_window()
+
+    def read_boundaries(self) -> None:
+        """Copy the boundary gauges, surfaces, counters and filter state from the device into
+        ``sim.open`` (small arrays), so ``sim.boundary_gauges()`` / ``boundary_counts()`` read
+        the device's; the particles stay there."""
+        if self.open is not None:
+            self.sim.particles.next_id = int(self.open.read()["next_id"][0])
 
     def device_bytes(self) -> int:
         """Bytes of the particle buffers on the device."""
