@@ -154,7 +154,7 @@ class CudaStepper:
         cursor, order = self.cursor, self.order
         pc, shift, riemann, muscl, dplus = self._scheme
         if pc:   # symplectic_pc sorts first (x^n), then two force passes
-            head = [("bin", S.k_bin[gn, tpb, stream], (ps, n, cells, count, ctl))]
+            head = [("bin", K.k_bin[gn, tpb, stream], (ps, n, cells, count, ctl))]
         else:
             head = [("kick_drift_bin", K.k_kick_drift_bin[gn, tpb, stream],
                      (ps, n, prm, cells, count, clk, ctl))]

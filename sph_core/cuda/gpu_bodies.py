@@ -32,7 +32,7 @@ _bodies_advance = njit(inline="always")(bodies_advance.py_func)
 _bodies_v2max = njit(inline="always")(bodies_v2max.py_func)
 
 # the state read back (the rest are settings)
-READ = ("q", "qd", "acc", "qn", "qdn", "load", "fk_x", "fk_z", "fk_m")
+BODY_FIELDS_READ = ("q", "qd", "acc", "qn", "qdn", "load", "fk_x", "fk_z", "fk_m")
 
 
 @cuda.jit
@@ -102,5 +102,5 @@ class BodiesDevice:
 
     def read(self) -> None:
         """Copy the bodies' state (q, qd, acc, loads) into the Simulation's ``Bodies``."""
-        for k in READ:
+        for k in BODY_FIELDS_READ:
             getattr(self.host, k)[:] = self.st._to_host(getattr(self.bd, k))

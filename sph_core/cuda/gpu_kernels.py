@@ -169,6 +169,21 @@ def _block_scan(s, t, v):
 
 
 @cuda.jit
+def k_bin(buf, n, cells, count, ctl):
+    """The cell of every slot and its count (compute_cells + the counting sort's counts): the
+    sort's first launch where kick and drift are not fused with it (symplectic_pc, open ends,
+    bodies)."""
+    if ctl[STOP] != 0:
+        return
+    i = cuda.grid(1)
+    if i < n:
+        ps = _view(buf)
+        c = cell_of(i, ps, cells)
+        ps.cell[i] = c
+        cuda.atomic.add(count, c, 1)
+
+
+@cuda.jit
 def k_scan_blocks(count, start, bsum, m, ctl):
     """Exclusive prefix sum of count[0:m] within blocks of SCAN_B (Hillis-Steele in shared
     memory); each block's total goes to bsum."""

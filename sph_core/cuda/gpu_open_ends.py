@@ -44,7 +44,7 @@ from ..particles import FLUID, INACTIVE
 from ..wcsph import ST_CAPACITY
 from . import gpu_kernels as K
 from .gpu_kernels import _view
-from .per_particle import cell_of, kick_drift_particle
+from .per_particle import kick_drift_particle
 
 # the float scratch oe[F]: this step's window weight and each end's surface and correction
 R, ZS0, DU0, ZS1, DU1 = range(5)
@@ -57,8 +57,8 @@ N_OEI = 2
 ACT, KNEW, FLAG, OFF, F, I, DENS = range(7)
 
 # the window's arrays loaded per window, and the state read back
-WINDOW = ("win_t", "win_u", "win_w", "win_eta", "win_etag")
-READ = ("eta_meas", "zs", "counters", "next_id", "filt_x")
+END_FIELDS_WINDOW = ("win_t", "win_u", "win_w", "win_eta", "win_etag")
+END_FIELDS_READ = ("eta_meas", "zs", "counters", "next_id", "filt_x")
 
 
 @cuda.jit
@@ -177,19 +177,6 @@ def k_apply(buf, n, ends, ctl, oe):
 
 
 @cuda.jit
-def k_bin(buf, n, cells, count, ctl):
-    """The cell of every slot and its count (compute_cells + the counting sort's counts)."""
-    if ctl[K.STOP] != 0:
-        return
-    i = cuda.grid(1)
-    if i < n:
-        ps = _view(buf)
-        c = cell_of(i, ps, cells)
-        ps.cell[i] = c
-        cuda.atomic.add(count, c, 1)
-
-
-@cuda.jit
 def k_extrapolate(buf, n, cells, ends, prm, ctl, oe):
     """buffer_extrapolate (after the sort); thread 0 records the live count."""
     if ctl[K.STOP] != 0:
@@ -275,14 +262,14 @@ class OpenEndsDevice:
         """Copy a window's boundary data (``OpenBoundaries.load_window`` filled them in the
         host OpenEnds ``ends``, default the Simulation's) to the device: a few small arrays."""
         src = self.host if ends is None else ends
-        for k in WINDOW:
+        for k in END_FIELDS_WINDOW:
             self.st._put(getattr(self.ends, k), np.ascontiguousarray(getattr(src, k)))
 
     def read(self) -> dict[str, np.ndarray]:
         """The measured state back from the device into the host OpenEnds (and returned):
         eta_meas (gauges), zs, counters, next_id, filt_x."""
         out = {}
-        for k in READ:
+        for k in END_FIELDS_READ:
             v = self.st._to_host(getattr(self.ends, k))
             getattr(self.host, k)[:] = v
             out[k] = v

@@ -5,7 +5,7 @@ Each kernel is a thin shell around the per-particle function that its CPU pass's
 calls too (one source for both devices):
 
     kernel                   per-particle function               CPU pass
-    k_bin                    per_particle.cell_of                neighbours.compute_cells
+    (k_bin is gpu_kernels.k_bin)
     k_permute_pc             per_particle.permute_slot           neighbours.permute (14 rows)
     k_predict                wcsph.pc_predict_particle           wcsph.pc_predict
     k_correct                wcsph.pc_correct_particle           wcsph.pc_correct
@@ -33,20 +33,7 @@ from ..shifting import FS_ISOLATED, dplus_surface, dplus_tangential, fickian_shi
 from ..wcsph import fluid_rates, pc_correct_particle, pc_predict_particle
 from .gpu_kernels import (A2, DTS, N_BAD, N_BAND, N_OUT, RMAX, STOP, TPB, V2, _fluid_consts,
                           _fluid_i, _view)
-from .per_particle import cell_of, permute_slot
-
-
-@cuda.jit
-def k_bin(buf, n, cells, count, ctl):
-    """The cell of every slot and its count (the symplectic step sorts before it moves)."""
-    if ctl[STOP] != 0:
-        return
-    i = cuda.grid(1)
-    if i < n:
-        ps = _view(buf)
-        c = cell_of(i, ps, cells)
-        ps.cell[i] = c
-        cuda.atomic.add(count, c, 1)
+from .per_particle import permute_slot
 
 
 @cuda.jit

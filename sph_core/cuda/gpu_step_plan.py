@@ -66,7 +66,7 @@ def launches(st: Any, parity: int, stream: Any = 0) -> list:
     # with open ends the free slots' bin is large and its order immaterial: live cells only
     ncells = st.ncell if oed is not None else st.ncell + 1
     out += [
-        ("bin", _cfg(G.k_bin, gn, tpb, stream), (ps, n, cells, st.count, ctl)),
+        ("bin", _cfg(K.k_bin, gn, tpb, stream), (ps, n, cells, st.count, ctl)),
         ("scan_blocks", _cfg(K.k_scan_blocks, st.nb, sb, stream),
          (st.count, st.start, st.bsum, st.m, ctl)),
         ("scan_sums", _cfg(K.k_scan_sums, 1, sb, stream), (st.bsum, st.nb, ctl)),

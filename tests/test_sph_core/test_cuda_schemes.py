@@ -123,7 +123,7 @@ def test_pc_sort_predict_correct_match_cpu(make):
     n_sorted = sort_by_cell(ps.view, ps.view2, N_SORTED_PC, n, cpu.cells)
     _set_clock(st, dt)
     a, b = st.bufs[0], st.bufs[1]
-    _launch(st, S.k_bin, a, n, st.cells, st.count, st.ctl)
+    _launch(st, K.k_bin, a, n, st.cells, st.count, st.ctl)
     K.k_scan_blocks[st.nb, K.SCAN_B](st.count, st.start, st.bsum, st.m, st.ctl)
     K.k_scan_sums[1, K.SCAN_B](st.bsum, st.nb, st.ctl)
     K.k_scan_add[st.nb, K.SCAN_B](st.start, st.bsum, st.cursor, st.count, st.m, st.ctl)
