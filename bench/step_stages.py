@@ -16,6 +16,7 @@ even or ranges, ``imbalance_T``), then a summary (``threads``, ``particles``, ``
 ``step_ms``, ``serial_share``, ``model_efficiency``).
 
     NUMBA_NUM_THREADS=1 python bench/step_stages.py [--dp 0.005] [--steps 30]
+        [--model-threads 16] [--precision float64|float32]
 """
 
 from __future__ import annotations
@@ -66,7 +67,7 @@ def _imbalance(kind: np.ndarray, how: str, which: str | None, threads: int) -> f
     return float(per.max() / per.mean()) if per.mean() > 0 else 1.0
 
 
-def profile(dp: float, steps: int, model_threads: int) -> list[dict]:
+def profile(dp: float, steps: int, model_threads: int, precision: str = "float64") -> list[dict]:
     import numba
 
     from sph_core import neighbours, step, wcsph
@@ -74,7 +75,7 @@ def profile(dp: float, steps: int, model_threads: int) -> list[dict]:
     from sph_core.simulation import Simulation
     from wavesph.cases.dambreak import dambreak_scene
 
-    sim = Simulation(dambreak_scene(a=1.0, dp=dp, t_end=1.0))
+    sim = Simulation(dambreak_scene(a=1.0, dp=dp, t_end=1.0, precision=precision))
     sim.advance_steps(20)                 # compiled, memory touched
     t0 = time.perf_counter()
     sim.advance_steps(steps)
@@ -121,7 +122,8 @@ def profile(dp: float, steps: int, model_threads: int) -> list[dict]:
         out.append({"bench": "step_stages", "stage": name, "ms": round(1e3 * tot[name] / steps, 3),
                     "share": round(share, 4), "split": how,
                     f"imbalance_{model_threads}": round(imb, 3)})
-    out.append({"bench": "step_stages", "dp": dp, "particles": n, "steps": steps,
+    out.append({"bench": "step_stages", "dp": dp, "precision": precision, "particles": n,
+                "steps": steps,
                 "threads": numba.get_num_threads(), "threading_layer": numba.threading_layer(),
                 "stage_sum_ms": round(1e3 * total / steps, 3), "step_ms": round(step_ms, 3),
                 "serial_share": round(serial, 4), "model_threads": model_threads,
@@ -134,8 +136,10 @@ def main() -> None:
     ap.add_argument("--dp", type=float, default=0.005)
     ap.add_argument("--steps", type=int, default=30)
     ap.add_argument("--model-threads", type=int, default=16)
+    ap.add_argument("--precision", choices=["float64", "float32"], default="float64",
+                    help="storage of the particle fields")
     args = ap.parse_args()
-    for row in profile(args.dp, args.steps, args.model_threads):
+    for row in profile(args.dp, args.steps, args.model_threads, args.precision):
         print(json.dumps(row), flush=True)
 
 

@@ -49,6 +49,8 @@ def unsupported(sim: Any) -> list[str]:
         out.append("particle shifting")
     if prm.riemann:
         out.append("Riemann SPH")
+    if sim.particles.f.dtype != np.float64:
+        out.append("float32 storage")
     if np.any(sim.particles.kind[: sim.particles.n] < 0):
         out.append("inactive (excluded) particles")
     return out
