@@ -10,6 +10,7 @@ droplets ignored), sampled every 0.005 s, interpolated in time to the table's T 
 
 Output: one JSON object.
     python bench/dambreak_reference.py --dp 0.01 --t-end 1.0 [--integrator kdk] [--a 1.0]
+        [--precision float64|float32]
 """
 
 from __future__ import annotations
@@ -35,8 +36,10 @@ def main() -> None:
     ap.add_argument("--a", type=float, default=1.0, help="column width [m] (height 2a, tank 4a)")
     ap.add_argument("--integrator", choices=["kdk", "symplectic_pc"], default="kdk")
     ap.add_argument("--cfl", type=float, default=None)
+    ap.add_argument("--precision", choices=["float64", "float32"], default="float64",
+                    help="storage of the particle fields")
     args = ap.parse_args()
-    extra = {"integrator": args.integrator}
+    extra = {"integrator": args.integrator, "precision": args.precision}
     if args.cfl is not None:
         extra["cfl"] = args.cfl
     scene = dambreak_scene(a=args.a, dp=args.dp, t_end=args.t_end, probe_every=0.005 * math.sqrt(args.a),
@@ -55,7 +58,8 @@ def main() -> None:
     hist = [(r["t"], r["front_x"]) for r in sim.history if r["front_x"] is not None]
     t, xf = np.array(hist).T
     out = {"bench": "dambreak_reference", "dp": args.dp, "a": args.a, "t_end": args.t_end,
-           "integrator": args.integrator, "cfl": scene.constants.cfl, "c0": round(sim.c0, 3),
+           "integrator": args.integrator, "precision": args.precision,
+           "cfl": scene.constants.cfl, "c0": round(sim.c0, 3),
            "h_over_dp": scene.constants.h_over_dp, "status": status,
            "particles": sim.n_particles, "fluid_particles": sim.n_fluid, "steps": sim.steps,
            "passes_per_step": sim.passes_per_step, "wall_s": round(sim.wall_time, 2),

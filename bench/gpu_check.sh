@@ -5,7 +5,8 @@
 #   3. runs the CUDA tests on the real GPU (pytest -m cuda)
 #   4. GPU throughput of the 2D dam break at ~25.6k, ~340k, ~1.4M particles (dp 0.01/0.0025/0.00125),
 #      through Simulation(device="cuda") (bench/sph_throughput.py --device cuda)
-#   5. the CPU step at ~91k particles (dp 0.005) on 1, 2, 4, 8, 16 threads (bench/sph_throughput.py)
+#   5. the CPU step at ~91k particles (dp 0.005) on 1, 2, 4, 8, 16 threads (bench/sph_throughput.py
+#      --threads: efficiency_vs_2 per line), and its stages at 1 and 16 threads (bench/step_stages.py)
 # JSON lines go to stdout and $OUT/gpu.jsonl, the whole log to $OUT/gpu_check.log.
 # Every phase runs under `timeout`, capped by what is left of TOTAL_S, so the script ends in time.
 # Overrides (a rerun, or a dry run here): GPU_DPS, CPU_DP, CPU_STEPS, THREADS (empty: no CPU runs),
@@ -22,6 +23,7 @@ T0=$(date +%s)
 TOTAL_S=${TOTAL_S:-350}
 GPU_DPS=${GPU_DPS-0.01 0.0025 0.00125}
 CPU_DP=${CPU_DP:-0.005}
+CPU_STEPS=${CPU_STEPS:-100}
 THREADS=${THREADS-1 2 4 8 16}
 PY=${PYTHON:-python3}
 HT=${HOST_THREADS:-16}
@@ -51,10 +53,21 @@ print("cuda:", sc.unavailable_reason() or "available")
 PYEOF
 
 if [ -z "${SKIP_TESTS:-}" ]; then
-    say "pytest -m cuda (real GPU unless NUMBA_ENABLE_CUDASIM=1)"
-    NUMBA_NUM_THREADS=$HT timeout "$(left 170)" $PY -m pytest -m cuda tests/test_sph_core/test_cuda_*.py \
-        -q -rP -p no:cacheprovider 2>&1 | tee -a "$LOG"
-    say "pytest exit ${PIPESTATUS[0]}"
+    # one pytest process per CUDA test file, side by side (16 cores: each compiles its own CPU
+    # twins, the bulk of the time), each with its own numba cache so no two write one file
+    say "pytest -m cuda, one process per file (real GPU unless NUMBA_ENABLE_CUDASIM=1)"
+    TL=$(left 200)
+    for f in tests/test_sph_core/test_cuda_*.py; do
+        b=$(basename "$f" .py)
+        NUMBA_CACHE_DIR=/tmp/nc_$b NUMBA_NUM_THREADS=2 timeout "$TL" $PY -m pytest -m cuda "$f" \
+            -q -rP -p no:cacheprovider > "$OUT/$b.log" 2>&1 &
+    done
+    wait
+    for f in tests/test_sph_core/test_cuda_*.py; do
+        b=$(basename "$f" .py)
+        say "$b: $(tail -1 "$OUT/$b.log")"
+        grep -E "FAILED|Error|error" "$OUT/$b.log" | head -20 | tee -a "$LOG"
+    done
 fi
 
 if [ -n "$GPU_DPS" ]; then
@@ -64,10 +77,17 @@ if [ -n "$GPU_DPS" ]; then
     say "GPU bench exit ${PIPESTATUS[0]}"
 fi
 
-for t in $THREADS; do
-    say "CPU throughput, dp = $CPU_DP, $t thread(s)"
-    NUMBA_NUM_THREADS=$t timeout "$(left 45)" $PY bench/sph_throughput.py --device cpu \
-        --dps "$CPU_DP" --steps "${CPU_STEPS:-100}" --no-compile 2>&1 | tee -a "$LOG" \
-        | tee >(grep '^{' >> "$JSONL")
-done
+if [ -n "$THREADS" ]; then
+    # each thread count in a fresh process (efficiency_vs_2 per line), then the step's stages at
+    # 1 and at the most threads (share of each, its load balance: bench/step_stages.py)
+    say "CPU throughput, dp = $CPU_DP, $CPU_STEPS steps, threads $THREADS"
+    timeout "$(left 240)" $PY bench/sph_throughput.py --no-compile --steps "$CPU_STEPS" \
+        --dps "$CPU_DP" --threads $THREADS 2>>"$LOG" | tee -a "$JSONL" "$LOG"
+    TMAX=$(printf '%s\n' $THREADS | sort -n | tail -1)
+    for t in $(printf '%s\n' 1 "$TMAX" | sort -un); do
+        say "CPU step stages, dp = $CPU_DP, $t thread(s)"
+        NUMBA_NUM_THREADS=$t timeout "$(left 60)" $PY bench/step_stages.py --dp "$CPU_DP" \
+            --steps 20 --model-threads "$TMAX" 2>>"$LOG" | tee -a "$JSONL" "$LOG"
+    done
+fi
 say "done: $(wc -l < "$JSONL") JSON lines in $JSONL"

@@ -10,7 +10,7 @@ anchors do. Also measures the one-off numba compile time, cold (empty cache) and
 
 Output: one JSON object per line.
     python bench/sph_throughput.py [--steps 400] [--dps 0.01 0.005] [--integrator kdk]
-        [--cells-per-support 2] [--diagnostics]
+        [--cells-per-support 2] [--diagnostics] [--threads 1 2 4 8 16]
 
 ``--device cuda``: the same case stepped on the GPU through ``Simulation(device="cuda")``
 (sph_core/cuda), timed with plain kernel launches and/or two-step CUDA graph replays
@@ -183,6 +183,31 @@ def run_size_cuda(dp: float, budget: float, modes: list[bool]) -> list[dict]:
     return out
 
 
+def run_threads(threads: list[int], argv: list[str]) -> None:
+    """This bench at each thread count in a fresh process (NUMBA_NUM_THREADS is read at import),
+    its lines printed as they come with ``efficiency_vs_2`` = (rate / rate at 2 threads) / (T / 2)
+    (and ``efficiency_vs_1``); the 2-thread run goes first."""
+    order = sorted(set(threads), key=lambda t: (t != 2, t))
+    base: dict[tuple, dict] = {}
+    for t in order:
+        env = dict(os.environ, NUMBA_NUM_THREADS=str(t))
+        res = subprocess.run([sys.executable, __file__, *argv, "--no-compile"], env=env,
+                             capture_output=True, text=True)
+        rows = [json.loads(line) for line in res.stdout.splitlines() if line.startswith("{")]
+        if res.returncode != 0 or not rows:
+            print(json.dumps({"bench": "sph_throughput", "threads": t, "error":
+                              res.stderr.strip().splitlines()[-1:]}), flush=True)
+            continue
+        for row in rows:
+            key = (row["dp"], row["integrator"])
+            base.setdefault(key, {})[t] = row["particle_steps_per_s"]
+            for ref in (1, 2):
+                r = base[key].get(ref)
+                row[f"efficiency_vs_{ref}"] = (round(row["particle_steps_per_s"] / r / (t / ref), 3)
+                                               if r else None)
+            print(json.dumps(row), flush=True)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--steps", type=int, default=400)
@@ -198,12 +223,21 @@ def main() -> None:
                     help="cuda: seconds of timed stepping per size and mode")
     ap.add_argument("--graphs", choices=["off", "on", "both"], default="both",
                     help="cuda: plain launches (off), two-step CUDA graph replays (on), or both")
+    ap.add_argument("--threads", type=int, nargs="+", default=None,
+                    help="run at each of these numba thread counts, each in a fresh process")
     args = ap.parse_args()
     if args.device == "cuda":
         modes = {"off": [False], "on": [True], "both": [False, True]}[args.graphs]
         for dp in args.dps:
             for res in run_size_cuda(dp, args.budget, modes):
                 print(json.dumps(res), flush=True)
+        return
+    if args.threads:
+        argv = ["--steps", str(args.steps), "--dps", *map(str, args.dps),
+                "--integrator", args.integrator]
+        if args.cells_per_support:
+            argv += ["--cells-per-support", str(args.cells_per_support)]
+        run_threads(args.threads, argv)
         return
     if not args.no_compile:
         print(json.dumps(compile_times(args.integrator)), flush=True)

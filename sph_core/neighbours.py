@@ -96,11 +96,29 @@ def compute_cells(ps, n, cells):
             cell[i] = cz * ncx + cx
 
 
+# Parallel loops below split their work into a fixed number of pieces, not one per thread:
+# numba's get_num_threads() in a jitted function stops it caching, and a fixed count that is a
+# multiple of every usual thread count splits as evenly under numba's static schedule.
+SORT_CHUNKS = 64       # chunks of slots of the parallel counting sort
+PASS_RANGES = 480      # slot ranges of a pass balanced by kind (kind_ranges): 1..16, 20, 24, 32 threads
+
+
 @njit(cache=True)
 def counting_sort(cell, n, cells):
     """Stable counting sort of slots by cell: cells.order[k] = slot that goes to position k.
 
-    cells.start (size ncell + 2) receives the first position of each cell (bin ncell = inactive)."""
+    cells.start (size ncell + 2) receives the first position of each cell (bin ncell = inactive).
+    A large set whose chunks of slots each span few cells (the sorted order of the last step,
+    moved by a cell or so: every step but the first) takes the parallel
+    ``_counting_sort_chunks``, others the serial sort; both give the same order."""
+    if n >= 512 * SORT_CHUNKS:
+        if _counting_sort_chunks(cell, n, cells, SORT_CHUNKS):
+            return
+    _counting_sort_serial(cell, n, cells)
+
+
+@njit(cache=True)
+def _counting_sort_serial(cell, n, cells):
     ncell = cells.ncx * cells.ncz
     cell_start = cells.start
     cursor = cells.cursor
@@ -117,6 +135,125 @@ def counting_sort(cell, n, cells):
         c = cell[i]
         order[cursor[c]] = i
         cursor[c] += 1
+
+
+@njit(parallel=True, cache=True)
+def _counting_sort_chunks(cell, n, cells, nt):
+    """The counting sort in ``nt`` chunks of slots, each with a histogram over the span of bins
+    it touches (lo[t]..hi[t]); a bin's slots go chunk by chunk, so the order is the serial one.
+    Returns False, having written nothing, when the spans together exceed 2 (nbins + n) (an
+    unsorted set: the first sort, appended inflow): the caller then sorts serially."""
+    ncell = cells.ncx * cells.ncz
+    nb = ncell + 1                      # bins: the cells and the inactive bin
+    start = cells.start
+    order = cells.order
+    blk = (n + nt - 1) // nt
+    lo = np.empty(nt, np.int64)
+    hi = np.empty(nt, np.int64)
+    for t in prange(nt):
+        cl = nb
+        ch = -1
+        for i in range(t * blk, min(t * blk + blk, n)):
+            c = cell[i]
+            cl = min(cl, c)
+            ch = max(ch, c)
+        lo[t] = cl
+        hi[t] = max(ch, cl - 1)         # an empty chunk spans no bin
+    off = np.empty(nt + 1, np.int64)    # chunk t's histogram: hist[off[t] : off[t + 1]]
+    off[0] = 0
+    for t in range(nt):
+        off[t + 1] = off[t] + hi[t] - lo[t] + 1
+    if off[nt] > 2 * (nb + n):
+        return False
+    hist = np.empty(off[nt], np.int64)
+    for t in prange(nt):
+        h0 = off[t] - lo[t]
+        for k in range(off[t], off[t + 1]):
+            hist[k] = 0
+        for i in range(t * blk, min(t * blk + blk, n)):
+            hist[h0 + cell[i]] += 1
+    # per range of bins: the count of each bin (into start[c + 1]) and each chunk's histogram
+    # turned into the chunk's offset inside the bin (the counts of the chunks before it)
+    bblk = (nb + nt - 1) // nt
+    part = np.empty(nt + 1, np.int64)
+    part[0] = 0
+    for s in prange(nt):
+        c0 = s * bblk
+        c1 = min(c0 + bblk, nb)
+        t0 = nt
+        t1 = -1
+        for t in range(nt):             # the chunks whose span meets this range of bins
+            if lo[t] < c1 and hi[t] >= c0:
+                t0 = min(t0, t)
+                t1 = max(t1, t)
+        acc = 0
+        for c in range(c0, c1):
+            tot = 0
+            for t in range(t0, t1 + 1):
+                if lo[t] <= c and c <= hi[t]:
+                    k = off[t] - lo[t] + c
+                    m = hist[k]
+                    hist[k] = tot
+                    tot += m
+            acc += tot
+            start[c + 1] = acc          # running count inside the range
+        part[s + 1] = acc
+    for s in range(nt):
+        part[s + 1] += part[s]
+    start[0] = 0
+    for s in prange(nt):
+        base = part[s]
+        for c in range(s * bblk, min(s * bblk + bblk, nb)):
+            start[c + 1] += base
+    for t in prange(nt):
+        h0 = off[t] - lo[t]
+        for i in range(t * blk, min(t * blk + blk, n)):
+            c = cell[i]
+            k = h0 + c
+            order[start[c] + hist[k]] = i
+            hist[k] += 1
+    return True
+
+
+@njit(parallel=True, cache=True)
+def kind_ranges(kind, n, k, nr):
+    """Bounds b[0] = 0 <= ... <= b[nr] = n of ``nr`` slot ranges that hold the same number of
+    particles of kind ``k`` (to one): a prange over the ranges gives every thread an equal share
+    of a pass that works on kind k alone (numba's static schedule splits the slots evenly, and
+    in a sorted tank the walls crowd at its ends: bench/step_stages.py). ``nr``: PASS_RANGES.
+    Counts per block of slots, then each bound scans one block."""
+    blk = (n + nr - 1) // nr
+    cnt = np.empty(nr + 1, np.int64)
+    cnt[0] = 0
+    for t in prange(nr):
+        s = 0
+        for i in range(t * blk, min(t * blk + blk, n)):
+            if kind[i] == k:
+                s += 1
+        cnt[t + 1] = s
+    for t in range(nr):
+        cnt[t + 1] += cnt[t]
+    b = np.empty(nr + 1, np.int64)
+    b[0] = 0
+    b[nr] = n
+    for t in prange(1, nr):
+        target = t * cnt[nr] // nr      # range t starts after the target-th particle of kind k
+        c = 0                           # the last block with cnt[c] < target (or 0)
+        e = nr
+        while e - c > 1:
+            m = (c + e) // 2
+            if cnt[m] < target:
+                c = m
+            else:
+                e = m
+        s = cnt[c]
+        i = c * blk
+        while s < target:
+            if kind[i] == k:
+                s += 1
+            i += 1
+        b[t] = i
+    return b
 
 
 @njit(parallel=True, cache=True)

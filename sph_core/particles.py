@@ -1,6 +1,7 @@
 """Particles as structure-of-arrays with spare capacity.
 
-All real-valued fields live in one float64 array ``f[field, slot]`` (each field row contiguous);
+All real-valued fields live in one array ``f[field, slot]`` (each field row contiguous), float64
+or, with the scene's ``constants.precision = "float32"``, float32;
 ``kind`` (int8), ``ids`` (int64) and ``cell`` (int64) are separate. Slots ``[0, n)`` are in use;
 ``n <= capacity`` leaves room for open boundaries to create particles. Every array has a twin
 buffer: reordering by cell gathers into the twin and the two are swapped, so nothing is
@@ -69,11 +70,13 @@ class Checkpoint:
 class ParticleSet:
     """Structure-of-arrays particle storage with twin buffers and spare capacity."""
 
-    def __init__(self, capacity: int) -> None:
+    def __init__(self, capacity: int, dtype: Any = np.float64) -> None:
         if capacity <= 0:
             raise ValueError(f"capacity: must be > 0, got {capacity}")
         self.capacity = int(capacity)
-        self.f = np.zeros((N_FIELDS, self.capacity))
+        # float32 stores half the bytes; the kernels compile for either and compute in float64
+        # wherever a float64 operand (dt, h, Params) enters (docs/studies/float32_storage.md)
+        self.f = np.zeros((N_FIELDS, self.capacity), dtype=np.dtype(dtype))
         self.f2 = np.zeros_like(self.f)
         self.kind = np.full(self.capacity, INACTIVE, dtype=np.int8)
         self.kind2 = self.kind.copy()

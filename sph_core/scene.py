@@ -235,6 +235,9 @@ class Constants(_Model):
         "left the tank over its top or through a wall) before the run stops as unstable"))
     integrator: Literal["kdk", "symplectic_pc"] = Field(
         "kdk", description="kdk: leapfrog, 1 force pass/step; symplectic_pc: DualSPHysics-style, 2 passes")
+    precision: Literal["float64", "float32"] = Field("float64", description=(
+        "storage of the particle fields: float64 (default), or float32 (half the memory; the "
+        "arithmetic stays float64 where a float64 operand enters; docs/studies/float32_storage.md)"))
 
     @model_validator(mode="after")
     def _band(self) -> "Constants":

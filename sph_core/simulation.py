@@ -120,7 +120,8 @@ class Simulation:
             layout.fluid_x, layout.fluid_z = layout.fluid_x[keep], layout.fluid_z[keep]
             layout.fluid_surface = layout.fluid_surface[keep]
         n = layout.wall_x.size + layout.fluid_x.size + self.bodies.x.size
-        self.particles = ps = ParticleSet(max(int(n * (1.0 + spare)), n + 1))
+        self.particles = ps = ParticleSet(max(int(n * (1.0 + spare)), n + 1),
+                                          np.float32 if c.precision == "float32" else np.float64)
         # the scheme: its Params, initial state and time loop (steppers.py)
         self.stepper: Stepper = make_stepper(scene, ps.capacity)
         vol = dp * dp

@@ -37,6 +37,7 @@ import math
 from numba import njit, prange
 
 from .eos import density, pressure
+from .neighbours import PASS_RANGES, kind_ranges
 from .pairs import fluidlike, gather, interacting
 from .particles import (AX, AZ, DRHO, DVNX, DVNZ, FLUID, P, PW, RHO, RHON, VWX, VWZ, VX, VXN, VZ,
                         VZN, WALL, XN, ZN, X, Z)
@@ -89,9 +90,11 @@ def wall_pass(ps, n, cells, prm):
     """Adami et al. (2012) pressure, density and no-slip velocity of every wall particle."""
     f = ps.f   # writes go through the storage (module note on prange stores)
     kind = ps.kind
-    for i in prange(n):
-        if kind[i] == WALL:
-            f[P, i], f[RHO, i], f[VWX, i], f[VWZ, i] = adami_state(i, ps, cells, prm)
+    b = kind_ranges(kind, n, WALL, PASS_RANGES)   # equal shares of the walls per thread
+    for r in prange(b.size - 1):
+        for i in range(b[r], b[r + 1]):
+            if kind[i] == WALL:
+                f[P, i], f[RHO, i], f[VWX, i], f[VWZ, i] = adami_state(i, ps, cells, prm)
 
 
 @njit(cache=True, inline="always")
@@ -138,12 +141,14 @@ def fluid_pass(ps, n, cells, prm, riemann):
     alone (step.py)."""
     f = ps.f
     kind = ps.kind
-    for i in prange(n):
-        if kind[i] == FLUID:
-            k = fluid_consts(prm)
-            fi = fluid_i(i, ps, k)
-            f[AX, i], f[AZ, i], f[DRHO, i], f[PW, i], f[DVNX, i], f[DVNZ, i] = fluid_rates(
-                i, ps, cells, prm, riemann, k, fi)
+    b = kind_ranges(kind, n, FLUID, PASS_RANGES)  # equal shares of the fluid per thread
+    for r in prange(b.size - 1):
+        for i in range(b[r], b[r + 1]):
+            if kind[i] == FLUID:
+                k = fluid_consts(prm)
+                fi = fluid_i(i, ps, k)
+                f[AX, i], f[AZ, i], f[DRHO, i], f[PW, i], f[DVNX, i], f[DVNZ, i] = fluid_rates(
+                    i, ps, cells, prm, riemann, k, fi)
 
 
 # Numba drops stores made inside a prange loop through ``ps.row[i] = ...``: the passes write

@@ -61,6 +61,8 @@ def unsupported(sim: Any) -> list[str]:
             out.append(f"particle shifting with {what}")
         if prm.riemann:
             out.append(f"Riemann SPH with {what}")
+    if sim.particles.f.dtype != np.float64:
+        out.append("float32 storage")
     return out
 
 

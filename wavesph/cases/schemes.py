@@ -59,6 +59,8 @@ def add_constant_arguments(ap: argparse.ArgumentParser, open_ends: bool = False)
     ap.add_argument("--no-shift-carry", action="store_true",
                     help="do not Taylor-carry rho, v of a shifted particle")
     ap.add_argument("--alpha-wall", type=float, help="artificial viscosity factor against walls")
+    ap.add_argument("--precision", choices=["float64", "float32"],
+                    help="storage of the particle fields")
 
 
 def constants_from_args(a: argparse.Namespace) -> dict[str, Any]:
@@ -70,5 +72,6 @@ def constants_from_args(a: argparse.Namespace) -> dict[str, Any]:
              "alpha_wall_factor": a.alpha_wall,
              "shift_dplus_scale": a.shift_dplus_scale,
              "shift_carry": False if a.no_shift_carry else None,
-             "shift_open_end": getattr(a, "shift_open_end", None)}
+             "shift_open_end": getattr(a, "shift_open_end", None),
+             "precision": getattr(a, "precision", None)}
     return {k: v for k, v in given.items() if v is not None}
