@@ -9,7 +9,7 @@
 #      --threads: efficiency_vs_2 per line), and its stages at 1 and 16 threads (bench/step_stages.py)
 # JSON lines go to stdout and $OUT/gpu.jsonl, the whole log to $OUT/gpu_check.log.
 # Every phase runs under `timeout`, capped by what is left of TOTAL_S, so the script ends in time.
-# Overrides (a rerun, or a dry run here): GPU_DPS, CPU_DP, CPU_STEPS, THREADS (empty: no CPU runs),
+# Overrides (a rerun, or a dry run here): GPU_DPS, CPU_DP, CPU_STEPS, THREADS (empty: no CPU runs), TEST_S,
 # HOST_THREADS (16: pytest and the GPU runs' host side), TOTAL_S, PYTHON, SKIP_WHEELS, SKIP_TESTS,
 # NUMBA_ENABLE_CUDASIM.
 set -u
@@ -56,7 +56,7 @@ if [ -z "${SKIP_TESTS:-}" ]; then
     # one pytest process per CUDA test file, side by side (16 cores: each compiles its own CPU
     # twins, the bulk of the time), each with its own numba cache so no two write one file
     say "pytest -m cuda, one process per file (real GPU unless NUMBA_ENABLE_CUDASIM=1)"
-    TL=$(left 200)
+    TL=$(left ${TEST_S:-200})
     for f in tests/test_sph_core/test_cuda_*.py; do
         b=$(basename "$f" .py)
         NUMBA_CACHE_DIR=/tmp/nc_$b NUMBA_NUM_THREADS=2 timeout "$TL" $PY -m pytest -m cuda "$f" \
