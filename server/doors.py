@@ -262,11 +262,13 @@ async def serve_client(manager: RunManager, run: Run, transport: DoorTransport,
         await asyncio.wait_for(transport.close(), 5.0)
     except Exception:  # noqa: BLE001
         pass
-    if at_boundary and end.state != UNSTABLE and run.info.windows > 0:
-        await _save_state(manager, run)  # what a resumed session starts from
-    _progress(manager, run, engine, None, connected, solve_time)
-    manager._set_state(run, end.state, end.reason)
-    run.session_done.set()
+    try:
+        if at_boundary and end.state != UNSTABLE and run.info.windows > 0:
+            await _save_state(manager, run)  # what a resumed session starts from
+        _progress(manager, run, engine, None, connected, solve_time)
+    finally:  # whatever failed above (a full disk), the run ends and its slot is released
+        manager._set_state(run, end.state, end.reason)
+        run.session_done.set()
 
 
 class _Gone(Exception):

@@ -101,6 +101,7 @@ class RunManager:
         self.executor = ThreadPoolExecutor(max_workers=settings.max_runs, thread_name_prefix="sph")
         self.builder = ThreadPoolExecutor(max_workers=1, thread_name_prefix="sph-build")
         self.stopping = False
+        self.unsaved: set[str] = set()   # runs whose last meta.json write failed (disk full)
         self._changed = asyncio.Event()
         self._load_existing()
 
@@ -179,9 +180,24 @@ class RunManager:
         return force or time.monotonic() - run._saved_at >= self.settings.meta_interval
 
     def save(self, run: Run, force: bool = True) -> None:
-        if self.save_due(run, force):
-            run._saved_at = time.monotonic()
+        """meta.json of the run; a failed write (a full disk) is logged, never raised: the run's
+        state in memory still moves on and its slot is released (written again when it can)."""
+        if not self.save_due(run, force):
+            return
+        run._saved_at = time.monotonic()
+        try:
             self.store.save(run.info)
+        except OSError as exc:
+            self.unsaved.add(run.info.id)
+            log.error("run %s: could not write meta.json: %s", run.info.id, exc)
+            return
+        self.unsaved.discard(run.info.id)
+        for rid in list(self.unsaved):  # the disk has room again: records that missed a write
+            try:
+                self.store.save(self.runs[rid].info)
+            except OSError:
+                return
+            self.unsaved.discard(rid)
 
     def _set_state(self, run: Run, state: str, reason: str | None = None) -> None:
         run.info.state = state
@@ -407,11 +423,15 @@ class RunManager:
         except Exception as exc:  # noqa: BLE001
             self._fail(run, exc)
         finally:
-            if run.gauges:
-                run.gauges.close()
-            if run.engine:
-                await loop.run_in_executor(self.builder, run.engine.close)
-            self._release(run)
+            try:  # closing flushes files: on a full disk it raises, and the slot must still go
+                if run.gauges:
+                    run.gauges.close()
+                if run.engine:
+                    await loop.run_in_executor(self.builder, run.engine.close)
+            except Exception as exc:  # noqa: BLE001
+                log.error("run %s: closing its files failed: %s", run.info.id, exc)
+            finally:
+                self._release(run)
 
     def _build(self, run: Run) -> CouplingEngine:
         """Builder thread: the run's engine (the detail's check imports sph_core off the loop)."""

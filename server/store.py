@@ -19,6 +19,7 @@ import json
 import logging
 import os
 import re
+import shutil
 from pathlib import Path
 from typing import Any, Callable
 
@@ -46,8 +47,12 @@ class RunStore:
     def create(self, run_id: str, request: dict[str, Any], scene_bytes: bytes) -> Path:
         d = self.run_dir(run_id)
         d.mkdir()
-        write_json_atomic(d / "request.json", request)
-        (d / "scene.json").write_bytes(scene_bytes)
+        try:
+            write_json_atomic(d / "request.json", request)
+            (d / "scene.json").write_bytes(scene_bytes)
+        except OSError:  # a full disk: no half-made run left to be found at the next start
+            shutil.rmtree(d, ignore_errors=True)
+            raise
         return d
 
     def save(self, info: RunInfo) -> None:
@@ -59,6 +64,9 @@ class RunStore:
         a log line, never stops the server."""
         out = []
         for d in sorted(self.root.iterdir()):
+            if d.is_symlink():  # its records would be written outside the store
+                log.warning("run store: skipping %s: a symbolic link, not a run directory", d)
+                continue
             if not d.is_dir() or not RUN_ID.fullmatch(d.name):
                 log.warning("run store: skipping %s: not a run directory", d)
                 continue
@@ -90,10 +98,21 @@ def _sha256(path: Path) -> str:
 
 def save_sealed(save: Callable[[Path], None], path: Path) -> None:
     """``save(path)``, then its SHA-256 beside it: a state is trusted only if it matches (a crash
-    between the two leaves a state without a valid seal, which is not resumed)."""
-    _seal_path(path).unlink(missing_ok=True)
+    between the two leaves a state without a valid seal, which is not resumed). ``save`` must
+    replace ``path`` atomically: if it fails (a full disk), the state before and its seal stay."""
     save(path)
-    _seal_path(path).write_text(_sha256(path) + "\n")
+    write_text_atomic(_seal_path(path), _sha256(path) + "\n")
+
+
+def write_text_atomic(path: Path, text: str) -> None:
+    """``text`` to ``path`` through a temporary file, removed if the write fails."""
+    tmp = path.with_name(path.name + ".tmp")
+    try:
+        tmp.write_text(text)
+        os.replace(tmp, path)
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
 
 
 def fresh_path(folder: Path, stem: str, suffix: str = "") -> Path:

@@ -62,7 +62,8 @@ async def _read_body(request: Request, limit: int) -> bytes:
                                      "mode 'coupled' needs open_boundaries; 'source' only for a "
                                      "standalone run with open_boundaries (and required there); "
                                      "coupling.z_ref in the water column; windows at most 1e7"),
-                        429: _detail("the queue is full (max_queued); see Retry-After")})
+                        429: _detail("the queue is full (max_queued); see Retry-After"),
+                        507: _detail("the run store cannot write (disk full)")})
 async def create_run(request: Request, manager: Manager) -> RunInfo:
     """Create a run from a scene (body: RunRequest as JSON, or a scene file as TOML with
     Content-Type application/toml: its mode, [coupling] and [source] tables beside the
@@ -82,6 +83,8 @@ async def create_run(request: Request, manager: Manager) -> RunInfo:
         return manager.submit(body).info
     except QueueFull as exc:
         raise _queue_full(exc) from None
+    except OSError as exc:  # the store cannot write (disk full): say so, no 500
+        raise HTTPException(507, f"the run store cannot write: {exc.strerror or exc}") from None
 
 
 @router.get("", response_model=list[RunInfo])
@@ -105,7 +108,7 @@ async def get_scene(run: RunDep) -> Response:
 async def get_gauges(run: RunDep, format: Literal["csv", "json"] = Query("csv")) -> Response:
     """Gauge series as CSV (a dry gauge an empty field) or JSON (`null` where dry)."""
     path = run.dir / (run.info.gauges_file or "gauges.csv")
-    if not path.exists():
+    if not path.is_file():  # a directory in its place (a damaged store) is no data either
         raise HTTPException(404, f"run {run.info.id} has no gauge data yet")
     if format == "csv":
         return FileResponse(path, media_type="text/csv", filename=f"{run.info.id}-gauges.csv")

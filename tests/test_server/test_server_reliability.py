@@ -1,0 +1,132 @@
+"""Reliability defects of the server (docs: the reliability review), one reproducing case each.
+Real servers on 127.0.0.1 with the engine double; every wait polls with a deadline."""
+
+from __future__ import annotations
+
+import errno
+import json
+
+import pytest
+
+from server_harness import live_server, scene, wait_until
+
+
+def _coupled_body(**overrides) -> dict:
+    return {"scene": scene(open_boundaries=[{"side": "left"}], **overrides), "mode": "coupled"}
+
+
+def _enospc(*args, **kwargs):
+    raise OSError(errno.ENOSPC, "No space left on device")
+
+
+# tiny wave period: a 422, not a 500 -------------------------------------------------------------
+def test_tiny_source_period_is_a_422(srv):
+    body = {**_coupled_body(), "mode": "standalone",
+            "source": {"theory": "stokes", "H": 0.04, "T": 1e-9, "order": 2}}
+    r = srv.http.post("/runs", json=body)
+    assert r.status_code == 422, r.text
+    assert r.json()["detail"][0]["loc"][:2] == ["body", "source"]
+
+
+# a 404 never echoes a huge id ------------------------------------------------------------------
+def test_404_does_not_echo_a_long_run_id(srv):
+    r = srv.http.get("/runs/" + "a" * 10_000)
+    assert r.status_code == 404 and len(r.content) < 300
+
+
+def test_upper_case_token_in_a_url_is_redacted():
+    from server.deps import redact_tokens
+
+    assert redact_tokens("GET /runs/x/couple?TOKEN=s3cr3t-0123456789&a=1") == \
+        "GET /runs/x/couple?TOKEN=***&a=1"
+
+
+# the store follows no symbolic link; a directory in place of gauges.csv is a 404 ---------------
+def test_store_skips_a_symlinked_run_dir_and_serves_no_directory_as_gauges(tmp_path, factory):
+    with live_server(tmp_path, factory) as srv:
+        run = srv.create()
+        srv.wait_state(run["id"], "waiting_for_client")
+    runs = tmp_path / "runs"
+    outside = tmp_path / "outside"
+    (runs / run["id"]).rename(outside)
+    (runs / run["id"]).symlink_to(outside, target_is_directory=True)
+    before = (outside / "meta.json").read_text()
+    with live_server(tmp_path, factory) as srv:
+        assert srv.http.get("/runs").json() == []
+    assert (outside / "meta.json").read_text() == before  # nothing written through the link
+    (runs / run["id"]).unlink()
+    outside.rename(runs / run["id"])
+    (runs / run["id"] / "gauges.csv").unlink(missing_ok=True)
+    (runs / run["id"] / "gauges.csv").mkdir()
+    with live_server(tmp_path, factory) as srv:
+        r = srv.http.get(f"/runs/{run['id']}/gauges")
+        assert r.status_code == 404, r.text
+
+
+# a full disk: the run ends, its slot comes back, no .tmp is left --------------------------------
+def test_full_disk_at_the_end_of_a_session_ends_the_run_and_frees_its_slot(tmp_path, factory,
+                                                                           monkeypatch):
+    import server.store as store
+    from coupling_client import bye, run_windows
+
+    real = store.write_json_atomic
+    with live_server(tmp_path, factory, max_runs=1) as srv:
+        run = srv.create()
+        c, welcome, nodes = srv.couple(run["id"])
+        run_windows(c, welcome, nodes, 2)
+        monkeypatch.setattr(store, "write_json_atomic", _enospc)  # meta.json cannot be written
+        bye(c)
+        assert srv.wait_state(run["id"], "finished", timeout=10)["state"] == "finished"
+        wait_until(lambda: not srv.manager.active, "the stepping slot is released", 10)
+        monkeypatch.setattr(store, "write_json_atomic", real)  # space freed
+        second = srv.create()
+        c, welcome, nodes = srv.couple(second["id"])  # the one slot is free again
+        run_windows(c, welcome, nodes, 1)
+        bye(c)
+        srv.wait_state(second["id"], "finished")
+        wait_until(lambda: json.loads((tmp_path / "runs" / run["id"] / "meta.json").read_text())
+                   ["state"] == "finished", "the first run's record caught up once space was free")
+    assert not list((tmp_path / "runs").rglob("*.tmp"))
+
+
+def test_full_disk_while_writing_gauges_fails_the_run_and_frees_its_slot(tmp_path, factory,
+                                                                        monkeypatch):
+    import server.store as store
+    from coupling_client import run_windows
+
+    with live_server(tmp_path, factory, max_runs=1) as srv:
+        run = srv.create()
+        c, welcome, nodes = srv.couple(run["id"])
+        run_windows(c, welcome, nodes, 1)
+        monkeypatch.setattr(store.GaugeWriter, "row", _enospc)
+        monkeypatch.setattr(store, "write_json_atomic", _enospc)
+        with pytest.raises(Exception):
+            run_windows(c, welcome, nodes, 1, t0=0.05)
+        info = srv.wait_state(run["id"], "failed", timeout=10)
+        assert "No space left" in info["status"]
+        wait_until(lambda: not srv.manager.active, "the stepping slot is released", 10)
+        c.close()
+
+
+def test_atomic_writes_leave_no_tmp_file_on_a_full_disk(tmp_path, monkeypatch):
+    import os
+    import pathlib
+
+    from server.store import write_text_atomic
+    from sph_core.checkpoint_file import save_checkpoint
+    from sph_core.output import write_json_atomic
+
+    real_write = pathlib.Path.write_text
+
+    def half_then_full(self, text, *a, **kw):  # some bytes land, then the disk is full
+        real_write(self, text[: len(text) // 2], *a, **kw)
+        _enospc()
+
+    monkeypatch.setattr(pathlib.Path, "write_text", half_then_full)
+    for write in (write_json_atomic, write_text_atomic):
+        with pytest.raises(OSError):
+            write(tmp_path / "meta.json", {"a": 1} if write is write_json_atomic else "x" * 100)
+    monkeypatch.setattr(os, "fsync", _enospc)
+    with pytest.raises(OSError):
+        save_checkpoint(tmp_path / "state.npz", {"t": 1.0})
+    assert list(tmp_path.iterdir()) == []
