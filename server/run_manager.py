@@ -323,6 +323,7 @@ class RunManager:
                 self._set_state(run, FAILED, "server stopped before the run ended")
         self.executor.shutdown(wait=False, cancel_futures=True)
         self.builder.shutdown(wait=False, cancel_futures=True)
+        self.store.close()
 
     # ------------------------------------------------------------------ standalone
     async def _standalone(self, run: Run) -> None:

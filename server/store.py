@@ -14,6 +14,7 @@
 from __future__ import annotations
 
 import csv
+import fcntl
 import hashlib
 import json
 import logging
@@ -21,7 +22,7 @@ import os
 import re
 import shutil
 from pathlib import Path
-from typing import Any, Callable
+from typing import IO, Any, Callable
 
 from sph_core.output import format_time, write_json_atomic
 
@@ -33,10 +34,24 @@ RUN_ID = re.compile(r"[A-Za-z0-9_-]{1,64}")  # a run's directory name: never a p
 log = logging.getLogger("wavesph.server")
 
 
+LOCK = ".lock"  # held (flock) by the one server that uses the store
+
+
+class StoreLocked(RuntimeError):
+    """Another server holds the run store: two would write the same runs' files."""
+
+
 class RunStore:
     def __init__(self, root: Path) -> None:
         self.root = Path(root)
         self.root.mkdir(parents=True, exist_ok=True)
+        self._lock = lock_store(self.root)
+
+    def close(self) -> None:
+        """Release the store's lock (the server stops)."""
+        if self._lock is not None:
+            self._lock.close()
+            self._lock = None
 
     def run_dir(self, run_id: str) -> Path:
         """The run's directory, inside the store whatever the id says (ValueError if not a name)."""
@@ -67,6 +82,8 @@ class RunStore:
             if d.is_symlink():  # its records would be written outside the store
                 log.warning("run store: skipping %s: a symbolic link, not a run directory", d)
                 continue
+            if d.name == LOCK:
+                continue
             if not d.is_dir() or not RUN_ID.fullmatch(d.name):
                 log.warning("run store: skipping %s: not a run directory", d)
                 continue
@@ -82,6 +99,37 @@ class RunStore:
                 info = info.model_copy(update={"id": d.name})
             out.append((info, request))
         return out
+
+
+def lock_store(root: Path) -> IO[str]:
+    """An exclusive lock on ``root``'s lock file, held while the returned file is open; it
+    names this process. StoreLocked (naming the holder) if another server holds it. The OS
+    releases it when the process ends, even on kill -9."""
+    f = open(root / LOCK, "a+")
+    try:
+        fcntl.flock(f, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except OSError:
+        f.seek(0)
+        holder = f.read().strip()[:40] or "unknown"
+        f.close()
+        raise StoreLocked(f"runs dir {root} is in use by another wavesph server (pid {holder}); "
+                          f"give each server its own --runs-dir") from None
+    f.seek(0)
+    f.truncate()
+    f.write(f"{os.getpid()}\n")
+    f.flush()
+    return f
+
+
+def store_in_use(root: Path) -> str | None:
+    """Why a server cannot use the store ``root`` now (another holds it), or None."""
+    if not (Path(root) / LOCK).exists():
+        return None
+    try:
+        lock_store(Path(root)).close()
+    except StoreLocked as exc:
+        return str(exc)
+    return None
 
 
 def _seal_path(path: Path) -> Path:

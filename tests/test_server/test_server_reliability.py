@@ -130,3 +130,26 @@ def test_atomic_writes_leave_no_tmp_file_on_a_full_disk(tmp_path, monkeypatch):
     with pytest.raises(OSError):
         save_checkpoint(tmp_path / "state.npz", {"t": 1.0})
     assert list(tmp_path.iterdir()) == []
+
+
+# one server per run store ----------------------------------------------------------------------
+def test_second_server_on_one_runs_dir_is_refused_with_one_line(tmp_path, factory):
+    import argparse
+
+    from server.store import RunStore, StoreLocked, store_in_use
+    from wavesph.cli import serve
+
+    with live_server(tmp_path, factory) as srv:
+        run = srv.create()
+        srv.wait_state(run["id"], "waiting_for_client")
+        with pytest.raises(StoreLocked, match="in use by another wavesph server"):
+            RunStore(tmp_path / "runs")
+        reason = store_in_use(tmp_path / "runs")
+        assert reason and "\n" not in reason and "--runs-dir" in reason
+        args = argparse.Namespace(host=None, port=0, tcp_port=0, runs_dir=tmp_path / "runs",
+                                  max_runs=None, max_particles=None, token=None)
+        assert serve.main(args) == 1  # refused before it binds or touches a run
+        assert srv.http.get(f"/runs/{run['id']}").json()["state"] == "waiting_for_client"
+    assert store_in_use(tmp_path / "runs") is None  # released when the server stopped
+    with live_server(tmp_path, factory) as srv:
+        assert [r["id"] for r in srv.http.get("/runs").json()] == [run["id"]]
