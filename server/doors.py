@@ -22,7 +22,7 @@ from protocol import (NO_SCENE_HASH, Capability, ErrorCode, GaugeKind, Gauges, N
 from protocol.messages import Error, Hello, Message, Working
 from protocol.session import Measure, PeerError, Reply, Restore, SetWindow, SolveWindow
 
-from .engine import CouplingEngine, Measurement
+from .engine import CouplingEngine, Measurement, SolveCancelled
 from .run_manager import Run, RunManager
 from .schemas import FAILED, FINISHED, RUNNING, UNSTABLE
 from .store import save_sealed
@@ -231,7 +231,7 @@ async def serve_client(manager: RunManager, run: Run, transport: DoorTransport,
                 raise _Cancel()
     except _SessionEnd as exc:
         end = exc
-    except _Cancel:
+    except (_Cancel, SolveCancelled):
         state, reason = manager.cancel_reason
         end = _SessionEnd(state, reason, session.error_frame(ProtocolError(ErrorCode.CANCELLED, reason)))
     except (_Gone, PeerGone):

@@ -14,6 +14,7 @@ Protocol view of the flume (PROTOCOL.md):
 from __future__ import annotations
 
 import math
+import threading
 from dataclasses import replace
 from pathlib import Path
 
@@ -26,7 +27,7 @@ from sph_core.open_ends import SIDES
 from sph_core.scene import PointProbe, Scene
 from sph_core.simulation import Simulation
 
-from .engine import EngineNodes, Measurement, SceneSummary
+from .engine import EngineNodes, Measurement, SceneSummary, SolveCancelled
 from .schemas import RunRequest
 from .store import fresh_path  # sph/, then sph.1/ ... for resumed sessions
 
@@ -89,6 +90,7 @@ class FlumeEngine:
         self._window: tuple[float, float, dict[str, BoundarySample]] | None = None
         self._saved = None
         self._window_steps = 0
+        self.cancel: threading.Event | None = None  # the run's cancel flag (server/engine.py)
 
     # -- clock and size --------------------------------------------------------------------
     @property
@@ -121,13 +123,18 @@ class FlumeEngine:
         _, t1, samples = self._window
         before = self.flume.steps
         try:
-            self.flume.advance_window(t1, **samples)
+            self.flume.advance_window(t1, **samples, progress=self._check_cancel)
         except BoundaryDataError as exc:  # the client's data, not our failure
             raise ProtocolError(ErrorCode.BAD_VALUE, f"SET: {exc}") from None
         finally:
             self._window = None
         m = self.measure()
         return Measurement(m.eta, m.wet, m.u_ref, m.w_ref, steps=self.flume.steps - before)
+
+    def _check_cancel(self, _: Simulation) -> None:
+        """Called between chunks of steps (sph_core STEPS_PER_CALL) and at each output."""
+        if self.cancel is not None and self.cancel.is_set():
+            raise SolveCancelled()
 
     def measure(self) -> Measurement:
         values = self.flume.probe_values()

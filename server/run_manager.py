@@ -384,6 +384,8 @@ class RunManager:
         loop = asyncio.get_running_loop()
         try:
             run.engine = await loop.run_in_executor(self.builder, self._build, run)
+            if hasattr(run.engine, "cancel"):  # it stops a long window when the run is cancelled
+                run.engine.cancel = run.cancel_flag
             run.info.detail = None
             if run.resume_from is not None:
                 await loop.run_in_executor(self.builder, run.engine.load_state, run.resume_from)

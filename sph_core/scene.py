@@ -422,6 +422,9 @@ class OpenBoundary(_Model):
                           "hydrostatic buffers extrapolate within h of their surface")
 
 
+MAX_OUTPUTS = 10_000_000  # probe rows or snapshots of one run (beyond: an interval below dt)
+
+
 class Output(_Model):
     """Output cadence in simulated seconds (0 = never)."""
 
@@ -515,6 +518,11 @@ class Scene(_Model):
                 raise ValueError(f"probes.{i}.follow: no body named {follow!r} (bodies: {bnames})")
         if self.output.snapshot_every and self.output.snapshot_every > self.t_end - self.t_start:
             raise ValueError("output.snapshot_every: must not exceed the run's length t_end - t_start")
+        for name in ("probe_every", "snapshot_every"):  # 1e-300 s: a run that only writes rows
+            every = getattr(self.output, name)
+            if every and (self.t_end - self.t_start) / every > MAX_OUTPUTS:
+                raise ValueError(f"output.{name}: {every:g} s makes more than {MAX_OUTPUTS:,} "
+                                 f"outputs of the run's {self.t_end - self.t_start:g} s")
         return self
 
     # derived quantities -------------------------------------------------------------------

@@ -153,3 +153,39 @@ def test_second_server_on_one_runs_dir_is_refused_with_one_line(tmp_path, factor
     assert store_in_use(tmp_path / "runs") is None  # released when the server stopped
     with live_server(tmp_path, factory) as srv:
         assert [r["id"] for r in srv.http.get("/runs").json()] == [run["id"]]
+
+
+# output intervals are bounded; a DELETE reaches inside a window that does not end ---------------
+@pytest.mark.parametrize("output", [{"probe_every": 1e-300}, {"snapshot_every": 1e-300}])
+def test_output_interval_below_any_step_is_a_422(srv, output):
+    r = srv.http.post("/runs", json=_coupled_body(output=output))
+    assert r.status_code == 422, r.text
+    assert next(iter(output)) in r.text and "outputs" in r.text
+
+
+def test_delete_ends_a_window_that_never_ends(tmp_path, factory):
+    import threading
+
+    import numpy as np
+
+    from protocol import Error, ErrorCode, Set, Solve
+
+    gate = threading.Event()  # never opened: the window would take for ever
+    with live_server(tmp_path, lambda r, d: factory(r, d, gate=gate, honours_cancel=True),
+                     max_runs=1) as srv:
+        run = srv.create()
+        c, welcome, nodes = srv.couple(run["id"])
+        n = welcome.n_nodes
+        c.request(Set(0.0, 0.05, np.zeros(n), np.zeros(n), np.zeros(n)), Solve())
+        wait_until(lambda: srv.http.get(f"/runs/{run['id']}").json()["state"] == "running",
+                   "the window is being solved", 10)
+        assert srv.http.delete(f"/runs/{run['id']}").status_code == 200
+        info = srv.wait_state(run["id"], "cancelled", timeout=10)
+        assert info["windows"] == 0
+        while True:  # WORKING frames may come first
+            seq, msg = c.recv()
+            if isinstance(msg, Error):
+                break
+        assert msg.code == ErrorCode.CANCELLED
+        wait_until(lambda: not srv.manager.active, "the stepping slot is released", 10)
+        c.close()
