@@ -6,7 +6,14 @@ Three caps, so that runs whose client never comes cannot block the server:
   holds none; a client's HELLO reserves its run (``reserve``) and waits in ``attach`` while the
   run is queued or every slot is busy.
 - ``max_waiting`` coupled runs built (engine in memory) and waiting for their client;
-- ``max_queued`` runs in the queue; one more is refused (HTTP 429 with Retry-After).
+- ``max_queued`` runs of each kind in the queue (coupled runs waiting for a client, and the
+  others, counted apart: clientless coupled POSTs never lock standalone runs out); one more is
+  refused (HTTP 429 with Retry-After).
+
+A coupled run whose client does not come within ``client_wait_timeout`` of its POST (queued or
+built) fails, freeing its places. A claimed run (resumed by its owner, or reserved by its
+client's HELLO) goes to the head of the queue and needs no waiting place: it is never stuck
+behind clientless runs of strangers, and a resume is never refused for a full queue.
 
 Everything here runs on the event loop except the SPH work, which goes to a thread pool
 (``Run.executor``): numba releases the GIL in its parallel loops, and Python threads switch every
@@ -17,6 +24,7 @@ from __future__ import annotations
 
 import asyncio
 import logging
+import math
 import threading
 import time
 import uuid
@@ -62,6 +70,7 @@ class Run:
         self.task_client: asyncio.Task | None = None   # the built-in theory client, if any
         self.client_attached = False
         self.resume_from: Path | None = None
+        self.wait_deadline = math.inf             # monotonic [s]: no client by then, it fails
         self._saved_at = 0.0
 
     @property
@@ -79,6 +88,12 @@ class Run:
     @property
     def terminal(self) -> bool:
         return self.info.state in TERMINAL
+
+    @property
+    def claimed(self) -> bool:
+        """Its owner asked for it again (resume) or its client is here (HELLO): takes no
+        waiting place and jumps the queue."""
+        return self.client_attached or self.resume_from is not None
 
 
 SourceDriver = Callable[["RunManager", Run], Awaitable[None]]
@@ -136,6 +151,7 @@ class RunManager:
                 run.resume_from = run.state_file
             run.info.ended = None
             self.queue.append(run.info.id)
+            self._wait_for_client(run)
             self._set_state(run, QUEUED)
             log.info("run %s: queued again (it had not started when the server stopped)",
                      run.info.id)
@@ -223,13 +239,33 @@ class RunManager:
             self.runs[rid].info.queue_position = i + 1
 
     # ------------------------------------------------------------------ lifecycle
-    def _check_queue_room(self) -> None:
-        if len(self.queue) >= self.settings.max_queued:
-            raise QueueFull(f"the queue holds {len(self.queue)} runs, the server's max_queued: "
+    def _check_queue_room(self, request: RunRequest) -> None:
+        kind = _waits_for_client(request)
+        queued = sum(1 for rid in self.queue if _waits_for_client(self.runs[rid].request) == kind)
+        if queued >= self.settings.max_queued:
+            what = "coupled runs waiting for a client" if kind else "standalone runs"
+            raise QueueFull(f"the queue holds {queued} {what}, the server's max_queued: "
                             f"retry when a run has ended")
 
+    def _wait_for_client(self, run: Run) -> None:
+        """A coupled run fails if no client comes within client_wait_timeout from now (queued
+        or built: a queue of clientless runs empties by itself)."""
+        if not _waits_for_client(run.request):
+            return
+        timeout = self.settings.client_wait_timeout
+        run.wait_deadline = time.monotonic() + timeout
+        deadline = run.wait_deadline
+
+        def expire() -> None:
+            if (run.wait_deadline == deadline and run.info.id in self.queue
+                    and not run.client_attached):
+                self.queue.remove(run.info.id)
+                self._set_state(run, FAILED, f"no client connected within {timeout:g} s")
+                self._queue_positions()
+        asyncio.get_running_loop().call_later(timeout, expire)
+
     def submit(self, request: RunRequest) -> Run:
-        self._check_queue_room()
+        self._check_queue_room(request)
         run_id = uuid.uuid4().hex  # 128 random bits: also the credential on the TCP port
         scene_bytes = canonical_scene(request.scene)
         from protocol import scene_hash
@@ -241,6 +277,7 @@ class RunManager:
         run = Run(info, request, run_dir)
         self.runs[run_id] = run
         self.queue.append(run_id)
+        self._wait_for_client(run)
         self._queue_positions()
         self.save(run)
         self._schedule()
@@ -253,13 +290,13 @@ class RunManager:
         if not run.info.resumable:
             raise ValueError(f"run {run.info.id} is {run.info.status}: only a failed or cancelled "
                              f"coupled run with a saved state can be resumed")
-        self._check_queue_room()
         run.reset_live_parts()
         run.resume_from = run.state_file
         run.info.resumed += 1
         run.info.ended = None
         self._set_state(run, QUEUED)
-        self.queue.append(run.info.id)
+        self.queue.appendleft(run.info.id)  # its owner's run: ahead of strangers' new ones
+        self._wait_for_client(run)
         self._queue_positions()
         self._schedule()
 
@@ -271,7 +308,8 @@ class RunManager:
         for rid in list(self.queue):
             run = self.runs[rid]
             if _waits_for_client(run.request):
-                if len(self.waiting) >= self.settings.max_waiting:
+                unclaimed = sum(1 for w in self.waiting if not self.runs[w].claimed)
+                if unclaimed >= self.settings.max_waiting and not run.claimed:
                     continue
                 self.waiting.add(rid)
             else:
@@ -408,8 +446,10 @@ class RunManager:
                 run.info.detail = compile_detail("first window")
                 run.attached.set()
                 run.task_client = asyncio.get_running_loop().create_task(self.source_driver(self, run))
-            while True:
-                woke = await _first_of(run.attached, run.cancelled, self.settings.client_wait_timeout)
+            while True:  # a reserving client waits for a slot: its run does not expire then
+                left = run.wait_deadline - time.monotonic()
+                woke = await _first_of(run.attached, run.cancelled, None if math.isinf(left)
+                                       else max(left, 1.0 if run.client_attached else 0.0))
                 if woke is None and run.client_attached:
                     continue  # its client is connected (reserved it) and waits for a slot
                 break
@@ -454,6 +494,10 @@ class RunManager:
         if run.info.state not in (QUEUED, WAITING) or not _waits_for_client(run.request):
             raise ValueError(f"run {run_id} is {run.info.status}: it takes no coupling client")
         run.client_attached = True
+        if run.info.id in self.queue:  # its client is here: ahead of clientless runs
+            self.queue.remove(run.info.id)
+            self.queue.appendleft(run.info.id)
+            self._schedule()
         return run
 
     def unreserve(self, run: Run) -> None:
@@ -506,8 +550,9 @@ def _windowed(request: RunRequest) -> bool:
     return request.mode == "coupled" or request.source is not None
 
 
-async def _first_of(a: asyncio.Event, b: asyncio.Event, timeout: float) -> asyncio.Event | None:
-    """Whichever event is set first, or None after ``timeout`` seconds."""
+async def _first_of(a: asyncio.Event, b: asyncio.Event,
+                    timeout: float | None) -> asyncio.Event | None:
+    """Whichever event is set first, or None after ``timeout`` seconds (None: no limit)."""
     waits = {asyncio.ensure_future(a.wait()): a, asyncio.ensure_future(b.wait()): b}
     done, pending = await asyncio.wait(waits, timeout=timeout, return_when=asyncio.FIRST_COMPLETED)
     for f in pending:

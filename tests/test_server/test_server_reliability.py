@@ -189,3 +189,60 @@ def test_delete_ends_a_window_that_never_ends(tmp_path, factory):
         assert msg.code == ErrorCode.CANCELLED
         wait_until(lambda: not srv.manager.active, "the stepping slot is released", 10)
         c.close()
+
+
+# clientless coupled runs cannot deny service ---------------------------------------------------
+def test_queued_run_without_a_client_expires_while_the_waiting_places_are_taken(tmp_path, factory):
+    import threading
+
+    building = threading.Event()  # the first run's build is held: it keeps the one waiting place
+
+    def slow_first(request, run_dir):
+        if not building.is_set():
+            building.set()
+            release.wait(30)
+        return factory(request, run_dir)
+
+    release = threading.Event()
+    with live_server(tmp_path, slow_first, max_waiting=1, client_wait_timeout=0.3) as srv:
+        try:
+            first = srv.create()
+            queued = srv.create()
+            assert building.wait(10)
+            info = srv.wait_state(queued["id"], "failed", timeout=10)
+            assert "no client connected within 0.3 s" in info["status"]
+            assert srv.http.get(f"/runs/{first['id']}").json()["state"] == "queued"  # still building
+        finally:
+            release.set()
+        srv.wait_state(first["id"], "failed", timeout=10)  # it had no client either
+
+
+def test_standalone_posts_are_not_refused_for_a_queue_of_clientless_runs(tmp_path, factory,
+                                                                         monkeypatch):
+    from server.run_manager import RunManager
+
+    monkeypatch.setattr(RunManager, "_step_standalone", lambda self, run: None)  # no SPH here
+    with live_server(tmp_path, factory, max_waiting=1, max_queued=1) as srv:
+        srv.wait_state(srv.create()["id"], "waiting_for_client")
+        srv.create()  # queued: the coupled queue is full now
+        assert srv.http.post("/runs", json=_coupled_body()).status_code == 429
+        standalone = srv.http.post("/runs", json={"scene": scene(t_end=0.05), "mode": "standalone"})
+        assert standalone.status_code == 201, standalone.text
+
+
+def test_resume_goes_ahead_of_strangers_clientless_runs(tmp_path, factory):
+    from coupling_client import run_windows
+
+    with live_server(tmp_path, factory, max_waiting=1, max_queued=1) as srv:
+        mine = srv.create()
+        c, welcome, nodes = srv.couple(mine["id"])
+        run_windows(c, welcome, nodes, 2)
+        c.close()  # gone without BYE: failed, resumable
+        assert srv.wait_state(mine["id"], "failed")["resumable"]
+        srv.wait_state(srv.create()["id"], "waiting_for_client")  # strangers: the waiting place
+        srv.create()                                              # and the queue, full
+        r = srv.http.post(f"/runs/{mine['id']}/resume")
+        assert r.status_code == 202, r.text
+        c, welcome, nodes = srv.couple(mine["id"])  # built at once, not behind the strangers
+        assert welcome.t_start == pytest.approx(0.1)
+        c.close()
