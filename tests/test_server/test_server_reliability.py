@@ -246,3 +246,18 @@ def test_resume_goes_ahead_of_strangers_clientless_runs(tmp_path, factory):
         c, welcome, nodes = srv.couple(mine["id"])  # built at once, not behind the strangers
         assert welcome.t_start == pytest.approx(0.1)
         c.close()
+
+
+# a 413 reaches a client that writes the whole body before it reads ------------------------------
+def test_413_reaches_urllib_which_sends_the_whole_body_first(tmp_path, factory):
+    import urllib.error
+    import urllib.request
+
+    with live_server(tmp_path, factory, max_body=1024 * 1024) as srv:
+        body = b'{"a": "' + b"x" * 20_000_000 + b'"}'  # more than the socket buffers hold
+        req = urllib.request.Request(srv.url + "/runs", data=body,
+                                     headers={"Content-Type": "application/json"})
+        with pytest.raises(urllib.error.HTTPError) as exc:
+            urllib.request.urlopen(req, timeout=30)
+        assert exc.value.code == 413 and b"max_body" in exc.value.read()
+        assert srv.http.get("/runs").status_code == 200  # and the server serves on
