@@ -261,3 +261,16 @@ def test_413_reaches_urllib_which_sends_the_whole_body_first(tmp_path, factory):
             urllib.request.urlopen(req, timeout=30)
         assert exc.value.code == 413 and b"max_body" in exc.value.read()
         assert srv.http.get("/runs").status_code == 200  # and the server serves on
+
+
+# finite but absurd values: a 422 before the run exists, not a 201 and a failed run ---------------
+@pytest.mark.parametrize("overrides, loc", [
+    ({"constants": {"c0": 1e300}}, ["body", "scene", "constants", "c0"]),
+    ({"constants": {"c0": 1e-300}}, ["body", "scene", "constants", "c0"]),
+    ({"beds": [{"points": [[0.05, 0.0], [0.9, 0.2]]}]}, ["body", "scene", "beds", 0]),
+])
+def test_absurd_finite_values_are_a_422(srv, overrides, loc):
+    r = srv.http.post("/runs", json=_coupled_body(**overrides))
+    assert r.status_code == 422, r.text
+    assert r.json()["detail"][0]["loc"] == loc
+    assert srv.http.get("/runs").json() == []
