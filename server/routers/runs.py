@@ -81,6 +81,7 @@ async def _read_body(request: Request, limit: int) -> bytes:
              responses={400: _detail("the body is not JSON (or not TOML, with Content-Type "
                                      "application/toml)"),
                         413: _detail("the body exceeds max_body"),
+                        415: _detail("the Content-Type is not application/json or application/toml"),
                         422: _detail("a field, or a rule across fields, is not met: `detail` lists "
                                      "loc, msg, type (never the input); numbers must be finite; "
                                      "the scene within max_particles and max_probes; "
@@ -96,6 +97,11 @@ async def create_run(request: Request, manager: Manager) -> RunInfo:
     wait for a client on
     `/runs/{id}/couple` (WebSocket) or the TCP coupling port; standalone runs start stepping when
     a slot is free. Everything the run needs is checked before the 201."""
+    kind = request.headers.get("content-type", "").split(";")[0].strip().lower()
+    if "json" not in kind and "toml" not in kind:
+        # text/plain, a form or none: what a web page may send without asking (CSRF)
+        raise HTTPException(415, "Content-Type must be application/json (a RunRequest) or "
+                                 "application/toml (a scene file)")
     raw = await _read_body(request, manager.settings.max_body)
     try:  # parsing and validation off the event loop: a big scene never stalls other requests
         body = await asyncio.to_thread(parse_run_request, raw, manager.settings,

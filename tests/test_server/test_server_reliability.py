@@ -274,3 +274,33 @@ def test_absurd_finite_values_are_a_422(srv, overrides, loc):
     assert r.status_code == 422, r.text
     assert r.json()["detail"][0]["loc"] == loc
     assert srv.http.get("/runs").json() == []
+
+
+# a loopback server refuses what a foreign web page can send (CSRF, DNS rebinding) --------------
+def test_loopback_server_refuses_foreign_pages_and_hosts(srv):
+    body = json.dumps(_coupled_body())
+    r = srv.http.post("/runs", content=body, headers={"content-type": "text/plain"})
+    assert r.status_code == 415  # a "simple" request no browser preflights
+    r = srv.http.post("/runs", content=body, headers={"content-type": "application/json",
+                                                      "origin": "http://evil.example"})
+    assert r.status_code == 403
+    assert srv.http.get("/runs", headers={"host": "evil.example"}).status_code == 421
+    assert srv.http.get("/runs", headers={"host": f"localhost:{srv.port}"}).status_code == 200
+    own = srv.http.post("/runs", content=body, headers={"content-type": "application/json",
+                                                        "origin": srv.url})  # its own page
+    assert own.status_code == 201, own.text
+    assert len(srv.http.get("/runs").json()) == 1
+
+
+def test_websocket_door_refuses_a_foreign_origin(srv):
+    from websockets.exceptions import InvalidStatus
+    from websockets.sync.client import connect
+
+    run = srv.create()
+    url = f"ws://127.0.0.1:{srv.port}/runs/{run['id']}/couple"
+    with pytest.raises(InvalidStatus) as exc:
+        with connect(url, origin="http://evil.example", open_timeout=10):
+            pass
+    assert exc.value.response.status_code == 403
+    with connect(url, origin=srv.url, open_timeout=10):  # the server's own page may
+        pass
