@@ -304,3 +304,26 @@ def test_websocket_door_refuses_a_foreign_origin(srv):
     assert exc.value.response.status_code == 403
     with connect(url, origin=srv.url, open_timeout=10):  # the server's own page may
         pass
+
+
+# the WebSocket door holds no 16 MiB message from a client that has not said HELLO ---------------
+def test_websocket_door_refuses_a_big_message_before_hello_at_its_header(srv):
+    from websockets.exceptions import ConnectionClosed
+    from websockets.sync.client import connect
+
+    from protocol import Result
+    from coupling_client import WsClient, handshake, run_windows
+
+    run = srv.create(dp=0.0005)  # 600 boundary nodes: a SET frame of 14 kB, over a HELLO's 8 kB
+    url = f"ws://127.0.0.1:{srv.port}/runs/{run['id']}/couple"
+    with connect(url, open_timeout=10, max_size=None) as ws:
+        ws.send(b"WSPH" + bytes(1_000_000))  # far over a HELLO
+        with pytest.raises(ConnectionClosed) as exc:
+            ws.recv(timeout=10)
+    assert exc.value.rcvd is not None and exc.value.rcvd.code == 1009  # message too big
+    srv.wait_state(run["id"], "waiting_for_client")
+    c = WsClient(url)  # after HELLO, a session's frames up to max_frame pass
+    welcome, nodes = handshake(c, run["id"])
+    assert welcome.n_nodes == 600
+    assert isinstance(run_windows(c, welcome, nodes, 1)[0], Result)
+    c.close()
