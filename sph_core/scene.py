@@ -48,7 +48,8 @@ def retired_page(key: str) -> str:
 
 
 class _Model(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    # allow_inf_nan: t_end = inf or dp = nan in a file is named at once as not finite
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
 
     @model_validator(mode="before")
     @classmethod
@@ -593,6 +594,10 @@ def load_scene(path: str | Path) -> Scene:
         raise SceneError(f"scene file not found: {path}") from None
     except tomllib.TOMLDecodeError as exc:
         raise SceneError(f"{path}: not valid TOML ({exc})") from None
+    except UnicodeDecodeError as exc:
+        raise SceneError(f"{path}: not UTF-8 text (byte {exc.start}): a scene file is TOML") from None
+    except OSError as exc:  # a directory, no permission
+        raise SceneError(f"{path}: cannot be read ({exc.strerror or exc})") from None
     try:
         return make_scene(split_scene_file(data)[0])
     except SceneError as exc:
