@@ -31,6 +31,8 @@ class Settings(BaseModel):
     max_body: int = Field(1024 * 1024, ge=1024, description="largest POST /runs body [bytes]")
     max_frame: int = Field(16 * 1024 * 1024, ge=4104, le=16 * 1024 * 1024,
                            description="largest coupling frame payload [bytes]")
+    header_timeout: float = Field(10.0, gt=0, description="[s] for an HTTP request's line and "
+                                  "headers, from the connection or the previous response")
     hello_timeout: float = Field(30.0, gt=0, description="[s] for the first frame after connect")
     idle_timeout: float = Field(600.0, gt=0, description="[s] between client frames")
     keepalive_every: float = Field(5.0, gt=0, description="[s] between WORKING frames while a "

@@ -327,3 +327,36 @@ def test_websocket_door_refuses_a_big_message_before_hello_at_its_header(srv):
     assert welcome.n_nodes == 600
     assert isinstance(run_windows(c, welcome, nodes, 1)[0], Result)
     c.close()
+
+
+# an HTTP request head that never ends is cut (slowloris) ----------------------------------------
+def test_incomplete_request_head_is_closed_after_header_timeout(tmp_path, factory):
+    import socket
+    import time
+
+    from coupling_client import WsClient, handshake, run_windows
+
+    with live_server(tmp_path, factory, header_timeout=0.5) as srv:
+        run = srv.create()
+        srv.wait_state(run["id"], "waiting_for_client")
+        ws = WsClient(f"ws://127.0.0.1:{srv.port}/runs/{run['id']}/couple")
+        welcome, nodes = handshake(ws, run["id"])
+        slow = socket.create_connection(("127.0.0.1", srv.port), timeout=10)
+        slow.sendall(b"GET /runs HTTP/1.1\r\nHost: 127.0.0.1\r\nX-a: ")
+        deadline = time.monotonic() + 10
+        while True:  # one more header byte now and then, as a slowloris client does
+            try:
+                slow.sendall(b"a")
+                slow.settimeout(0.2)
+                if slow.recv(1) == b"":
+                    break
+            except socket.timeout:
+                pass
+            except OSError:
+                break
+            assert time.monotonic() < deadline, "the incomplete request was never closed"
+        slow.close()
+        # served requests and an upgraded WebSocket outlive the header timeout
+        assert srv.http.get("/runs").status_code == 200
+        run_windows(ws, welcome, nodes, 1)
+        ws.close()
