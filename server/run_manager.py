@@ -337,6 +337,8 @@ class RunManager:
             self.queue.remove(run.info.id)
             self._set_state(run, CANCELLED, "cancelled by the user")
             self._queue_positions()
+        elif run.info.state == QUEUED and not self.stopping:  # its engine is being built: the
+            self._set_state(run, CANCELLED, "cancelled by the user")  # build's end is dropped
         # a starting, waiting or running run ends in its own task, which sets the state
 
     @property
@@ -427,6 +429,8 @@ class RunManager:
             run.info.detail = None
             if run.resume_from is not None:
                 await loop.run_in_executor(self.builder, run.engine.load_state, run.resume_from)
+            if run.terminal:  # cancelled while it was built (state already set)
+                return
             run.info.particles = run.engine.n_particles
             run.info.t, run.info.steps = run.engine.t, run.engine.steps
             need = set_payload_size(run.engine.nodes().x.size)
@@ -464,7 +468,8 @@ class RunManager:
             else:
                 await run.session_done.wait()  # the door sets the final state
         except Exception as exc:  # noqa: BLE001
-            self._fail(run, exc)
+            if not run.terminal:  # a run cancelled while it was built stays cancelled
+                self._fail(run, exc)
         finally:
             try:  # closing flushes files: on a full disk it raises, and the slot must still go
                 if run.gauges:

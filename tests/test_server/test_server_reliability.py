@@ -360,3 +360,25 @@ def test_incomplete_request_head_is_closed_after_header_timeout(tmp_path, factor
         assert srv.http.get("/runs").status_code == 200
         run_windows(ws, welcome, nodes, 1)
         ws.close()
+
+
+def test_delete_while_the_engine_is_built_is_cancelled_at_once(tmp_path, factory, engines):
+    import threading
+
+    building, release = threading.Event(), threading.Event()
+
+    def slow(request, run_dir):
+        building.set()
+        release.wait(30)
+        return factory(request, run_dir)
+
+    with live_server(tmp_path, slow) as srv:
+        try:
+            run = srv.create()
+            assert building.wait(10)
+            assert srv.http.delete(f"/runs/{run['id']}").json()["state"] == "cancelled"
+        finally:
+            release.set()
+        wait_until(lambda: engines and engines[0].closed, "the late engine is closed", 10)
+        wait_until(lambda: not srv.manager.waiting, "the waiting place is free", 10)
+        assert srv.http.get(f"/runs/{run['id']}").json()["state"] == "cancelled"  # and stays so
