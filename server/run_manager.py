@@ -509,6 +509,8 @@ class RunManager:
         """The reserving client left before its session began."""
         if not run.attached.is_set():
             run.client_attached = False
+            if run.info.id in self.queue:  # clientless again: it expires again
+                self._wait_for_client(run)
 
     async def attach(self, run: Run) -> None:
         """Wait until the reserved run is built and a stepping slot is free, then take the slot.
