@@ -8,8 +8,9 @@ of the doors use a deterministic double. ``solve_window`` raises protocol.Protoc
 (BAD_VALUE) for boundary data the solver cannot use, UnstableError when the run blows up.
 
 An engine with a ``cancel`` attribute gets the run's cancel flag (a threading.Event) there
-once built; its ``solve_window`` checks it between chunks of steps and raises SolveCancelled,
-so DELETE or a server stop ends even a window that takes hours.
+once built; its ``solve_window`` checks it between chunks of steps and raises SolveCancelled
+(the flume once the window has solved 2 s: a short window still ends on its boundary), so
+DELETE or a server stop ends even a window that takes hours.
 """
 
 from __future__ import annotations

@@ -11,9 +11,10 @@ Three caps, so that runs whose client never comes cannot block the server:
   refused (HTTP 429 with Retry-After).
 
 A coupled run whose client does not come within ``client_wait_timeout`` of its POST (queued or
-built) fails, freeing its places. A claimed run (resumed by its owner, or reserved by its
-client's HELLO) goes to the head of the queue and needs no waiting place: it is never stuck
-behind clientless runs of strangers, and a resume is never refused for a full queue.
+built) fails, freeing its places. A run resumed by its owner goes to the head of the queue and
+needs no waiting place: it is never stuck behind clientless runs of strangers, and a resume is
+never refused for a full queue. A queued run whose client has said HELLO goes to the head of
+the queue too, and takes the next waiting place.
 
 Everything here runs on the event loop except the SPH work, which goes to a thread pool
 (``Run.executor``): numba releases the GIL in its parallel loops, and Python threads switch every
@@ -90,10 +91,9 @@ class Run:
         return self.info.state in TERMINAL
 
     @property
-    def claimed(self) -> bool:
-        """Its owner asked for it again (resume) or its client is here (HELLO): takes no
-        waiting place and jumps the queue."""
-        return self.client_attached or self.resume_from is not None
+    def resumed_here(self) -> bool:
+        """Its owner asked for it again (resume): it takes no waiting place."""
+        return self.resume_from is not None
 
 
 SourceDriver = Callable[["RunManager", Run], Awaitable[None]]
@@ -305,11 +305,12 @@ class RunManager:
         place, any other run a stepping slot (so one kind never waits behind the other)."""
         if self.stopping:
             return
-        for rid in list(self.queue):
+        # runs whose client is here first, in queue order (a stable sort), then the others
+        for rid in sorted(self.queue, key=lambda r: not self.runs[r].client_attached):
             run = self.runs[rid]
             if _waits_for_client(run.request):
-                unclaimed = sum(1 for w in self.waiting if not self.runs[w].claimed)
-                if unclaimed >= self.settings.max_waiting and not run.claimed:
+                places = sum(1 for w in self.waiting if not self.runs[w].resumed_here)
+                if places >= self.settings.max_waiting and not run.resumed_here:
                     continue
                 self.waiting.add(rid)
             else:
@@ -500,8 +501,6 @@ class RunManager:
             raise ValueError(f"run {run_id} is {run.info.status}: it takes no coupling client")
         run.client_attached = True
         if run.info.id in self.queue:  # its client is here: ahead of clientless runs
-            self.queue.remove(run.info.id)
-            self.queue.appendleft(run.info.id)
             self._schedule()
         return run
 

@@ -300,14 +300,11 @@ def test_client_of_a_queued_run_reserves_it_and_waits_for_welcome(tmp_path, fact
         late = TcpClient(srv.tcp_port)
         late.request(Hello(1, bytes(32), other["id"], "late"))
         late.session.reply(*late.recv(), expect=Welcome)
-        # cancelling a reserved run whose client waits for a stepping slot tells that client
-        # (a reserved run needs no waiting place: it goes ahead of clientless ones)
-        filler = srv.create()
+        # cancelling a reserved, still queued run tells its waiting client
+        filler = srv.create()  # takes the one waiting place
         srv.wait_state(filler["id"], "waiting_for_client")
-        filling = TcpClient(srv.tcp_port)
-        filling.request(Hello(1, bytes(32), filler["id"], "filling"))
-        filling.session.reply(*filling.recv(), expect=Welcome)  # both stepping slots busy now
         third = srv.create()
+        assert srv.http.get(f"/runs/{third['id']}").json()["state"] == "queued"
         waiter = TcpClient(srv.tcp_port)
         waiter.request(Hello(1, bytes(32), third["id"], "waiter"))
         srv.http.delete(f"/runs/{third['id']}")
