@@ -43,6 +43,7 @@ class EngineDouble:
         self.gate = gate  # a solve waits until the test sets it (no timing guess under load)
         if honours_cancel:  # as the flume engine: the server hands it the run's cancel flag
             self.cancel: threading.Event | None = None
+        self.cancelled_solves = 0
         self.in_force = {"u": np.zeros(n), "w": np.zeros(n), "eta": np.zeros(n)}
         self.pending: tuple[float, float, dict[str, np.ndarray]] | None = None
         self.imposed: list[tuple[float, float, float]] = []  # (t, mean u, mean eta) per sub-step
@@ -62,6 +63,7 @@ class EngineDouble:
         deadline = time.monotonic() + 60.0
         while self.gate is not None and not self.gate.wait(0.01):
             if getattr(self, "cancel", None) is not None and self.cancel.is_set():
+                self.cancelled_solves += 1
                 raise SolveCancelled()
             if time.monotonic() > deadline:
                 raise RuntimeError("test double: the gate was never opened")

@@ -382,3 +382,25 @@ def test_delete_while_the_engine_is_built_is_cancelled_at_once(tmp_path, factory
         wait_until(lambda: engines and engines[0].closed, "the late engine is closed", 10)
         wait_until(lambda: not srv.manager.waiting, "the waiting place is free", 10)
         assert srv.http.get(f"/runs/{run['id']}").json()["state"] == "cancelled"  # and stays so
+
+
+def test_client_gone_during_a_window_that_never_ends_stops_the_window(tmp_path, factory, engines):
+    import threading
+
+    import numpy as np
+
+    from protocol import Capability, Set, Solve
+
+    gate = threading.Event()  # never opened: the window would take for ever
+    with live_server(tmp_path, lambda r, d: factory(r, d, gate=gate, honours_cancel=True),
+                     max_runs=1, keepalive_every=0.05) as srv:
+        run = srv.create()
+        c, welcome, nodes = srv.couple(run["id"], caps=int(Capability.KEEPALIVE))
+        n = welcome.n_nodes
+        c.request(Set(0.0, 0.05, np.zeros(n), np.zeros(n), np.zeros(n)), Solve())
+        c.recv()  # a WORKING frame: the window is being solved
+        c.close()  # the client vanishes mid-window
+        info = srv.wait_state(run["id"], "failed", timeout=10)
+        assert info["status"] == "failed: client disconnected"
+        wait_until(lambda: engines[0].cancelled_solves == 1, "the window stopped", 10)
+        wait_until(lambda: engines[0].closed and not srv.manager.active, "the slot is free", 10)
