@@ -8,7 +8,8 @@ HTTP (OpenAPI docs at /docs):
                                      source: {theory, H, T, ...} (standalone with open ends)}
                                     201; 400 not JSON, 413 > max_body, 422 names the field (every
                                     number finite, the cross-field rules of server/validation.py),
-                                    429 queue full (Retry-After)
+                                    415 not JSON/TOML Content-Type, 429 queue full
+                                    (Retry-After), 507 the store cannot write
     GET    /runs                    every run, including those of earlier server processes
     GET    /runs/{id}               status, t, steps, particles, particle_steps_per_s,
                                     coupling_overhead_share, stability, last_gauges, scene_hash

@@ -17,12 +17,43 @@ from typing import Any
 from server.settings import Settings
 
 
+def head_timeout_protocol(timeout: float) -> type:
+    """uvicorn's h11 HTTP protocol, closing a connection whose request head (request line and
+    headers) has not all come within ``timeout`` seconds of the connection or of the previous
+    response. uvicorn has no such limit: a client sending a header line now and then (slowloris)
+    held its connection for ever. A request being served (an event stream, a body) and a
+    connection upgraded to a WebSocket are never cut."""
+    from uvicorn.protocols.http.h11_impl import H11Protocol
+
+    class HeadTimeoutH11(H11Protocol):
+        def connection_made(self, transport: Any) -> None:
+            super().connection_made(transport)
+            self._arm_head_timer()
+
+        def on_response_complete(self) -> None:
+            super().on_response_complete()
+            self._arm_head_timer()
+
+        def _arm_head_timer(self) -> None:
+            self.loop.call_later(timeout, self._head_due, self.cycle)
+
+        def _head_due(self, cycle: Any) -> None:
+            transport = self.transport
+            if (self.cycle is cycle  # no request head has come since the timer was armed
+                    and (cycle is None or cycle.response_complete)
+                    and transport.get_protocol() is self and not transport.is_closing()):
+                transport.close()
+
+    return HeadTimeoutH11
+
+
 def uvicorn_config(app: Any, settings: Settings, *, log_level: str = "info") -> Any:
     """A ``uvicorn.Config`` serving ``app`` on ``settings.host:settings.port``."""
     import uvicorn
 
     return uvicorn.Config(
         app, host=settings.host, port=settings.port, log_level=log_level, lifespan="on",
+        http=head_timeout_protocol(settings.header_timeout),
         ws_max_size=settings.max_frame + 16,  # one frame = one message: header + payload
         ws_per_message_deflate=False,  # float64 arrays do not compress: deflate only costs time
         ws_ping_interval=settings.ws_ping_interval,

@@ -54,7 +54,7 @@ def websocket_subprotocol(ws: WebSocket) -> str | None:
     return SUBPROTOCOL if SUBPROTOCOL in ws.scope.get("subprotocols", []) else None
 
 
-_TOKEN_IN_URL = re.compile(r"([?&](?:access_)?token=)[^&\s\"']*")
+_TOKEN_IN_URL = re.compile(r"([?&](?:access_)?token=)[^&\s\"']*", re.IGNORECASE)  # ?TOKEN= too
 
 
 def redact_tokens(text: str) -> str:
@@ -84,7 +84,8 @@ def redact_tokens_in_server_logs() -> None:
 def get_run(run_id: str, manager: Annotated[RunManager, Depends(get_manager)]) -> Run:
     run = manager.runs.get(run_id)
     if run is None:
-        raise HTTPException(404, f"no run {run_id!r}")
+        # never the whole id: a 70 kB path would come back in the reply
+        raise HTTPException(404, f"no run {run_id[:80]!r}" + (" (cut)" if len(run_id) > 80 else ""))
     return run
 
 

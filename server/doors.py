@@ -22,7 +22,7 @@ from protocol import (NO_SCENE_HASH, Capability, ErrorCode, GaugeKind, Gauges, N
 from protocol.messages import Error, Hello, Message, Working
 from protocol.session import Measure, PeerError, Reply, Restore, SetWindow, SolveWindow
 
-from .engine import CouplingEngine, Measurement
+from .engine import CouplingEngine, Measurement, SolveCancelled
 from .run_manager import Run, RunManager
 from .schemas import FAILED, FINISHED, RUNNING, UNSTABLE
 from .store import save_sealed
@@ -195,7 +195,7 @@ async def serve_client(manager: RunManager, run: Run, transport: DoorTransport,
                 if max(recent) < INLINE_SOLVE_S:
                     measured = _solve(engine, run, window, goback)
                 else:
-                    measured = await _working(session, transport, settings.keepalive_every,
+                    measured = await _working(session, transport, settings.keepalive_every, run,
                                               loop.run_in_executor(manager.executor, _solve, engine,
                                                                    run, window, goback))
                 at_boundary = True
@@ -212,13 +212,13 @@ async def serve_client(manager: RunManager, run: Run, transport: DoorTransport,
                     await _save_state(manager, run)  # by wall time and by simulated progress
                     saved_at, saved_t = time.monotonic(), engine.t
             elif isinstance(action, Measure):
-                measured = await _working(session, transport, settings.keepalive_every,
+                measured = await _working(session, transport, settings.keepalive_every, run,
                                           loop.run_in_executor(manager.executor, engine.measure))
                 await transport.send(session.result(action, _result(measured)))
             elif isinstance(action, Restore):
                 window = None
                 at_boundary = False
-                measured = await _working(session, transport, settings.keepalive_every,
+                measured = await _working(session, transport, settings.keepalive_every, run,
                                           loop.run_in_executor(manager.executor, _goback, engine))
                 at_boundary = True
                 run.gauges.rewind()
@@ -231,7 +231,7 @@ async def serve_client(manager: RunManager, run: Run, transport: DoorTransport,
                 raise _Cancel()
     except _SessionEnd as exc:
         end = exc
-    except _Cancel:
+    except (_Cancel, SolveCancelled):
         state, reason = manager.cancel_reason
         end = _SessionEnd(state, reason, session.error_frame(ProtocolError(ErrorCode.CANCELLED, reason)))
     except (_Gone, PeerGone):
@@ -262,11 +262,13 @@ async def serve_client(manager: RunManager, run: Run, transport: DoorTransport,
         await asyncio.wait_for(transport.close(), 5.0)
     except Exception:  # noqa: BLE001
         pass
-    if at_boundary and end.state != UNSTABLE and run.info.windows > 0:
-        await _save_state(manager, run)  # what a resumed session starts from
-    _progress(manager, run, engine, None, connected, solve_time)
-    manager._set_state(run, end.state, end.reason)
-    run.session_done.set()
+    try:
+        if at_boundary and end.state != UNSTABLE and run.info.windows > 0:
+            await _save_state(manager, run)  # what a resumed session starts from
+        _progress(manager, run, engine, None, connected, solve_time)
+    finally:  # whatever failed above (a full disk), the run ends and its slot is released
+        manager._set_state(run, end.state, end.reason)
+        run.session_done.set()
 
 
 class _Gone(Exception):
@@ -314,10 +316,12 @@ class _Reader:
         self.watcher.cancel()
 
 
-async def _working(session: SphSession, transport: DoorTransport, every: float,
+async def _working(session: SphSession, transport: DoorTransport, every: float, run: Run,
                    job: asyncio.Future) -> Measurement:
     """``job``'s result; meanwhile a WORKING frame every ``every`` seconds if the client asked
-    for KEEPALIVE (1.1): the first window waits for the solver's JIT compile."""
+    for KEEPALIVE (1.1): the first window waits for the solver's JIT compile. A client found
+    gone by a WORKING frame stops the window (the run's cancel flag, server/engine.py), and
+    PeerGone is raised only once the worker is done with the engine (it is closed next)."""
     if session.working_frame(0.0) is None:
         return await job
     tic = time.perf_counter()
@@ -327,7 +331,13 @@ async def _working(session: SphSession, transport: DoorTransport, every: float,
             return job.result()
         frame = session.working_frame(time.perf_counter() - tic)
         assert frame is not None
-        await transport.send(frame)
+        try:
+            await transport.send(frame)
+        except PeerGone:
+            run.cancel_flag.set()
+            await asyncio.wait({job})
+            job.exception()  # retrieved: SolveCancelled, or none; the client's leaving says it
+            raise
 
 
 def _solve(engine: CouplingEngine, run: Run, window: SetWindow, checkpoint: bool) -> Measurement:

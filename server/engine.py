@@ -6,6 +6,11 @@ protocol and call it from a worker thread, never on the event loop; per window t
 worker call. The production engine is server/flume_engine.py (an sph_core Simulation with open ends); the tests
 of the doors use a deterministic double. ``solve_window`` raises protocol.ProtocolError
 (BAD_VALUE) for boundary data the solver cannot use, UnstableError when the run blows up.
+
+An engine with a ``cancel`` attribute gets the run's cancel flag (a threading.Event) there
+once built; its ``solve_window`` checks it between chunks of steps and raises SolveCancelled
+(the flume once the window has solved 2 s: a short window still ends on its boundary), so
+DELETE or a server stop ends even a window that takes hours.
 """
 
 from __future__ import annotations
@@ -17,6 +22,10 @@ from typing import Callable, Protocol
 import numpy as np
 
 from .schemas import RunRequest
+
+
+class SolveCancelled(Exception):
+    """The run was cancelled while its engine solved a window (state mid-window: not saved)."""
 
 
 @dataclass(frozen=True)

@@ -14,6 +14,8 @@ Protocol view of the flume (PROTOCOL.md):
 from __future__ import annotations
 
 import math
+import threading
+import time
 from dataclasses import replace
 from pathlib import Path
 
@@ -26,11 +28,12 @@ from sph_core.open_ends import SIDES
 from sph_core.scene import PointProbe, Scene
 from sph_core.simulation import Simulation
 
-from .engine import EngineNodes, Measurement, SceneSummary
+from .engine import EngineNodes, Measurement, SceneSummary, SolveCancelled
 from .schemas import RunRequest
 from .store import fresh_path  # sph/, then sph.1/ ... for resumed sessions
 
 REF = "_ref"  # suffix of the point probes the engine adds at z_ref
+CANCEL_GRACE_S = 2.0  # [s] of solving before a cancelled run's window is cut
 
 
 def ref_scene(scene: Scene, z_ref: float) -> tuple[Scene, list[str], list[float]]:
@@ -89,6 +92,9 @@ class FlumeEngine:
         self._window: tuple[float, float, dict[str, BoundarySample]] | None = None
         self._saved = None
         self._window_steps = 0
+        self.cancel: threading.Event | None = None  # the run's cancel flag (server/engine.py)
+        self.cancel_grace = CANCEL_GRACE_S
+        self._solve_started = 0.0
 
     # -- clock and size --------------------------------------------------------------------
     @property
@@ -120,14 +126,23 @@ class FlumeEngine:
             raise RuntimeError("solve_window before set_window")
         _, t1, samples = self._window
         before = self.flume.steps
+        self._solve_started = time.perf_counter()
         try:
-            self.flume.advance_window(t1, **samples)
+            self.flume.advance_window(t1, **samples, progress=self._check_cancel)
         except BoundaryDataError as exc:  # the client's data, not our failure
             raise ProtocolError(ErrorCode.BAD_VALUE, f"SET: {exc}") from None
         finally:
             self._window = None
         m = self.measure()
         return Measurement(m.eta, m.wet, m.u_ref, m.w_ref, steps=self.flume.steps - before)
+
+    def _check_cancel(self, _: Simulation) -> None:
+        """Called between chunks of steps (sph_core STEPS_PER_CALL) and at each output: a
+        cancelled run's window is cut once it has solved ``cancel_grace`` s (a window that ends
+        soon ends on its boundary, whose state is saved for resuming)."""
+        if (self.cancel is not None and self.cancel.is_set()
+                and time.perf_counter() - self._solve_started >= self.cancel_grace):
+            raise SolveCancelled()
 
     def measure(self) -> Measurement:
         values = self.flume.probe_values()

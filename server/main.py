@@ -13,6 +13,7 @@ from fastapi.responses import JSONResponse
 from .deps import redact_tokens_in_server_logs
 from .engine import EngineFactory
 from .flume_engine import flume_engine
+from .guard import LoopbackGuard
 from .routers import couple, pages, runs
 from .run_manager import RunManager
 from .schemas import RunRequest
@@ -70,5 +71,6 @@ def create_app(settings: Settings | None = None,
         return app.openapi_schema
 
     app.openapi = openapi  # type: ignore[method-assign]
+    app.add_middleware(LoopbackGuard, enabled=settings.loopback_only)  # CSRF, DNS rebinding
     pages.install(app)  # the run monitor at /, offline /docs (server/routers/pages.py)
     return app

@@ -6,7 +6,15 @@ Three caps, so that runs whose client never comes cannot block the server:
   holds none; a client's HELLO reserves its run (``reserve``) and waits in ``attach`` while the
   run is queued or every slot is busy.
 - ``max_waiting`` coupled runs built (engine in memory) and waiting for their client;
-- ``max_queued`` runs in the queue; one more is refused (HTTP 429 with Retry-After).
+- ``max_queued`` runs of each kind in the queue (coupled runs waiting for a client, and the
+  others, counted apart: clientless coupled POSTs never lock standalone runs out); one more is
+  refused (HTTP 429 with Retry-After).
+
+A coupled run whose client does not come within ``client_wait_timeout`` of its POST (queued or
+built) fails, freeing its places. A run resumed by its owner goes to the head of the queue and
+needs no waiting place: it is never stuck behind clientless runs of strangers, and a resume is
+never refused for a full queue. A queued run whose client has said HELLO goes to the head of
+the queue too, and takes the next waiting place.
 
 Everything here runs on the event loop except the SPH work, which goes to a thread pool
 (``Run.executor``): numba releases the GIL in its parallel loops, and Python threads switch every
@@ -17,6 +25,7 @@ from __future__ import annotations
 
 import asyncio
 import logging
+import math
 import threading
 import time
 import uuid
@@ -62,6 +71,7 @@ class Run:
         self.task_client: asyncio.Task | None = None   # the built-in theory client, if any
         self.client_attached = False
         self.resume_from: Path | None = None
+        self.wait_deadline = math.inf             # monotonic [s]: no client by then, it fails
         self._saved_at = 0.0
 
     @property
@@ -79,6 +89,11 @@ class Run:
     @property
     def terminal(self) -> bool:
         return self.info.state in TERMINAL
+
+    @property
+    def resumed_here(self) -> bool:
+        """Its owner asked for it again (resume): it takes no waiting place."""
+        return self.resume_from is not None
 
 
 SourceDriver = Callable[["RunManager", Run], Awaitable[None]]
@@ -101,6 +116,7 @@ class RunManager:
         self.executor = ThreadPoolExecutor(max_workers=settings.max_runs, thread_name_prefix="sph")
         self.builder = ThreadPoolExecutor(max_workers=1, thread_name_prefix="sph-build")
         self.stopping = False
+        self.unsaved: set[str] = set()   # runs whose last meta.json write failed (disk full)
         self._changed = asyncio.Event()
         self._load_existing()
 
@@ -135,6 +151,7 @@ class RunManager:
                 run.resume_from = run.state_file
             run.info.ended = None
             self.queue.append(run.info.id)
+            self._wait_for_client(run)
             self._set_state(run, QUEUED)
             log.info("run %s: queued again (it had not started when the server stopped)",
                      run.info.id)
@@ -179,9 +196,24 @@ class RunManager:
         return force or time.monotonic() - run._saved_at >= self.settings.meta_interval
 
     def save(self, run: Run, force: bool = True) -> None:
-        if self.save_due(run, force):
-            run._saved_at = time.monotonic()
+        """meta.json of the run; a failed write (a full disk) is logged, never raised: the run's
+        state in memory still moves on and its slot is released (written again when it can)."""
+        if not self.save_due(run, force):
+            return
+        run._saved_at = time.monotonic()
+        try:
             self.store.save(run.info)
+        except OSError as exc:
+            self.unsaved.add(run.info.id)
+            log.error("run %s: could not write meta.json: %s", run.info.id, exc)
+            return
+        self.unsaved.discard(run.info.id)
+        for rid in list(self.unsaved):  # the disk has room again: records that missed a write
+            try:
+                self.store.save(self.runs[rid].info)
+            except OSError:
+                return
+            self.unsaved.discard(rid)
 
     def _set_state(self, run: Run, state: str, reason: str | None = None) -> None:
         run.info.state = state
@@ -207,13 +239,33 @@ class RunManager:
             self.runs[rid].info.queue_position = i + 1
 
     # ------------------------------------------------------------------ lifecycle
-    def _check_queue_room(self) -> None:
-        if len(self.queue) >= self.settings.max_queued:
-            raise QueueFull(f"the queue holds {len(self.queue)} runs, the server's max_queued: "
+    def _check_queue_room(self, request: RunRequest) -> None:
+        kind = _waits_for_client(request)
+        queued = sum(1 for rid in self.queue if _waits_for_client(self.runs[rid].request) == kind)
+        if queued >= self.settings.max_queued:
+            what = "coupled runs waiting for a client" if kind else "standalone runs"
+            raise QueueFull(f"the queue holds {queued} {what}, the server's max_queued: "
                             f"retry when a run has ended")
 
+    def _wait_for_client(self, run: Run) -> None:
+        """A coupled run fails if no client comes within client_wait_timeout from now (queued
+        or built: a queue of clientless runs empties by itself)."""
+        if not _waits_for_client(run.request):
+            return
+        timeout = self.settings.client_wait_timeout
+        run.wait_deadline = time.monotonic() + timeout
+        deadline = run.wait_deadline
+
+        def expire() -> None:
+            if (run.wait_deadline == deadline and run.info.id in self.queue
+                    and not run.client_attached):
+                self.queue.remove(run.info.id)
+                self._set_state(run, FAILED, f"no client connected within {timeout:g} s")
+                self._queue_positions()
+        asyncio.get_running_loop().call_later(timeout, expire)
+
     def submit(self, request: RunRequest) -> Run:
-        self._check_queue_room()
+        self._check_queue_room(request)
         run_id = uuid.uuid4().hex  # 128 random bits: also the credential on the TCP port
         scene_bytes = canonical_scene(request.scene)
         from protocol import scene_hash
@@ -226,6 +278,7 @@ class RunManager:
         run = Run(info, request, run_dir)
         self.runs[run_id] = run
         self.queue.append(run_id)
+        self._wait_for_client(run)
         self._queue_positions()
         self.save(run)
         self._schedule()
@@ -238,13 +291,13 @@ class RunManager:
         if not run.info.resumable:
             raise ValueError(f"run {run.info.id} is {run.info.status}: only a failed or cancelled "
                              f"coupled run with a saved state can be resumed")
-        self._check_queue_room()
         run.reset_live_parts()
         run.resume_from = run.state_file
         run.info.resumed += 1
         run.info.ended = None
         self._set_state(run, QUEUED)
-        self.queue.append(run.info.id)
+        self.queue.appendleft(run.info.id)  # its owner's run: ahead of strangers' new ones
+        self._wait_for_client(run)
         self._queue_positions()
         self._schedule()
 
@@ -253,10 +306,12 @@ class RunManager:
         place, any other run a stepping slot (so one kind never waits behind the other)."""
         if self.stopping:
             return
-        for rid in list(self.queue):
+        # runs whose client is here first, in queue order (a stable sort), then the others
+        for rid in sorted(self.queue, key=lambda r: not self.runs[r].client_attached):
             run = self.runs[rid]
             if _waits_for_client(run.request):
-                if len(self.waiting) >= self.settings.max_waiting:
+                places = sum(1 for w in self.waiting if not self.runs[w].resumed_here)
+                if places >= self.settings.max_waiting and not run.resumed_here:
                     continue
                 self.waiting.add(rid)
             else:
@@ -284,6 +339,8 @@ class RunManager:
             self.queue.remove(run.info.id)
             self._set_state(run, CANCELLED, "cancelled by the user")
             self._queue_positions()
+        elif run.info.state == QUEUED and not self.stopping:  # its engine is being built: the
+            self._set_state(run, CANCELLED, "cancelled by the user")  # build's end is dropped
         # a starting, waiting or running run ends in its own task, which sets the state
 
     @property
@@ -308,6 +365,7 @@ class RunManager:
                 self._set_state(run, FAILED, "server stopped before the run ended")
         self.executor.shutdown(wait=False, cancel_futures=True)
         self.builder.shutdown(wait=False, cancel_futures=True)
+        self.store.close()
 
     # ------------------------------------------------------------------ standalone
     async def _standalone(self, run: Run) -> None:
@@ -371,9 +429,13 @@ class RunManager:
         loop = asyncio.get_running_loop()
         try:
             run.engine = await loop.run_in_executor(self.builder, self._build, run)
+            if hasattr(run.engine, "cancel"):  # it stops a long window when the run is cancelled
+                run.engine.cancel = run.cancel_flag
             run.info.detail = None
             if run.resume_from is not None:
                 await loop.run_in_executor(self.builder, run.engine.load_state, run.resume_from)
+            if run.terminal:  # cancelled while it was built (state already set)
+                return
             run.info.particles = run.engine.n_particles
             run.info.t, run.info.steps = run.engine.t, run.engine.steps
             need = set_payload_size(run.engine.nodes().x.size)
@@ -393,8 +455,10 @@ class RunManager:
                 run.info.detail = compile_detail("first window")
                 run.attached.set()
                 run.task_client = asyncio.get_running_loop().create_task(self.source_driver(self, run))
-            while True:
-                woke = await _first_of(run.attached, run.cancelled, self.settings.client_wait_timeout)
+            while True:  # a reserving client waits for a slot: its run does not expire then
+                left = run.wait_deadline - time.monotonic()
+                woke = await _first_of(run.attached, run.cancelled, None if math.isinf(left)
+                                       else max(left, 1.0 if run.client_attached else 0.0))
                 if woke is None and run.client_attached:
                     continue  # its client is connected (reserved it) and waits for a slot
                 break
@@ -409,13 +473,18 @@ class RunManager:
             else:
                 await run.session_done.wait()  # the door sets the final state
         except Exception as exc:  # noqa: BLE001
-            self._fail(run, exc)
+            if not run.terminal:  # a run cancelled while it was built stays cancelled
+                self._fail(run, exc)
         finally:
-            if run.gauges:
-                run.gauges.close()
-            if run.engine:
-                await loop.run_in_executor(self.builder, run.engine.close)
-            self._release(run)
+            try:  # closing flushes files: on a full disk it raises, and the slot must still go
+                if run.gauges:
+                    run.gauges.close()
+                if run.engine:
+                    await loop.run_in_executor(self.builder, run.engine.close)
+            except Exception as exc:  # noqa: BLE001
+                log.error("run %s: closing its files failed: %s", run.info.id, exc)
+            finally:
+                self._release(run)
 
     def _build(self, run: Run) -> CouplingEngine:
         """Builder thread: the run's engine (the detail's check imports sph_core off the loop)."""
@@ -435,12 +504,16 @@ class RunManager:
         if run.info.state not in (QUEUED, WAITING) or not _waits_for_client(run.request):
             raise ValueError(f"run {run_id} is {run.info.status}: it takes no coupling client")
         run.client_attached = True
+        if run.info.id in self.queue:  # its client is here: ahead of clientless runs
+            self._schedule()
         return run
 
     def unreserve(self, run: Run) -> None:
         """The reserving client left before its session began."""
         if not run.attached.is_set():
             run.client_attached = False
+            if run.info.id in self.queue:  # clientless again: it expires again
+                self._wait_for_client(run)
 
     async def attach(self, run: Run) -> None:
         """Wait until the reserved run is built and a stepping slot is free, then take the slot.
@@ -487,8 +560,9 @@ def _windowed(request: RunRequest) -> bool:
     return request.mode == "coupled" or request.source is not None
 
 
-async def _first_of(a: asyncio.Event, b: asyncio.Event, timeout: float) -> asyncio.Event | None:
-    """Whichever event is set first, or None after ``timeout`` seconds."""
+async def _first_of(a: asyncio.Event, b: asyncio.Event,
+                    timeout: float | None) -> asyncio.Event | None:
+    """Whichever event is set first, or None after ``timeout`` seconds (None: no limit)."""
     waits = {asyncio.ensure_future(a.wait()): a, asyncio.ensure_future(b.wait()): b}
     done, pending = await asyncio.wait(waits, timeout=timeout, return_when=asyncio.FIRST_COMPLETED)
     for f in pending:

@@ -24,7 +24,9 @@ class Settings(BaseModel):
                                                "client's HELLO on)")
     max_waiting: int = Field(4, ge=1, description="coupled runs built and waiting for their client "
                                                   "(each holds its particles in memory)")
-    max_queued: int = Field(32, ge=0, description="runs in the queue; beyond: HTTP 429")
+    max_queued: int = Field(32, ge=0, description="runs of each kind (coupled, standalone) in "
+                                                 "the queue; beyond: HTTP 429 (a resume is "
+                                                 "never refused)")
     max_particles: int = Field(2_000_000, ge=1, description="particle-count cap per run")
     device: Literal["cpu", "cuda"] = Field("cpu", description="where a run's SPH steps run when "
                                            "its scene does not say ([run] device)")
@@ -32,6 +34,8 @@ class Settings(BaseModel):
     max_body: int = Field(1024 * 1024, ge=1024, description="largest POST /runs body [bytes]")
     max_frame: int = Field(16 * 1024 * 1024, ge=4104, le=16 * 1024 * 1024,
                            description="largest coupling frame payload [bytes]")
+    header_timeout: float = Field(10.0, gt=0, description="[s] for an HTTP request's line and "
+                                  "headers, from the connection or the previous response")
     hello_timeout: float = Field(30.0, gt=0, description="[s] for the first frame after connect")
     idle_timeout: float = Field(600.0, gt=0, description="[s] between client frames")
     keepalive_every: float = Field(5.0, gt=0, description="[s] between WORKING frames while a "
@@ -42,7 +46,9 @@ class Settings(BaseModel):
     ws_ping_timeout: float | None = Field(None, gt=0, description="[s] a WebSocket client whose pong "
                                           "is this late is dropped; None (default): never, see "
                                           "server/asgi.py (a dead client is found by idle_timeout)")
-    client_wait_timeout: float = Field(3600.0, gt=0, description="[s] a coupled run waits for its client")
+    client_wait_timeout: float = Field(300.0, gt=0, description="[s] a coupled run waits for its "
+                                       "client, queued or built, from its POST (or resume); then "
+                                       "it fails and its places are free")
     meta_interval: float = Field(0.5, ge=0, description="[s] least time between meta.json rewrites")
     checkpoint_every: float = Field(60.0, gt=0, description="[s] wall time between saved states of "
                                                             "a coupled run (for resuming it)")

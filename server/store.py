@@ -14,13 +14,15 @@
 from __future__ import annotations
 
 import csv
+import fcntl
 import hashlib
 import json
 import logging
 import os
 import re
+import shutil
 from pathlib import Path
-from typing import Any, Callable
+from typing import IO, Any, Callable
 
 from sph_core.output import format_time, write_json_atomic
 
@@ -32,10 +34,24 @@ RUN_ID = re.compile(r"[A-Za-z0-9_-]{1,64}")  # a run's directory name: never a p
 log = logging.getLogger("wavesph.server")
 
 
+LOCK = ".lock"  # held (flock) by the one server that uses the store
+
+
+class StoreLocked(RuntimeError):
+    """Another server holds the run store: two would write the same runs' files."""
+
+
 class RunStore:
     def __init__(self, root: Path) -> None:
         self.root = Path(root)
         self.root.mkdir(parents=True, exist_ok=True)
+        self._lock = lock_store(self.root)
+
+    def close(self) -> None:
+        """Release the store's lock (the server stops)."""
+        if self._lock is not None:
+            self._lock.close()
+            self._lock = None
 
     def run_dir(self, run_id: str) -> Path:
         """The run's directory, inside the store whatever the id says (ValueError if not a name)."""
@@ -46,8 +62,12 @@ class RunStore:
     def create(self, run_id: str, request: dict[str, Any], scene_bytes: bytes) -> Path:
         d = self.run_dir(run_id)
         d.mkdir()
-        write_json_atomic(d / "request.json", request)
-        (d / "scene.json").write_bytes(scene_bytes)
+        try:
+            write_json_atomic(d / "request.json", request)
+            (d / "scene.json").write_bytes(scene_bytes)
+        except OSError:  # a full disk: no half-made run left to be found at the next start
+            shutil.rmtree(d, ignore_errors=True)
+            raise
         return d
 
     def save(self, info: RunInfo) -> None:
@@ -59,6 +79,11 @@ class RunStore:
         a log line, never stops the server."""
         out = []
         for d in sorted(self.root.iterdir()):
+            if d.is_symlink():  # its records would be written outside the store
+                log.warning("run store: skipping %s: a symbolic link, not a run directory", d)
+                continue
+            if d.name == LOCK:
+                continue
             if not d.is_dir() or not RUN_ID.fullmatch(d.name):
                 log.warning("run store: skipping %s: not a run directory", d)
                 continue
@@ -76,6 +101,37 @@ class RunStore:
         return out
 
 
+def lock_store(root: Path) -> IO[str]:
+    """An exclusive lock on ``root``'s lock file, held while the returned file is open; it
+    names this process. StoreLocked (naming the holder) if another server holds it. The OS
+    releases it when the process ends, even on kill -9."""
+    f = open(root / LOCK, "a+")
+    try:
+        fcntl.flock(f, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except OSError:
+        f.seek(0)
+        holder = f.read().strip()[:40] or "unknown"
+        f.close()
+        raise StoreLocked(f"runs dir {root} is in use by another wavesph server (pid {holder}); "
+                          f"give each server its own --runs-dir") from None
+    f.seek(0)
+    f.truncate()
+    f.write(f"{os.getpid()}\n")
+    f.flush()
+    return f
+
+
+def store_in_use(root: Path) -> str | None:
+    """Why a server cannot use the store ``root`` now (another holds it), or None."""
+    if not (Path(root) / LOCK).exists():
+        return None
+    try:
+        lock_store(Path(root)).close()
+    except StoreLocked as exc:
+        return str(exc)
+    return None
+
+
 def _seal_path(path: Path) -> Path:
     return path.with_name(path.name + ".sha256")
 
@@ -90,10 +146,21 @@ def _sha256(path: Path) -> str:
 
 def save_sealed(save: Callable[[Path], None], path: Path) -> None:
     """``save(path)``, then its SHA-256 beside it: a state is trusted only if it matches (a crash
-    between the two leaves a state without a valid seal, which is not resumed)."""
-    _seal_path(path).unlink(missing_ok=True)
+    between the two leaves a state without a valid seal, which is not resumed). ``save`` must
+    replace ``path`` atomically: if it fails (a full disk), the state before and its seal stay."""
     save(path)
-    _seal_path(path).write_text(_sha256(path) + "\n")
+    write_text_atomic(_seal_path(path), _sha256(path) + "\n")
+
+
+def write_text_atomic(path: Path, text: str) -> None:
+    """``text`` to ``path`` through a temporary file, removed if the write fails."""
+    tmp = path.with_name(path.name + ".tmp")
+    try:
+        tmp.write_text(text)
+        os.replace(tmp, path)
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
 
 
 def fresh_path(folder: Path, stem: str, suffix: str = "") -> Path:

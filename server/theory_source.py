@@ -83,6 +83,9 @@ def source_errors(scene: "Scene", mode: str, source: TheorySource | None,
     depth = float(scene.still_water_level) - scene.tank.z0
     try:
         source.build(depth)
+    except ArithmeticError as exc:  # T = 1e-9 s divides by zero in raschii's breaking check
+        return [(["source"], f"the {source.theory} theory cannot be computed for H = {source.H:g} m, "
+                             f"T = {source.T:g} s at depth {depth:g} m ({type(exc).__name__})")]
     except ValueError as exc:
         word = str(exc).split("=")[0].split()[0].strip(":").lower()
         return [(["source", _ERROR_FIELD.get(word, "H")], f"{exc} (depth {depth:g} m at the inlet)")]

@@ -11,6 +11,7 @@ from typing import Protocol
 from fastapi import WebSocket, WebSocketDisconnect
 
 from protocol import ErrorCode, FrameDecoder, ProtocolError, decode_frame
+from protocol.wire import HEADER_SIZE
 from protocol.messages import Message
 
 READ_CHUNK = 1 << 16
@@ -79,6 +80,24 @@ class WebSocketDoor:
     def __init__(self, ws: WebSocket, max_payload: int) -> None:
         self.ws = ws
         self.max_payload = max_payload
+
+    def limit_messages(self, payload: int) -> bool:
+        """Make the WebSocket connection refuse (close 1009) any message over a frame of
+        ``payload`` bytes as it reads its header, before buffering it: the ASGI server's own
+        limit (asgi.py, ws_max_size) is the largest frame of any session, 16 MiB, which a
+        client that has not even said HELLO must not make the server hold. Works on uvicorn's
+        websockets protocols (sans-I/O and legacy), whose limits are read per message; False
+        where the server exposes none (its own limit stays)."""
+        proto = getattr(getattr(self.ws, "_receive", None), "__self__", None)
+        size = payload + HEADER_SIZE
+        conn = getattr(proto, "conn", None)
+        if conn is not None and hasattr(conn, "max_message_size"):
+            conn.max_message_size = size
+            return True
+        if proto is not None and hasattr(proto, "max_size"):
+            proto.max_size = size
+            return True
+        return False
 
     async def recv(self) -> list[tuple[int, Message]] | None:
         try:

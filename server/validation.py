@@ -21,6 +21,7 @@ from .settings import Settings
 from .theory_source import source_errors
 
 MAX_WINDOWS = 10_000_000   # windows of one run: below, window sizes are sane for a clock in float64
+MAX_STEPS = 1e9            # time steps of one run (c0 1e300 m/s: steps of 1e-302 s)
 MAX_ERRORS = 20            # listed in one 422 reply
 MAX_MSG = 500              # characters of one message
 
@@ -128,6 +129,25 @@ def run_errors(body: RunRequest, settings: Settings) -> list[dict[str, Any]]:
         if reason is not None:
             errors.append(error(["scene", "run", "device"], f"device cuda: {reason}"))
     duration = scene.t_end - scene.t_start
+    c = scene.constants
+    floor = math.sqrt(2.0 * c.g * scene.water_height)  # the speed of water falling its height
+    if c.c0 is not None and c.c0 < floor:
+        errors.append(error(["scene", "constants", "c0"], f"{c.c0:g} m/s is below "
+                            f"sqrt(2 g H) = {floor:.3g} m/s: the water would be compressible"))
+    steps = duration * scene.c0 / (c.cfl * scene.h)  # the fewest a run takes: dt <= cfl h / c0
+    if not steps <= MAX_STEPS:
+        errors.append(error(["scene", "constants", "c0" if c.c0 is not None else "c0_factor"],
+                            f"c0 = {scene.c0:.3g} m/s makes more than {MAX_STEPS:.0e} time steps "
+                            f"of the run's {duration:g} s"))
+    if scene.open_boundaries:
+        from sph_core.open_ends import check_open_end_layout
+
+        try:  # the engine would refuse it when built, after the 201
+            check_open_end_layout(scene)
+        except ValueError as exc:
+            field, _, msg = str(exc).partition(": ")
+            errors.append(error(["scene", *[int(p) if p.isdigit() else p
+                                            for p in field.split(".")]], msg))
     windows = [(["coupling", "window_max"], coupling.window_max)]
     if body.source is not None and body.source.window is not None:
         windows.append((["source", "window"], body.source.window))

@@ -49,6 +49,27 @@ class OpenState:
     zs: np.ndarray | None = None   # the buffers' surfaces (None in checkpoints made before it)
 
 
+def check_open_end_layout(scene: Scene) -> None:
+    """ValueError naming the scene field whose geometry open ends cannot stand in (checked
+    cheaply, before any particle: a server refuses such a run before it accepts it)."""
+    cells = (scene.tank.x1 - scene.tank.x0) / scene.dp
+    if "right" in {o.side for o in scene.open_boundaries} and abs(cells - round(cells)) > 1e-6:
+        # the right buffer continues the fluid lattice laid out from x0: a partial spacing
+        # would leave a gap (or an overlap) of particles at the face
+        raise ValueError(f"tank.x1: x1 - x0 = {scene.tank.x1 - scene.tank.x0} m must be a "
+                         f"whole number of particle spacings dp = {scene.dp} m with a right "
+                         "open end")
+    reach = 4.0 * scene.h  # the buffer (2h) and the support of its outermost fluid
+    for i, bed in enumerate(scene.beds):
+        xs = [pt[0] for pt in bed.points]
+        for o in scene.open_boundaries:
+            xf = scene.tank.x0 if o.side == "left" else scene.tank.x1
+            if min(xs) - reach < xf < max(xs) + reach:
+                # buffers stand on the tank floor: a bed there would cut through them
+                raise ValueError(f"beds.{i}: comes within {reach:.3g} m of the {o.side} open "
+                                 "end; open ends need the flat tank floor there")
+
+
 class OpenBoundaries:
     """The open ends of a run: their settings, data sources and window (module docstring)."""
 
@@ -81,22 +102,7 @@ class OpenBoundaries:
             return cls.closed(capacity)
         if not (math.isfinite(window) and window > 0):
             raise ValueError(f"window: must be a positive number of seconds, got {window}")
-        cells = (scene.tank.x1 - scene.tank.x0) / scene.dp
-        if "right" in {o.side for o in scene.open_boundaries} and abs(cells - round(cells)) > 1e-6:
-            # the right buffer continues the fluid lattice laid out from x0: a partial spacing
-            # would leave a gap (or an overlap) of particles at the face
-            raise ValueError(f"tank.x1: x1 - x0 = {scene.tank.x1 - scene.tank.x0} m must be a "
-                             f"whole number of particle spacings dp = {scene.dp} m with a right "
-                             "open end")
-        reach = 4.0 * scene.h  # the buffer (2h) and the support of its outermost fluid
-        for i, bed in enumerate(scene.beds):
-            xs = [pt[0] for pt in bed.points]
-            for o in scene.open_boundaries:
-                xf = scene.tank.x0 if o.side == "left" else scene.tank.x1
-                if min(xs) - reach < xf < max(xs) + reach:
-                    # buffers stand on the tank floor: a bed there would cut through them
-                    raise ValueError(f"beds.{i}: comes within {reach:.3g} m of the {o.side} open "
-                                     "end; open ends need the flat tank floor there")
+        check_open_end_layout(scene)
         sides = tuple(o.side for o in scene.open_boundaries)
         sources = dict(sources or {})
         unknown = set(sources) - set(sides)

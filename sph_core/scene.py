@@ -48,7 +48,8 @@ def retired_page(key: str) -> str:
 
 
 class _Model(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    # allow_inf_nan: t_end = inf or dp = nan in a file is named at once as not finite
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
 
     @model_validator(mode="before")
     @classmethod
@@ -425,6 +426,9 @@ class OpenBoundary(_Model):
                           "hydrostatic buffers extrapolate within h of their surface")
 
 
+MAX_OUTPUTS = 10_000_000  # probe rows or snapshots of one run (beyond: an interval below dt)
+
+
 class Output(_Model):
     """Output cadence in simulated seconds (0 = never)."""
 
@@ -531,6 +535,11 @@ class Scene(_Model):
                 raise ValueError(f"probes.{i}.follow: no body named {follow!r} (bodies: {bnames})")
         if self.output.snapshot_every and self.output.snapshot_every > self.t_end - self.t_start:
             raise ValueError("output.snapshot_every: must not exceed the run's length t_end - t_start")
+        for name in ("probe_every", "snapshot_every"):  # 1e-300 s: a run that only writes rows
+            every = getattr(self.output, name)
+            if every and (self.t_end - self.t_start) / every > MAX_OUTPUTS:
+                raise ValueError(f"output.{name}: {every:g} s makes more than {MAX_OUTPUTS:,} "
+                                 f"outputs of the run's {self.t_end - self.t_start:g} s")
         return self
 
     # derived quantities -------------------------------------------------------------------
@@ -602,6 +611,10 @@ def load_scene(path: str | Path) -> Scene:
         raise SceneError(f"scene file not found: {path}") from None
     except tomllib.TOMLDecodeError as exc:
         raise SceneError(f"{path}: not valid TOML ({exc})") from None
+    except UnicodeDecodeError as exc:
+        raise SceneError(f"{path}: not UTF-8 text (byte {exc.start}): a scene file is TOML") from None
+    except OSError as exc:  # a directory, no permission
+        raise SceneError(f"{path}: cannot be read ({exc.strerror or exc})") from None
     try:
         return make_scene(split_scene_file(data)[0])
     except SceneError as exc:

@@ -212,3 +212,24 @@ def test_an_unknown_device_is_refused(tmp_path, capsys):
     assert wavesph.cli.main(["run", str(scene), "-o", str(tmp_path / "out")]) == 2
     err = capsys.readouterr().err
     assert "run.device" in err and "'cpu' or 'cuda'" in err and len(err.splitlines()) == 1
+
+
+@pytest.mark.parametrize("change, words", [
+    (lambda text: text.replace("t_end = ", "t_end = inf #", 1), "t_end"),
+    (lambda text: text.replace("dp = ", "dp = nan #", 1), "finite"),
+    (lambda text: text.replace("dp = ", "dp = 1e-6 #", 1), "particles, above --max-particles"),
+    (lambda text: text.encode() + b"\n# \xff\xfe", "not UTF-8"),
+    (None, "cannot be read"),
+])
+def test_run_refuses_bad_scene_files_in_one_line(tmp_path, capsys, change, words):
+    """No traceback, no allocation of 1e12 particles: one line naming the problem, rc 2."""
+    scene = tmp_path / "scene.toml"
+    if change is None:
+        scene.mkdir()  # a directory given as the scene
+    else:
+        new = change(TANK.read_text())
+        scene.write_bytes(new if isinstance(new, bytes) else new.encode())
+    assert wavesph.cli.main(["run", str(scene), "-o", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("wavesph run: ") and "\n" not in err and words in err, err
+    assert not (tmp_path / "out").exists()

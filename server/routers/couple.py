@@ -22,6 +22,7 @@ async def couple_websocket(ws: WebSocket, run_id: str) -> None:
     await ws.accept(subprotocol=websocket_subprotocol(ws))
     manager = ws.app.state.manager
     transport = WebSocketDoor(ws, min(HELLO_LIMIT, manager.settings.max_frame))
+    transport.limit_messages(transport.max_payload)  # before HELLO: a HELLO at most
 
     def run_id_of(hello: Hello) -> str:
         if hello.run_id not in ("", run_id):
@@ -31,4 +32,5 @@ async def couple_websocket(ws: WebSocket, run_id: str) -> None:
     admitted = await admit(manager, transport, run_id_of)
     if admitted is not None:
         run, frames = admitted
+        transport.limit_messages(manager.settings.max_frame)  # a session's SET frames
         await serve_client(manager, run, transport, frames)

@@ -8,6 +8,7 @@ from typing import Literal
 
 from fastapi import APIRouter, HTTPException, Query, Request, Response
 from fastapi.responses import FileResponse, StreamingResponse
+from starlette.requests import ClientDisconnect
 
 from ..deps import Auth, Manager, RunDep
 from ..run_manager import QueueFull
@@ -34,16 +35,40 @@ def _detail(description: str) -> dict:
 NOT_FOUND = {404: _detail("no such run")}
 
 
+DRAIN_BODIES = 64   # an oversized body is read and dropped up to this many max_body ...
+DRAIN_S = 5.0       # ... and this many seconds, so that its 413 reaches the client
+
+
+async def _drain(request: Request, budget: int) -> None:
+    """Read and drop the rest of the body, bounded. A client that writes the whole body before
+    it reads (Python's urllib) would otherwise get a connection reset instead of the 413: the
+    kernel resets a socket closed with unread data."""
+    try:
+        async with asyncio.timeout(DRAIN_S):
+            async for chunk in request.stream():
+                budget -= len(chunk)
+                if budget < 0:
+                    return
+    except (TimeoutError, ClientDisconnect):
+        pass
+
+
 async def _read_body(request: Request, limit: int) -> bytes:
     """The body, refused (413) as soon as it exceeds ``limit`` bytes, declared or streamed."""
     declared = request.headers.get("content-length")
+    close = {"Connection": "close"}
     if declared is not None and declared.isdigit() and int(declared) > limit:
-        raise HTTPException(413, f"the body has {declared} bytes, the server's max_body is {limit}")
+        if int(declared) <= DRAIN_BODIES * limit:
+            await _drain(request, DRAIN_BODIES * limit)
+        raise HTTPException(413, f"the body has {declared} bytes, the server's max_body is {limit}",
+                            headers=close)
     chunks, size = [], 0
     async for chunk in request.stream():
         size += len(chunk)
         if size > limit:
-            raise HTTPException(413, f"the body exceeds the server's max_body of {limit} bytes")
+            await _drain(request, DRAIN_BODIES * limit - size)
+            raise HTTPException(413, f"the body exceeds the server's max_body of {limit} bytes",
+                                headers=close)
         chunks.append(chunk)
     return b"".join(chunks)
 
@@ -56,13 +81,15 @@ async def _read_body(request: Request, limit: int) -> bytes:
              responses={400: _detail("the body is not JSON (or not TOML, with Content-Type "
                                      "application/toml)"),
                         413: _detail("the body exceeds max_body"),
+                        415: _detail("the Content-Type is not application/json or application/toml"),
                         422: _detail("a field, or a rule across fields, is not met: `detail` lists "
                                      "loc, msg, type (never the input); numbers must be finite; "
                                      "the scene within max_particles and max_probes; "
                                      "mode 'coupled' needs open_boundaries; 'source' only for a "
                                      "standalone run with open_boundaries (and required there); "
                                      "coupling.z_ref in the water column; windows at most 1e7"),
-                        429: _detail("the queue is full (max_queued); see Retry-After")})
+                        429: _detail("the queue is full (max_queued); see Retry-After"),
+                        507: _detail("the run store cannot write (disk full)")})
 async def create_run(request: Request, manager: Manager) -> RunInfo:
     """Create a run from a scene (body: RunRequest as JSON, or a scene file as TOML with
     Content-Type application/toml: its mode, [coupling] and [source] tables beside the
@@ -70,6 +97,11 @@ async def create_run(request: Request, manager: Manager) -> RunInfo:
     wait for a client on
     `/runs/{id}/couple` (WebSocket) or the TCP coupling port; standalone runs start stepping when
     a slot is free. Everything the run needs is checked before the 201."""
+    kind = request.headers.get("content-type", "").split(";")[0].strip().lower()
+    if "json" not in kind and "toml" not in kind:
+        # text/plain, a form or none: what a web page may send without asking (CSRF)
+        raise HTTPException(415, "Content-Type must be application/json (a RunRequest) or "
+                                 "application/toml (a scene file)")
     raw = await _read_body(request, manager.settings.max_body)
     try:  # parsing and validation off the event loop: a big scene never stalls other requests
         body = await asyncio.to_thread(parse_run_request, raw, manager.settings,
@@ -82,6 +114,8 @@ async def create_run(request: Request, manager: Manager) -> RunInfo:
         return manager.submit(body).info
     except QueueFull as exc:
         raise _queue_full(exc) from None
+    except OSError as exc:  # the store cannot write (disk full): say so, no 500
+        raise HTTPException(507, f"the run store cannot write: {exc.strerror or exc}") from None
 
 
 @router.get("", response_model=list[RunInfo])
@@ -105,7 +139,7 @@ async def get_scene(run: RunDep) -> Response:
 async def get_gauges(run: RunDep, format: Literal["csv", "json"] = Query("csv")) -> Response:
     """Gauge series as CSV (a dry gauge an empty field) or JSON (`null` where dry)."""
     path = run.dir / (run.info.gauges_file or "gauges.csv")
-    if not path.exists():
+    if not path.is_file():  # a directory in its place (a damaged store) is no data either
         raise HTTPException(404, f"run {run.info.id} has no gauge data yet")
     if format == "csv":
         return FileResponse(path, media_type="text/csv", filename=f"{run.info.id}-gauges.csv")

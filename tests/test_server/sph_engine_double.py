@@ -17,14 +17,15 @@ import time
 
 import numpy as np
 
-from server.engine import EngineNodes, Measurement, SceneSummary
+from server.engine import EngineNodes, Measurement, SceneSummary, SolveCancelled
 from server.schemas import RunRequest
 from sph_core.simulation import UnstableError
 
 
 class EngineDouble:
     def __init__(self, request: RunRequest, dt_sph: float = 1e-3, solve_delay: float = 0.0,
-                 unstable_after: float | None = None, gate: threading.Event | None = None) -> None:
+                 unstable_after: float | None = None, gate: threading.Event | None = None,
+                 honours_cancel: bool = False) -> None:
         scene = request.scene
         swl = scene.still_water_level if scene.still_water_level is not None else max(
             b.z1 for b in scene.water_blocks)
@@ -40,6 +41,9 @@ class EngineDouble:
         self.t, self.steps, self.n_particles = 0.0, 0, 1000
         self.solve_delay, self.unstable_after = solve_delay, unstable_after
         self.gate = gate  # a solve waits until the test sets it (no timing guess under load)
+        if honours_cancel:  # as the flume engine: the server hands it the run's cancel flag
+            self.cancel: threading.Event | None = None
+        self.cancelled_solves = 0
         self.in_force = {"u": np.zeros(n), "w": np.zeros(n), "eta": np.zeros(n)}
         self.pending: tuple[float, float, dict[str, np.ndarray]] | None = None
         self.imposed: list[tuple[float, float, float]] = []  # (t, mean u, mean eta) per sub-step
@@ -56,8 +60,13 @@ class EngineDouble:
         t0, t1, new = self.pending
         if self.solve_delay:
             time.sleep(self.solve_delay)
-        if self.gate is not None and not self.gate.wait(60.0):
-            raise RuntimeError("test double: the gate was never opened")
+        deadline = time.monotonic() + 60.0
+        while self.gate is not None and not self.gate.wait(0.01):
+            if getattr(self, "cancel", None) is not None and self.cancel.is_set():
+                self.cancelled_solves += 1
+                raise SolveCancelled()
+            if time.monotonic() > deadline:
+                raise RuntimeError("test double: the gate was never opened")
         k = max(1, math.ceil((t1 - t0) / self.summary.dt_sph - 1e-9))
         for i in range(1, k + 1):
             s = i / k

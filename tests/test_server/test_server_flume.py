@@ -121,3 +121,21 @@ def test_flume_gauge_metadata_names_the_ends_own_gauges():
         assert nodes.eta_gauge == (0, NO_GAUGE)  # the right end does not absorb
     finally:
         engine.close()
+
+
+def test_flume_window_stops_when_the_run_is_cancelled():
+    """A cancelled run's window ends at the next chunk of steps, not at t1 (a window of hours)."""
+    import threading
+
+    from server.engine import SolveCancelled
+
+    body = {"scene": FLUME, "mode": "coupled", "coupling": {"window_max": 1.0}}
+    engine = FlumeEngine(RunRequest.model_validate(body), None)
+    engine.cancel = threading.Event()
+    engine.cancel.set()
+    engine.cancel_grace = 0.0  # cut at once (a server gives a window 2 s to end by itself)
+    n = engine.nodes().x.size
+    engine.set_window(0.0, 1.0, np.zeros(n), np.zeros(n), np.zeros(n))
+    with pytest.raises(SolveCancelled):
+        engine.solve_window()
+    assert engine.t < 1.0

@@ -43,7 +43,8 @@ def _strict(token: str):
 def client(tmp_path_factory):
     s = Settings(runs_dir=tmp_path_factory.mktemp("fuzz") / "runs", tcp_port=None,
                  max_queued=1000, max_waiting=1)
-    with TestClient(create_app(s, lambda request, run_dir: EngineDouble(request))) as c:
+    with TestClient(create_app(s, lambda request, run_dir: EngineDouble(request)),
+                    base_url="http://127.0.0.1") as c:  # a loopback server checks the Host
         yield c
 
 

@@ -13,6 +13,8 @@ from sph_core.simulation import DeviceError, Simulation
 
 from ._common import add_device_argument, positive_float, refuse_non_empty
 
+MAX_PARTICLES = 2e7  # ten times the server's cap: a typo in dp, not a big study
+
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("scene", type=Path, help="scene file (TOML)")
@@ -28,6 +30,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--threads", type=int, default=None,
                         help="numba threads (default: NUMBA_NUM_THREADS or all cores)")
     add_device_argument(parser, "")
+    parser.add_argument("--max-particles", type=positive_float, default=MAX_PARTICLES,
+                        help=f"refuse a scene estimated above this many particles (default "
+                             f"{MAX_PARTICLES:.0e}: a dp typed wrong would fill the memory)")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar or lines")
     parser.add_argument("--preview", action="store_true",
                         help="write the initial particles (snapshots/particles_00000.vtu) and the "
@@ -58,6 +63,14 @@ def main(args: argparse.Namespace) -> int:
         scene = make_scene(data)             # the overrides are validated like the file
     except SceneError as exc:
         print(f"wavesph run: {exc}", file=sys.stderr)
+        return 2
+    from server.schemas import estimate_particles
+
+    n = estimate_particles(scene)
+    if n > args.max_particles:
+        print(f"wavesph run: the scene needs about {n:.3g} particles, above --max-particles "
+              f"{args.max_particles:.3g}: increase dp (now {scene.dp:g} m) or raise the cap",
+              file=sys.stderr)
         return 2
     if args.threads is not None:
         import numba

@@ -66,9 +66,16 @@ def main(args: argparse.Namespace) -> int:
             print(f"wavesph serve: {what} {port} on {host} is not free ({busy}); "
                   f"choose another port", file=sys.stderr)
             return 1
+    from server.store import store_in_use
+
+    locked = store_in_use(settings.runs_dir)
+    if locked:
+        print(f"wavesph serve: {locked}", file=sys.stderr)
+        return 1
     logging.basicConfig(level=logging.INFO, format="%(asctime)s %(name)s %(message)s")
     app = create_app(settings)
-    print(f"wavesph serve: http://{settings.host}:{settings.port} (docs at /docs), TCP coupling "
+    host = f"[{settings.host}]" if ":" in settings.host else settings.host  # an IPv6 URL
+    print(f"wavesph serve: http://{host}:{settings.port} (docs at /docs), TCP coupling "
           f"port {settings.tcp_port}, runs in {settings.runs_dir.resolve()}", file=sys.stderr)
     uvicorn.Server(uvicorn_config(app, settings, log_level="info")).run()
     return 0
