@@ -64,8 +64,8 @@ async def admit(manager: RunManager, transport: DoorTransport,
         if run is None:
             await transport.close()
             return None
-    except ProtocolError as exc:
-        await _refuse(transport, exc.code, exc.text, seq)
+    except ProtocolError as exc:  # a refused frame's own seq where its header was read
+        await _refuse(transport, exc.code, exc.text, seq if exc.seq is None else exc.seq)
         return None
     except TimeoutError:
         await _refuse(transport, ErrorCode.TIMEOUT, f"no HELLO within {manager.settings.hello_timeout:g} s", 0)
@@ -89,7 +89,9 @@ async def claim_run(manager: RunManager, run_id: str, hello: Hello,
     None if the client left while waiting; ProtocolError (BUSY, CANCELLED, OUT_OF_ORDER,
     SCENE_MISMATCH) to refuse it. A refused client leaves the run as it was."""
     known = manager.runs.get(run_id)
-    if known is not None and hello.scene_hash not in (NO_SCENE_HASH, bytes.fromhex(known.info.scene_hash)):
+    if known is None:
+        raise ProtocolError(ErrorCode.NOT_FOUND, f"no run {run_id[:64]!r} on this server")
+    if hello.scene_hash not in (NO_SCENE_HASH, bytes.fromhex(known.info.scene_hash)):
         raise ProtocolError(ErrorCode.SCENE_MISMATCH,
                             f"client expects scene {hello.scene_hash.hex()[:16]}..., run {run_id} "
                             f"has {known.info.scene_hash[:16]}... (GET /runs/{run_id}/scene); "
