@@ -5,9 +5,11 @@ Against a server (any language)::
     python -m protocol.conformance ws://HOST:PORT/runs/RUN_ID/couple
     python -m protocol.conformance tcp://HOST:PORT --run-id RUN_ID [--error-run-id RUN2]
 
-Against a client: ``python -m protocol.conformance --serve PORT`` plays a scripted server on
-TCP (PORT 0: any free port, printed first as ``listening on PORT``) for one connection; point
-the client at it (any run id) and let it couple to the end.
+Against a client: ``python -m protocol.conformance --serve PORT [--ws]`` plays a scripted server
+on TCP, or WebSocket at ws://HOST:PORT/runs/ANY_ID/couple (PORT 0: any free port, printed first
+as ``listening on PORT``), for three connections in turn; point the client at it (any run id)
+three times: the run, then a RESULT with a wrong seq, then an ERROR (``--sessions 1``: the run
+only).
 
 One line per check (``PASS``, ``FAIL`` or ``SKIP``, its name, what was seen); exit code 0 only
 if no check failed. Server checks: frames before HELLO answered with the right ERROR code
@@ -16,9 +18,10 @@ run, the handshake and version negotiation, GETNODES, GETGAUGES (1.1), a few sti
 windows, GET, GOBACK exactness (the redone window bit-identical), BYE. ``--error-run-id`` names
 a second run that the kit spends on an out-of-order SOLVE inside a session (answered ERROR
 OUT_OF_ORDER with the SOLVE's seq; that run ends failed). The first run ends ``finished``.
-Client checks: HELLO first, frames numbered 1, 2, 3, ..., nodes asked before the first SET,
-windows contiguous with N finite values each, BYE at the end; a client that asks for KEEPALIVE
-(1.1) gets WORKING frames before WELCOME and before the first RESULT, and must wait through them.
+Client checks: HELLO first, frames numbered 1, 2, 3, ..., windows contiguous with N finite values
+each, BYE at the end (a SET before GETNODES is a NOTE); a client that asks for KEEPALIVE (1.1)
+gets WORKING frames before WELCOME and before the first RESULT, and must wait through them; it
+must refuse a RESULT with a wrong seq (ERROR or close) and send nothing after an ERROR.
 The server checks ask for KEEPALIVE too and check every WORKING frame's seq and elapsed.
 
 Imports only ``protocol`` (and the websockets package for ws://).
