@@ -31,11 +31,12 @@ Every line carries the 1-minute load average before and after it (`load`).
 
 `--profile` adds, for the null-engine runs, where a window's time goes inside the server:
 timers around decode (frame bytes to messages), validate (the session's checks), engine (the
-solve call, inline for a null engine), record (gauge row and run progress), encode (RESULT
-frame) and write (the transport's send), summed per window; `server_busy` is from the first
-decode of a window to the end of its write, and `outside_server` = rtt - server_busy is the
-client's own encode/decode, the sockets, the kernel and the event loops' wake-ups. One JSON
-object per line.
+solve call, inline for a null engine), record (gauge row and run progress before the reply),
+encode (RESULT frame) and write (the transport's send), summed per window; `server_busy` is from
+the first decode of a window to the end of its write, `after_reply` the run's progress the
+server records once the RESULT is written (overlapping the client's next window), and
+`outside_server` = rtt - server_busy is the client's own encode/decode, the sockets, the kernel
+and the event loops' wake-ups. One JSON object per line.
 
     .venv/bin/python bench/coupling_overhead.py [--windows 40] [--small-windows 150]
                                                 [--null-windows 500] [--only null] [--profile]
@@ -181,10 +182,17 @@ def install_profile() -> list[dict[str, int]]:
 
     windows: list[dict[str, int]] = []
     cur: dict[str, int] = defaultdict(int)
+    replied = [False]  # the window's RESULT is written: what follows is overlapped bookkeeping
 
     def timed(stage: str, fn: Callable) -> Callable:
         def wrapper(*a: Any, **k: Any) -> Any:
             tic = time.perf_counter_ns()
+            if replied[0] and stage == "record" and windows:  # the run's progress, after the reply
+                try:
+                    return fn(*a, **k)
+                finally:
+                    windows[-1]["after_reply"] = windows[-1].get("after_reply", 0) + time.perf_counter_ns() - tic
+            replied[0] = False
             cur.setdefault("first", tic)
             try:
                 return fn(*a, **k)
@@ -201,6 +209,7 @@ def install_profile() -> list[dict[str, int]]:
             if "engine" in cur:  # the RESULT of a window: the window is over
                 windows.append({**cur, "server_busy": toc - cur.pop("first")})
                 cur.clear()
+                replied[0] = True
         return wrapper
 
     framing.FrameDecoder.feed = timed("decode", framing.FrameDecoder.feed)
@@ -217,7 +226,19 @@ def install_profile() -> list[dict[str, int]]:
     return windows
 
 
-def serve(tmp: Path, null_nodes: int, ports: Any, solves: Any, profile: bool = False) -> None:
+def event_loop(loop: str) -> str:
+    """The event loop uvicorn runs for ``loop`` ("auto": uvloop where it is installed)."""
+    if loop != "auto":
+        return loop
+    try:
+        import uvloop  # noqa: F401
+        return "uvloop"
+    except ImportError:
+        return "asyncio"
+
+
+def serve(tmp: Path, null_nodes: int, ports: Any, solves: Any, profile: bool = False,
+          loop: str = "auto") -> None:
     """Child process: the server, so client and server do not share one GIL."""
     global _SOLVES, _PROFILE
     _SOLVES = solves
@@ -227,7 +248,9 @@ def serve(tmp: Path, null_nodes: int, ports: Any, solves: Any, profile: bool = F
                          else lambda req, d: NullEngine(null_nodes, req.scene.t_end))
     settings = Settings(runs_dir=tmp, port=0, tcp_port=0)
     app = create_app(settings, factory)
-    server = uvicorn.Server(uvicorn_config(app, settings, log_level="error"))  # as `wavesph serve`
+    config = uvicorn_config(app, settings, log_level="error")  # as `wavesph serve`
+    config.loop = event_loop(loop)
+    server = uvicorn.Server(config)
     thread = threading.Thread(target=server.run, daemon=True)
     thread.start()
     while not server.started:
@@ -269,12 +292,12 @@ def _ms(a: np.ndarray, q: float) -> float:
 
 
 def coupled(door: str, body: dict, windows: int, null_nodes: int = 0, case: str = "",
-            profile: bool = False) -> dict:
+            profile: bool = False, loop: str = "auto") -> dict:
     load0 = _load()
     ctx = multiprocessing.get_context("spawn")  # the parent has OpenMP threads: no fork
     ports, solves = ctx.Queue(), ctx.Queue()
     with tempfile.TemporaryDirectory() as tmp:
-        child = ctx.Process(target=serve, args=(Path(tmp), null_nodes, ports, solves, profile),
+        child = ctx.Process(target=serve, args=(Path(tmp), null_nodes, ports, solves, profile, loop),
                             daemon=True)
         child.start()
         try:
@@ -317,7 +340,7 @@ def coupled(door: str, body: dict, windows: int, null_nodes: int = 0, case: str 
     rtt = c - s
     share = float(rtt.sum() / c.sum())
     out = {"question": QUESTION, "transport": "websocket" if door == "ws" else "tcp",
-           "case": "null engine (no SPH work)" if null_nodes else case,
+           "case": "null engine (no SPH work)" if null_nodes else case, "loop": event_loop(loop),
            "nodes": int(welcome.n_nodes), "substeps_per_window": int(np.median(steps)),
            "windows_timed": int(c.size), "rtt_p50_ms": _ms(rtt, 50), "rtt_p99_ms": _ms(rtt, 99)}
     if null_nodes:
@@ -344,7 +367,7 @@ def _stage_table(stages: list[dict[str, int]], rtt: np.ndarray) -> dict[str, dic
         return {"p50_us": round(float(np.percentile(a, 50)), 1),
                 "p99_us": round(float(np.percentile(a, 99)), 1), "mean_us": round(float(a.mean()), 1)}
 
-    names = ["decode", "validate", "engine", "record", "encode", "write", "server_busy"]
+    names = ["decode", "validate", "engine", "record", "encode", "write", "server_busy", "after_reply"]
     table = {name: row(1e-3 * np.array([w.get(name, 0) for w in stages], dtype=float))
              for name in names}
     busy = 1e-3 * np.array([w["server_busy"] for w in stages], dtype=float)
@@ -354,7 +377,7 @@ def _stage_table(stages: list[dict[str, int]], rtt: np.ndarray) -> dict[str, dic
 
 
 # --------------------------------------------------------------------------- echo floor
-def _echo_tcp(ports: Any, request_bytes: int, reply: bytes) -> None:
+def _echo_tcp(ports: Any, request_bytes: int, reply: bytes, loop: str) -> None:
     """Child process: asyncio streams answering each request of ``request_bytes`` with ``reply``."""
     import asyncio
 
@@ -373,10 +396,15 @@ def _echo_tcp(ports: Any, request_bytes: int, reply: bytes) -> None:
         ports.put(srv.sockets[0].getsockname()[1])
         await srv.serve_forever()
 
-    asyncio.run(main())
+    if event_loop(loop) == "uvloop":
+        import uvloop
+
+        uvloop.run(main())
+    else:
+        asyncio.run(main())
 
 
-def _echo_ws(ports: Any, reply: bytes) -> None:
+def _echo_ws(ports: Any, reply: bytes, loop: str) -> None:
     """Child process: a Starlette WebSocket endpoint under the server's uvicorn configuration,
     answering each pair of binary messages (SET, SOLVE) with ``reply``."""
     from starlette.applications import Starlette
@@ -394,7 +422,9 @@ def _echo_ws(ports: Any, reply: bytes) -> None:
             await ws.send_bytes(reply)
 
     app = Starlette(routes=[WebSocketRoute("/echo", echo)])
-    server = uvicorn.Server(uvicorn_config(app, Settings(port=0), log_level="error"))
+    config = uvicorn_config(app, Settings(port=0), log_level="error")
+    config.loop = event_loop(loop)
+    server = uvicorn.Server(config)
     thread = threading.Thread(target=server.run, daemon=True)
     thread.start()
     while not server.started:
@@ -403,7 +433,8 @@ def _echo_ws(ports: Any, reply: bytes) -> None:
     thread.join()
 
 
-def echo_floor(door: str, windows: int, n_nodes: int = 64, n_gauges: int = 2) -> dict:
+def echo_floor(door: str, windows: int, n_nodes: int = 64, n_gauges: int = 2,
+               loop: str = "auto") -> dict:
     """The round trip of the same request (SET + SOLVE frames) and reply (a RESULT frame) sizes
     through a server that only answers: what the transport and asyncio cost by themselves."""
     load0 = _load()
@@ -412,7 +443,8 @@ def echo_floor(door: str, windows: int, n_nodes: int = 64, n_gauges: int = 2) ->
     reply = bytes(16 + 8 + 4 + 4 * (4 + 8 * n_gauges) - 4 * n_gauges)
     ctx = multiprocessing.get_context("spawn")
     ports = ctx.Queue()
-    target, args = (_echo_tcp, (ports, set_bytes + 16, reply)) if door == "tcp" else (_echo_ws, (ports, reply))
+    target, args = ((_echo_tcp, (ports, set_bytes + 16, reply, loop)) if door == "tcp"
+                    else (_echo_ws, (ports, reply, loop)))
     child = ctx.Process(target=target, args=args, daemon=True)
     child.start()
     try:
@@ -443,7 +475,8 @@ def echo_floor(door: str, windows: int, n_nodes: int = 64, n_gauges: int = 2) ->
         child.join(timeout=10)
     a = np.array(rtt[1:])
     return {"question": QUESTION, "transport": "websocket" if door == "ws" else "tcp",
-            "case": "asyncio echo floor (same sizes, no protocol work)", "nodes": n_nodes,
+            "case": "asyncio echo floor (same sizes, no protocol work)", "loop": event_loop(loop),
+            "nodes": n_nodes,
             "windows_timed": int(a.size), "rtt_p50_ms": _ms(a, 50), "rtt_p99_ms": _ms(a, 99),
             "load": [load0, _load()]}
 
@@ -484,6 +517,10 @@ def main() -> None:
                     help="null: only the null-engine runs and the echo floor (no SPH)")
     ap.add_argument("--profile", action="store_true",
                     help="time the server's stages per window in the null-engine runs")
+    ap.add_argument("--loop", choices=["auto", "asyncio", "uvloop"], default="auto",
+                    help="the servers' event loop (auto, as `wavesph serve`: uvloop if installed)")
+    ap.add_argument("--nodes", type=int, nargs="+", default=[64, 4096],
+                    help="boundary nodes of the null-engine runs")
     args = ap.parse_args()
     cases = [("beach flume, dp 0.01 m, inlet only", beach_flume(), args.windows),
              ("small flume, dp 0.03 m, both ends open", flume(0.03, 4.0), args.small_windows)]
@@ -494,11 +531,11 @@ def main() -> None:
             print(json.dumps(coupled(door, body, windows, case=case)), flush=True)
     null_body = {"scene": NULL_SCENE, "mode": "coupled", "coupling": {"window_max": WINDOW}}
     for door in ("ws", "tcp"):
-        print(json.dumps(echo_floor(door, args.null_windows)), flush=True)
-    for n_nodes in (64, 4096):
+        print(json.dumps(echo_floor(door, args.null_windows, loop=args.loop)), flush=True)
+    for n_nodes in args.nodes:
         for door in ("ws", "tcp"):
             print(json.dumps(coupled(door, null_body, args.null_windows, null_nodes=n_nodes,
-                                     profile=args.profile)), flush=True)
+                                     profile=args.profile, loop=args.loop)), flush=True)
 
 
 if __name__ == "__main__":

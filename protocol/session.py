@@ -16,6 +16,7 @@ States: AWAIT_HELLO -> READY <-> WINDOW_SET -> CLOSED (see PROTOCOL.md, "Session
 
 from __future__ import annotations
 
+from copy import copy
 from dataclasses import dataclass, replace
 from enum import Enum
 
@@ -229,7 +230,9 @@ class SphSession:
             self.last_window = None
             self.window = None
             self.state = State.READY
-        return self._frame(replace(result, t=self.t))
+        reply = copy(result)  # t is the session's clock; a shallow copy skips __post_init__
+        reply.t = self.t
+        return self._frame(reply)
 
     def working_frame(self, elapsed: float) -> bytes | None:
         """WORKING for the request being answered (1.1), None unless KEEPALIVE is in force."""

@@ -206,9 +206,11 @@ async def serve_client(manager: RunManager, run: Run, transport: DoorTransport,
                 solve_time += took
                 reply = session.result(action, _result(measured))
                 values = _gauge_values(names, measured)
-                run.gauges.row(engine.t, measured.steps, values)
-                _progress(manager, run, engine, values, connected, solve_time)
-                await transport.send(reply)
+                run.gauges.row(engine.t, measured.steps, values)  # on disk before the reply
+                try:
+                    await transport.send(reply)
+                finally:  # the run's progress (and, twice a second, meta.json) off the round trip
+                    _progress(manager, run, engine, values, connected, solve_time)
                 if (time.monotonic() - saved_at >= settings.checkpoint_every
                         or engine.t - saved_t >= settings.checkpoint_every_t * (1 - 1e-9)):
                     await _save_state(manager, run)  # by wall time and by simulated progress
@@ -360,6 +362,8 @@ def _goback(engine: CouplingEngine) -> Measurement:
 
 def _result(m: Measurement) -> Result:
     wet = np.asarray(m.wet, dtype=bool)
+    if wet.all():  # nothing to blank out
+        return Result(0.0, int(m.steps), m.eta, np.ones(wet.size, np.uint32), m.u_ref, m.w_ref)
     z = np.zeros(wet.size)
     return Result(0.0, int(m.steps), np.where(wet, m.eta, z), wet.astype(np.uint32),
                   np.where(wet, m.u_ref, z), np.where(wet, m.w_ref, z))
