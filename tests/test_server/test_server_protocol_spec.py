@@ -154,3 +154,28 @@ def test_the_node_column_spans_bed_to_tank_top_at_most_dp_over_2_apart():
         assert z[0] == sc.tank.z0 and z[-1] == sc.tank.z1
         assert np.allclose(np.diff(z), np.diff(z)[0]) and np.diff(z)[0] <= 0.5 * sc.dp
         assert abs(nodes.x_gauge - nodes.x_face) == pytest.approx(2 * sc.h)
+
+
+def test_a_window_the_solver_refuses_is_answered_with_the_solves_seq(tmp_path):
+    """SET's surface check is made by the solver (FlumeEngine raises BAD_VALUE "SET: ..." at
+    solve time): the ERROR carries the SOLVE's seq, not the SET's."""
+    from protocol import ProtocolError
+
+    from server_harness import live_server
+    from sph_engine_double import EngineDouble
+
+    class SurfaceChecked(EngineDouble):
+        def solve_window(self):
+            if self.pending[2]["eta"].mean() > 0.1:
+                self.pending = None
+                raise ProtocolError(ErrorCode.BAD_VALUE, "SET: the surface is above the tank top")
+            return super().solve_window()
+
+    with live_server(tmp_path, lambda r, d: SurfaceChecked(r)) as srv:
+        run = srv.create()
+        client, welcome, _ = srv.couple(run["id"])          # HELLO 1, GETNODES 2
+        z, high = np.zeros(welcome.n_nodes), np.full(welcome.n_nodes, 0.5)
+        client.send_raw(encode_frame(Set(0.0, 0.05, z, z, high), 3) + encode_frame(Solve(), 4))
+        seq, err = _error(client)
+        assert (err.code, seq) == (ErrorCode.BAD_VALUE, 4) and "surface" in err.text
+        assert srv.wait_state(run["id"], "failed")["status"].startswith("failed: protocol error")
