@@ -5,9 +5,11 @@ Against a server (any language)::
     python -m protocol.conformance ws://HOST:PORT/runs/RUN_ID/couple
     python -m protocol.conformance tcp://HOST:PORT --run-id RUN_ID [--error-run-id RUN2]
 
-Against a client: ``python -m protocol.conformance --serve PORT`` plays a scripted server on
-TCP (PORT 0: any free port, printed first as ``listening on PORT``) for one connection; point
-the client at it (any run id) and let it couple to the end.
+Against a client: ``python -m protocol.conformance --serve PORT [--ws]`` plays a scripted server
+on TCP, or WebSocket at ws://HOST:PORT/runs/ANY_ID/couple (PORT 0: any free port, printed first
+as ``listening on PORT``), for three connections in turn; point the client at it (any run id)
+three times: the run, then a RESULT with a wrong seq, then an ERROR (``--sessions 1``: the run
+only).
 
 One line per check (``PASS``, ``FAIL`` or ``SKIP``, its name, what was seen); exit code 0 only
 if no check failed. Server checks: frames before HELLO answered with the right ERROR code
@@ -16,9 +18,10 @@ run, the handshake and version negotiation, GETNODES, GETGAUGES (1.1), a few sti
 windows, GET, GOBACK exactness (the redone window bit-identical), BYE. ``--error-run-id`` names
 a second run that the kit spends on an out-of-order SOLVE inside a session (answered ERROR
 OUT_OF_ORDER with the SOLVE's seq; that run ends failed). The first run ends ``finished``.
-Client checks: HELLO first, frames numbered 1, 2, 3, ..., nodes asked before the first SET,
-windows contiguous with N finite values each, BYE at the end; a client that asks for KEEPALIVE
-(1.1) gets WORKING frames before WELCOME and before the first RESULT, and must wait through them.
+Client checks: HELLO first, frames numbered 1, 2, 3, ..., windows contiguous with N finite values
+each, BYE at the end (a SET before GETNODES is a NOTE); a client that asks for KEEPALIVE (1.1)
+gets WORKING frames before WELCOME and before the first RESULT, and must wait through them; it
+must refuse a RESULT with a wrong seq (ERROR or close) and send nothing after an ERROR.
 The server checks ask for KEEPALIVE too and check every WORKING frame's seq and elapsed.
 
 Imports only ``protocol`` (and the websockets package for ws://).
@@ -314,6 +317,19 @@ def _seen(got: tuple[int, Message] | None) -> str:
 
 
 # --------------------------------------------------------------------------- against a client
+FAULT_GRACE = 10.0  # [s] a client has to refuse a faulty reply (ERROR or close) or to stop after an ERROR
+NAME_SEQ = "message order and seq 1, 2, 3, ..."
+NAME_NODES = "GETNODES before the first SET"
+NAME_WRONG_SEQ = "a RESULT with a wrong seq is refused (ERROR or close, nothing more)"
+NAME_ERROR = "an ERROR from the server ends the session (the client sends nothing more)"
+# the sessions a client is checked with: (fault, what the client is told to expect)
+SESSIONS: list[tuple[str | None, str]] = [
+    (None, "the scripted run (WORKING frames on the way, if KEEPALIVE is asked for)"),
+    ("wrong_seq", "the first RESULT carries a wrong seq: the client must refuse it"),
+    ("error", "the first SOLVE is answered ERROR ENGINE_FAILED: the client must stop"),
+]
+
+
 def scripted_scene(t_end: float = 0.2, window_max: float = 0.05,
                    run_id: str = "conformance") -> tuple[Welcome, Nodes, Gauges]:
     """The scripted server's run: one inlet column of 8 nodes, two gauges, depth 0.3 m."""
@@ -328,48 +344,114 @@ def scripted_scene(t_end: float = 0.2, window_max: float = 0.05,
     return welcome, nodes, gauges
 
 
-def check_client(sock: socket.socket, report: Report | None = None, t_end: float = 0.2) -> Report:
-    """Play the scripted server for one accepted connection ``sock``; check the client."""
+class ClientPeer:
+    """The scripted server's side of one client connection, TCP or WebSocket: ``recv(timeout)``
+    gives the next (seq, message) or None when the client closed; ``max_payload`` bounds what
+    the client may send now."""
+
+    def __init__(self, sock: socket.socket | None = None, ws: object | None = None,
+                 run_id: str = "", on_close: Callable[[], None] | None = None) -> None:
+        self.sock, self.ws, self.run_id, self.on_close = sock, ws, run_id, on_close
+        self.decoder = FrameDecoder(8236)
+        self.pending: list[tuple[int, Message]] = []
+
+    @property
+    def max_payload(self) -> int:
+        return self.decoder.max_payload
+
+    @max_payload.setter
+    def max_payload(self, value: int) -> None:
+        self.decoder.max_payload = value
+
+    def recv(self, timeout: float) -> tuple[int, Message] | None:
+        if self.ws is not None:
+            from websockets.exceptions import ConnectionClosed
+
+            try:
+                data = self.ws.recv(timeout=timeout)  # type: ignore[attr-defined]
+            except ConnectionClosed:
+                return None
+            if isinstance(data, str):
+                raise ProtocolError(ErrorCode.MALFORMED, "a text WebSocket message: frames are binary")
+            return decode_frame(data, self.decoder.max_payload)
+        assert self.sock is not None
+        self.sock.settimeout(timeout)
+        while not self.pending:
+            try:
+                data = self.sock.recv(1 << 16)
+            except ConnectionResetError:
+                return None
+            if not data:
+                self.decoder.eof()
+                return None
+            self.pending.extend(self.decoder.feed(data))
+        return self.pending.pop(0)
+
+    def send(self, data: bytes) -> None:
+        if self.ws is not None:
+            self.ws.send(data)  # type: ignore[attr-defined]
+        else:
+            assert self.sock is not None
+            self.sock.sendall(data)
+
+    def close(self) -> None:
+        if self.on_close is not None:
+            self.on_close()
+        elif self.sock is not None:
+            self.sock.close()
+
+
+def check_client(peer: ClientPeer | socket.socket, report: Report | None = None, t_end: float = 0.2,
+                 fault: str | None = None) -> Report:
+    """Play the scripted server for one client connection; check the client. ``fault``:
+    None (the run to its end), "wrong_seq" (the first RESULT with the SET's seq instead of the
+    SOLVE's) or "error" (the first SOLVE answered ERROR ENGINE_FAILED): then only what the
+    client does about it is checked (and any violation before it)."""
     rep = report or Report()
+    if isinstance(peer, socket.socket):
+        peer = ClientPeer(peer)
     welcome = scripted_scene(t_end)[0]
     session: SphSession | None = None  # made at the first frame: it serves any run id
-    decoder = FrameDecoder(8236)
-    sock.settimeout(TIMEOUT)
     seen_hello = asked_nodes = False
-    windows, t, pending, last_set = 0, welcome.t_start, [], None
+    windows, t, last_set = 0, welcome.t_start, None
     seqs: list[int] = []
     try:
         while True:
-            while not pending:
-                data = sock.recv(1 << 16)
-                if not data:
+            got = peer.recv(TIMEOUT)
+            if got is None:
+                if fault is None:
                     rep.check("BYE at the end", False, f"the client closed after {windows} windows "
                               "without BYE")
                     return _client_summary(rep, seen_hello, asked_nodes, windows, seqs)
-                pending.extend(decoder.feed(data))
-            seq, msg = pending.pop(0)
+                rep.check(_fault_name(fault), False, "the client closed before the first RESULT")
+                return rep
+            seq, msg = got
             seqs.append(seq)
             if not seen_hello:
                 seen_hello = rep.check("handshake: HELLO first, version 1", isinstance(msg, Hello),
                                        f"{msg.TYPE.name} seq={seq}")
-            asked_nodes |= isinstance(msg, GetNodes)
             if isinstance(msg, Set) and not asked_nodes:
-                rep.check("GETNODES before the first SET", False, "SET before GETNODES")
-                asked_nodes = True  # reported once
+                # the state machine (section 6) lets a client that knows its nodes skip GETNODES
+                rep.add("NOTE", NAME_NODES, "SET before GETNODES: the nodes were not asked for")
+                asked_nodes = True  # said once
+            asked_nodes |= isinstance(msg, GetNodes)
             if session is None:
-                run_id = msg.run_id if isinstance(msg, Hello) and msg.run_id else "conformance"
+                run_id = peer.run_id or (msg.run_id if isinstance(msg, Hello) and msg.run_id
+                                         else "conformance")
                 session = SphSession(*scripted_scene(t_end, run_id=run_id))
             action = session.receive(seq, msg)
-            decoder.max_payload = session.max_payload
+            peer.max_payload = session.max_payload
             if isinstance(msg, Hello) or (isinstance(action, SolveWindow) and windows == 0):
                 # a client that asked for KEEPALIVE must wait through WORKING before WELCOME (a
                 # run being built) and before the first RESULT (the compile); None for 1.0
                 for elapsed in (0.0, 0.01):
                     frame = session.working_frame(elapsed)
                     if frame is not None:
-                        sock.sendall(frame)
+                        peer.send(frame)
+            if isinstance(action, SolveWindow) and fault is not None:
+                return _fault(rep, peer, session, action, seq, fault)
             if isinstance(action, Reply):
-                sock.sendall(action.data)
+                peer.send(action.data)
                 if action.close:
                     rep.check("BYE at the end", True, f"after {windows} windows, t = {t:g} s")
                     return _client_summary(rep, seen_hello, asked_nodes, windows, seqs)
@@ -378,22 +460,16 @@ def check_client(sock: socket.socket, report: Report | None = None, t_end: float
             elif isinstance(action, SolveWindow):
                 assert last_set is not None
                 windows, t = windows + 1, last_set.t1
-                eta = float(np.mean(last_set.eta))  # the scripted "SPH": gauges see the imposed eta
-                sock.sendall(session.result(action, Result(0.0, 10, np.array([eta, 0.0]),
-                                                           np.ones(2, np.uint32), np.zeros(2),
-                                                           np.zeros(2))))
-            elif isinstance(action, Measure):
-                sock.sendall(session.result(action, Result(0.0, 0, np.zeros(2), np.ones(2, np.uint32),
-                                                           np.zeros(2), np.zeros(2))))
-            elif isinstance(action, Restore):
-                windows = max(windows - 1, 0)
-                sock.sendall(session.result(action, Result(0.0, 0, np.zeros(2), np.ones(2, np.uint32),
-                                                           np.zeros(2), np.zeros(2))))
+                peer.send(session.result(action, _scripted_result(10, float(np.mean(last_set.eta)))))
+            elif isinstance(action, (Measure, Restore)):
+                if isinstance(action, Restore):
+                    windows = max(windows - 1, 0)
+                peer.send(session.result(action, _scripted_result(0, 0.0)))
             elif isinstance(action, PeerError):
                 rep.check("no ERROR from the client", False, f"code {action.code}: {action.text}")
                 return _client_summary(rep, seen_hello, asked_nodes, windows, seqs)
     except ProtocolError as exc:
-        name = {ErrorCode.OUT_OF_ORDER: "message order and seq 1, 2, 3, ...",
+        name = {ErrorCode.OUT_OF_ORDER: NAME_SEQ,
                 ErrorCode.SHAPE_MISMATCH: "SET arrays of N values",
                 ErrorCode.TIME_MISMATCH: "windows contiguous (SET t0 = server time)",
                 ErrorCode.BAD_VALUE: "SET values finite, window within window_max and t_end"}.get(
@@ -401,36 +477,141 @@ def check_client(sock: socket.socket, report: Report | None = None, t_end: float
         rep.check(name, False, f"{exc.code.name}: {exc.text}")
         try:
             if session is not None:
-                sock.sendall(session.error_frame(exc))
+                peer.send(session.error_frame(exc))
         except OSError:
             pass
-        return _client_summary(rep, seen_hello, asked_nodes, windows, seqs)
+        return rep if fault else _client_summary(rep, seen_hello, asked_nodes, windows, seqs)
     except (OSError, TimeoutError) as exc:
         rep.check("connection", False, f"{type(exc).__name__}: {exc}")
-        return _client_summary(rep, seen_hello, asked_nodes, windows, seqs)
+        return rep if fault else _client_summary(rep, seen_hello, asked_nodes, windows, seqs)
+
+
+def _scripted_result(steps: int, eta: float) -> Result:
+    """The scripted "SPH": the first gauge sees the imposed eta, the second still water."""
+    return Result(0.0, steps, np.array([eta, 0.0]), np.ones(2, np.uint32), np.zeros(2), np.zeros(2))
+
+
+def _fault_name(fault: str) -> str:
+    return NAME_WRONG_SEQ if fault == "wrong_seq" else NAME_ERROR
+
+
+def _fault(rep: Report, peer: ClientPeer, session: SphSession, action: SolveWindow, seq: int,
+           fault: str) -> Report:
+    """Send the faulty reply to the SOLVE of frame ``seq``; check what the client does next."""
+    if fault == "wrong_seq":
+        frame = bytearray(session.result(action, _scripted_result(10, 0.0)))
+        frame[8:12] = (seq - 1).to_bytes(4, "little")  # the SET's seq: the reply to another frame
+        peer.send(bytes(frame))
+    else:
+        peer.send(session.error_frame(ProtocolError(
+            ErrorCode.ENGINE_FAILED, "conformance: a scripted engine failure (the kit's fault test)")))
+    name = _fault_name(fault)
+    try:
+        got = peer.recv(FAULT_GRACE)
+    except (TimeoutError, OSError):  # silent: refusing nothing, or waiting for our close
+        if fault == "wrong_seq":
+            rep.check(name, False, f"neither ERROR nor close within {FAULT_GRACE:g} s")
+        else:
+            rep.check(name, True, f"silent for {FAULT_GRACE:g} s, waiting for the server to close")
+        return rep
+    except ProtocolError as exc:
+        rep.check(name, False, f"it then sent bytes that are no frame: {exc}")
+        return rep
+    if got is None:
+        rep.check(name, True, "the client closed")
+    else:
+        refused = fault == "wrong_seq" and isinstance(got[1], Error)
+        rep.check(name, refused, ("it sent " if refused else "it went on: ") + _seen(got))
+    return rep
 
 
 def _client_summary(rep: Report, hello: bool, nodes: bool, windows: int, seqs: list[int]) -> Report:
     names = {n for _, n, _ in rep.lines}
-    if "message order and seq 1, 2, 3, ..." not in names:
-        rep.check("message order and seq 1, 2, 3, ...", seqs == list(range(1, len(seqs) + 1)),
-                  f"{len(seqs)} frames")
-    if "GETNODES before the first SET" not in names:
-        rep.check("GETNODES before the first SET", nodes)
+    if NAME_SEQ not in names:
+        rep.check(NAME_SEQ, seqs == list(range(1, len(seqs) + 1)), f"{len(seqs)} frames")
+    if NAME_NODES not in names:
+        rep.check(NAME_NODES, nodes)
     rep.check("at least one window solved", windows >= 1, f"{windows} windows")
     if not hello and "handshake: HELLO first, version 1" not in names:
         rep.check("handshake: HELLO first, version 1", False, "no frame")
     return rep
 
 
-def serve_scripted(port: int, t_end: float = 0.2, host: str = "127.0.0.1") -> Report:
-    """Listen on ``port`` (0: any), print it, check the first client that connects."""
+def _run_sessions(next_peer: Callable[[], ClientPeer], t_end: float, sessions: int,
+                  report: Report | None = None) -> Report:
+    """Check ``sessions`` connections in turn (SESSIONS: the run, then the faults); each
+    fault session reports its fault check, and any other check only if it failed."""
+    rep = report or Report()
+    for k, (fault, what) in enumerate(SESSIONS[:sessions], 1):
+        if sessions > 1 and rep.echo:
+            print(f"session {k}/{sessions}: {what}", flush=True)
+        peer = next_peer()
+        try:
+            if fault is None:
+                check_client(peer, rep, t_end)
+                continue
+            sub = check_client(peer, Report(echo=False), t_end, fault)
+        finally:
+            peer.close()
+        for verdict, name, detail in sub.lines:
+            if verdict == "FAIL" or name == _fault_name(fault):
+                rep.add(verdict, name, (detail if name == _fault_name(fault)
+                                        else f"(session {k}) {detail}"))
+    return rep
+
+
+def _print_port(port: int) -> None:
+    print(f"listening on {port}", flush=True)
+
+
+def serve_scripted(port: int, t_end: float = 0.2, host: str = "127.0.0.1", ws: bool = False,
+                   sessions: int = len(SESSIONS), report: Report | None = None,
+                   listening: Callable[[int], None] = _print_port) -> Report:
+    """Listen on ``port`` (0: any), tell ``listening`` the port (default: print it), check the
+    next ``sessions`` clients that connect (over WebSocket at ws://HOST:PORT/runs/ID/couple if
+    ``ws``)."""
+    if ws:
+        return _serve_ws(port, t_end, host, sessions, report, listening)
     with socket.create_server((host, port)) as srv:
-        print(f"listening on {srv.getsockname()[1]}", flush=True)
-        sock, _ = srv.accept()
-        with sock:
+        listening(srv.getsockname()[1])
+
+        def accept() -> ClientPeer:
+            sock, _ = srv.accept()
             sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
-            return check_client(sock, t_end=t_end)
+            return ClientPeer(sock)
+
+        return _run_sessions(accept, t_end, sessions, report)
+
+
+def _serve_ws(port: int, t_end: float, host: str, sessions: int, report: Report | None,
+              listening: Callable[[int], None]) -> Report:
+    import queue
+    import threading
+
+    from websockets.sync.server import serve
+
+    conns: queue.Queue = queue.Queue()
+
+    def handler(ws: object) -> None:  # one thread per connection, held until the kit is done
+        done = threading.Event()
+        path = ws.request.path.split("?")[0]  # type: ignore[attr-defined]
+        run_id = path.split("/")[2] if path.startswith("/runs/") and path.count("/") >= 3 else "conformance"
+        conns.put(ClientPeer(ws=ws, run_id=run_id, on_close=done.set))
+        done.wait()
+
+    def subprotocol(_: object, offered: list[str]) -> str | None:
+        return "wavesph" if "wavesph" in offered else None  # as our server: optional
+
+    server = serve(handler, host, port, select_subprotocol=subprotocol, max_size=None,
+                   compression=None, ping_interval=None)
+    thread = threading.Thread(target=server.serve_forever, daemon=True)
+    thread.start()
+    listening(server.socket.getsockname()[1])
+    try:
+        return _run_sessions(lambda: conns.get(timeout=TIMEOUT), t_end, sessions, report)
+    finally:
+        server.shutdown()
+        thread.join(timeout=10)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -442,10 +623,15 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--windows", type=int, default=3, help="still-water windows to solve")
     ap.add_argument("--timeout", type=float, default=TIMEOUT, help="[s] per reply")
     ap.add_argument("--serve", type=int, metavar="PORT", help="play a scripted server for a client")
+    ap.add_argument("--ws", action="store_true", help="with --serve: over WebSocket "
+                    "(ws://HOST:PORT/runs/ANY_ID/couple) instead of TCP")
+    ap.add_argument("--sessions", type=int, choices=range(1, len(SESSIONS) + 1), default=len(SESSIONS),
+                    help="with --serve: connections to check: 1 the run; 2 also a RESULT with a wrong "
+                         "seq; 3 (default) also an ERROR")
     ap.add_argument("--t-end", type=float, default=0.2, help="[s] the scripted server's run length")
     args = ap.parse_args(argv)
     if args.serve is not None:
-        rep = serve_scripted(args.serve, args.t_end)
+        rep = serve_scripted(args.serve, args.t_end, ws=args.ws, sessions=args.sessions)
     elif args.url:
         if args.url.startswith("tcp://") and not args.run_id:
             ap.error("tcp:// needs --run-id")

@@ -22,12 +22,16 @@ class ErrorCode(IntEnum):
     CANCELLED = 12           # the run was cancelled by its owner
     BUSY = 13                # run not accepting a coupling client (already coupled, finished, ...)
     INTERNAL = 14            # bug on the sending side
+    NOT_FOUND = 15           # HELLO names a run the server does not know
 
 
 class ProtocolError(Exception):
-    """Anything wrong with bytes or message order. ``code`` is what goes on the wire."""
+    """Anything wrong with bytes or message order. ``code`` is what goes on the wire; ``seq`` is
+    the refused frame's own seq where its header could be read (None: the ERROR then carries
+    the seq of the last frame accepted)."""
 
-    def __init__(self, code: ErrorCode, text: str) -> None:
+    def __init__(self, code: ErrorCode, text: str, seq: int | None = None) -> None:
         super().__init__(f"{code.name}: {text}")
         self.code = ErrorCode(code)
         self.text = text
+        self.seq = seq

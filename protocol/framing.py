@@ -52,11 +52,20 @@ def parse_header(data: bytes, max_payload: int = MAX_PAYLOAD) -> Header:
     try:
         mtype = MessageType(mtype)
     except ValueError:
-        raise ProtocolError(ErrorCode.UNKNOWN_TYPE, f"message type {mtype} is not defined") from None
+        raise ProtocolError(ErrorCode.UNKNOWN_TYPE, f"message type {mtype} is not defined", seq) from None
     if length > max_payload:
         raise ProtocolError(ErrorCode.FRAME_TOO_LARGE,
-                            f"{mtype.name} payload of {length} bytes > limit {max_payload}")
+                            f"{mtype.name} payload of {length} bytes > limit {max_payload}", seq)
     return Header(version, mtype, seq, length)
+
+
+def _parse_payload(header: Header, payload: bytes) -> Message:
+    """The message of a frame whose header was read; a refusal carries the frame's seq."""
+    try:
+        return MESSAGE_CLASSES[header.type].parse(payload)
+    except ProtocolError as exc:
+        exc.seq = header.seq
+        raise
 
 
 def decode_frame(data: bytes, max_payload: int = MAX_PAYLOAD) -> tuple[int, Message]:
@@ -65,8 +74,8 @@ def decode_frame(data: bytes, max_payload: int = MAX_PAYLOAD) -> tuple[int, Mess
     if len(data) != HEADER_SIZE + header.length:
         raise ProtocolError(ErrorCode.MALFORMED,
                             f"{header.type.name} header says {header.length} payload bytes, "
-                            f"frame has {len(data) - HEADER_SIZE}")
-    return header.seq, MESSAGE_CLASSES[header.type].parse(bytes(data[HEADER_SIZE:]))
+                            f"frame has {len(data) - HEADER_SIZE}", header.seq)
+    return header.seq, _parse_payload(header, bytes(data[HEADER_SIZE:]))
 
 
 class FrameDecoder:
@@ -107,7 +116,7 @@ class FrameDecoder:
                 payload = bytes(self._buf[HEADER_SIZE:end])
                 del self._buf[:end]
                 header, self._header = self._header, None
-                out.append((header.seq, MESSAGE_CLASSES[header.type].parse(payload)))
+                out.append((header.seq, _parse_payload(header, payload)))
         except ProtocolError as exc:
             self._failed = exc
             raise

@@ -11,7 +11,7 @@ from __future__ import annotations
 import math
 import struct
 from dataclasses import dataclass, field, fields
-from typing import ClassVar
+from typing import Callable, ClassVar
 
 import numpy as np
 
@@ -19,6 +19,7 @@ from .errors import ErrorCode, ProtocolError
 from .wire import MAX_COUNT, MAX_TEXT, NO_SCENE_HASH, SCENE_HASH_SIZE, MessageType
 
 _U32 = struct.Struct("<I")
+_LE_F64 = np.dtype("<f8")
 _F64 = struct.Struct("<d")
 _U32_MAX = 0xFFFFFFFF
 
@@ -44,11 +45,22 @@ class _Reader:
         self.pos += n
         return view
 
+    # the reads below unpack in place (unpack_from, frombuffer at an offset) and build a field's
+    # name only to refuse it: a SET's decoding was a tenth of a null window's server time
+
     def u32(self, name: str) -> int:
-        return _U32.unpack(self._take(4, name))[0]
+        pos = self.pos
+        if pos + 4 > len(self.buf):
+            self._take(4, name)  # raises, naming the field
+        self.pos = pos + 4
+        return _U32.unpack_from(self.buf, pos)[0]
 
     def f64(self, name: str) -> float:
-        value = _F64.unpack(self._take(8, name))[0]
+        pos = self.pos
+        if pos + 8 > len(self.buf):
+            self._take(8, name)  # raises, naming the field
+        self.pos = pos + 8
+        value = _F64.unpack_from(self.buf, pos)[0]
         if not math.isfinite(value):
             raise _bad(ErrorCode.BAD_VALUE, f"{self.what}.{name}", f"{value} is not finite")
         return value
@@ -67,7 +79,10 @@ class _Reader:
         return bytes(self._take(SCENE_HASH_SIZE, name))
 
     def _count(self, name: str, item: int) -> int:
-        n = self.u32(f"{name}.count")
+        if self.pos + 4 > len(self.buf):
+            self._take(4, f"{name}.count")  # raises, naming the field
+        n = _U32.unpack_from(self.buf, self.pos)[0]
+        self.pos += 4
         left = len(self.buf) - self.pos
         # checked before any allocation: the count must fit in the bytes actually received
         if n > MAX_COUNT or n * item > left:
@@ -76,8 +91,9 @@ class _Reader:
         return n
 
     def f64_array(self, name: str) -> np.ndarray:
-        n = self._count(name, 8)
-        arr = np.frombuffer(self._take(8 * n, name), dtype="<f8").astype(np.float64)
+        n = self._count(name, 8)  # the count fits the bytes left
+        arr = np.frombuffer(self.buf, dtype=_LE_F64, count=n, offset=self.pos).astype(np.float64)
+        self.pos += 8 * n
         if not np.isfinite(arr).all():
             i = int(np.flatnonzero(~np.isfinite(arr))[0])
             raise _bad(ErrorCode.BAD_VALUE, f"{self.what}.{name}[{i}]", f"{arr[i]} is not finite")
@@ -144,7 +160,8 @@ class _Writer:
 
     def u32_array(self, name: str, value: np.ndarray) -> None:
         arr = np.asarray(value)
-        if arr.size and (arr.dtype.kind not in "iu" or arr.min() < 0 or arr.max() > _U32_MAX):
+        if arr.size and arr.dtype != np.uint32 and (arr.dtype.kind not in "iu" or arr.min() < 0
+                                                    or arr.max() > _U32_MAX):
             raise _bad(ErrorCode.BAD_VALUE, f"{self.what}.{name}", "values are not u32")
         self._array(name, arr, "<u4")
 
@@ -172,14 +189,19 @@ class Message:
 
     TYPE: ClassVar[MessageType]
     LAYOUT: ClassVar[tuple[tuple[str, str], ...]] = ()
+    _ARRAYS: ClassVar[tuple[tuple[str, Callable[[object], object]], ...]] = ()
+
+    def __init_subclass__(cls, **kw: object) -> None:
+        super().__init_subclass__(**kw)
+        # the array fields, once per class: __post_init__ runs for every frame (a fifth of a
+        # null window's server time went to walking LAYOUT)
+        cls._ARRAYS = tuple((name, _COERCE[kind]) for name, kind in cls.LAYOUT if kind in _COERCE)
 
     def __post_init__(self) -> None:
         # array fields hold what the wire gives back (float64, uint32, list), so a message
         # compares equal to its own round trip; LAYOUT says which fields are arrays
-        for name, kind in self.LAYOUT:
-            coerce = _COERCE.get(kind)
-            if coerce is not None:
-                setattr(self, name, coerce(getattr(self, name)))
+        for name, coerce in self._ARRAYS:
+            setattr(self, name, coerce(getattr(self, name)))
 
     def serialize(self) -> bytes:
         """The payload bytes (without the frame header)."""
@@ -206,11 +228,15 @@ class Message:
 
 
 def _f64s(a: object) -> np.ndarray:
+    if type(a) is np.ndarray and a.dtype == np.float64:  # as the wire gives it
+        return a
     return np.asarray(a, dtype=np.float64)
 
 
 def _u32s(a: object) -> np.ndarray:
     arr = np.asarray(a)
+    if arr.dtype == np.uint32:  # as the wire gives it: nothing to check
+        return arr
     if arr.size == 0:
         return np.zeros(0, np.uint32)
     if arr.dtype.kind in "iu" and arr.min() >= 0 and arr.max() <= _U32_MAX:

@@ -16,6 +16,7 @@ States: AWAIT_HELLO -> READY <-> WINDOW_SET -> CLOSED (see PROTOCOL.md, "Session
 
 from __future__ import annotations
 
+from copy import copy
 from dataclasses import dataclass, replace
 from enum import Enum
 
@@ -134,7 +135,7 @@ class SphSession:
             raise ProtocolError(ErrorCode.OUT_OF_ORDER, f"{msg.TYPE.name} after the session closed")
         if seq != self._last_seq + 1:
             raise ProtocolError(ErrorCode.OUT_OF_ORDER,
-                                f"{msg.TYPE.name} has seq {seq}, expected {self._last_seq + 1}")
+                                f"{msg.TYPE.name} has seq {seq}, expected {self._last_seq + 1}", seq)
         self._last_seq = self._reply_seq = seq
         if isinstance(msg, Error):
             self.state = State.CLOSED
@@ -177,8 +178,8 @@ class SphSession:
 
     def _hello(self, msg: Hello) -> Reply:
         if msg.run_id and msg.run_id != self.offer.run_id:
-            raise ProtocolError(ErrorCode.BUSY, f"HELLO.run_id {msg.run_id!r}: this connection "
-                                                f"serves run {self.offer.run_id!r}")
+            raise ProtocolError(ErrorCode.BAD_VALUE, f"HELLO.run_id {msg.run_id[:64]!r}: this "
+                                                     f"connection serves run {self.offer.run_id!r}")
         if msg.scene_hash not in (NO_SCENE_HASH, self.offer.scene_hash):
             raise ProtocolError(ErrorCode.SCENE_MISMATCH,
                                 f"client expects scene {msg.scene_hash.hex()[:16]}..., "
@@ -229,7 +230,9 @@ class SphSession:
             self.last_window = None
             self.window = None
             self.state = State.READY
-        return self._frame(replace(result, t=self.t))
+        reply = copy(result)  # t is the session's clock; a shallow copy skips __post_init__
+        reply.t = self.t
+        return self._frame(reply)
 
     def working_frame(self, elapsed: float) -> bytes | None:
         """WORKING for the request being answered (1.1), None unless KEEPALIVE is in force."""
@@ -238,13 +241,16 @@ class SphSession:
         return self._frame(Working(float(elapsed)))
 
     def error_frame(self, exc: ProtocolError | Exception) -> bytes:
-        """ERROR frame for ``exc`` (the door closes after sending it)."""
+        """ERROR frame for ``exc`` (the door closes after sending it). It carries the refused
+        frame's own seq where its header was read, else that of the last client frame."""
         self.state = State.CLOSED
+        seq = self._reply_seq
         if isinstance(exc, ProtocolError):
             code, text = exc.code, exc.text
+            seq = seq if exc.seq is None else exc.seq
         else:
             code, text = ErrorCode.INTERNAL, f"{type(exc).__name__}: {exc}"
-        return self._frame(Error(int(code), _clip(text)))
+        return encode_frame(Error(int(code), _clip(text)), seq)
 
     def _frame(self, msg: Message) -> bytes:
         return encode_frame(msg, self._reply_seq)

@@ -64,8 +64,8 @@ async def admit(manager: RunManager, transport: DoorTransport,
         if run is None:
             await transport.close()
             return None
-    except ProtocolError as exc:
-        await _refuse(transport, exc.code, exc.text, seq)
+    except ProtocolError as exc:  # a refused frame's own seq where its header was read
+        await _refuse(transport, exc.code, exc.text, seq if exc.seq is None else exc.seq)
         return None
     except TimeoutError:
         await _refuse(transport, ErrorCode.TIMEOUT, f"no HELLO within {manager.settings.hello_timeout:g} s", 0)
@@ -89,7 +89,9 @@ async def claim_run(manager: RunManager, run_id: str, hello: Hello,
     None if the client left while waiting; ProtocolError (BUSY, CANCELLED, OUT_OF_ORDER,
     SCENE_MISMATCH) to refuse it. A refused client leaves the run as it was."""
     known = manager.runs.get(run_id)
-    if known is not None and hello.scene_hash not in (NO_SCENE_HASH, bytes.fromhex(known.info.scene_hash)):
+    if known is None:
+        raise ProtocolError(ErrorCode.NOT_FOUND, f"no run {run_id[:64]!r} on this server")
+    if hello.scene_hash not in (NO_SCENE_HASH, bytes.fromhex(known.info.scene_hash)):
         raise ProtocolError(ErrorCode.SCENE_MISMATCH,
                             f"client expects scene {hello.scene_hash.hex()[:16]}..., run {run_id} "
                             f"has {known.info.scene_hash[:16]}... (GET /runs/{run_id}/scene); "
@@ -204,9 +206,11 @@ async def serve_client(manager: RunManager, run: Run, transport: DoorTransport,
                 solve_time += took
                 reply = session.result(action, _result(measured))
                 values = _gauge_values(names, measured)
-                run.gauges.row(engine.t, measured.steps, values)
-                _progress(manager, run, engine, values, connected, solve_time)
-                await transport.send(reply)
+                run.gauges.row(engine.t, measured.steps, values)  # on disk before the reply
+                try:
+                    await transport.send(reply)
+                finally:  # the run's progress (and, twice a second, meta.json) off the round trip
+                    _progress(manager, run, engine, values, connected, solve_time)
                 if (time.monotonic() - saved_at >= settings.checkpoint_every
                         or engine.t - saved_t >= settings.checkpoint_every_t * (1 - 1e-9)):
                     await _save_state(manager, run)  # by wall time and by simulated progress
@@ -368,6 +372,8 @@ def _goback(engine: CouplingEngine) -> Measurement:
 
 def _result(m: Measurement) -> Result:
     wet = np.asarray(m.wet, dtype=bool)
+    if wet.all():  # nothing to blank out
+        return Result(0.0, int(m.steps), m.eta, np.ones(wet.size, np.uint32), m.u_ref, m.w_ref)
     z = np.zeros(wet.size)
     return Result(0.0, int(m.steps), np.where(wet, m.eta, z), wet.astype(np.uint32),
                   np.where(wet, m.u_ref, z), np.where(wet, m.w_ref, z))

@@ -499,7 +499,7 @@ class RunManager:
         run = self.runs.get(run_id)
         if run is None:
             raise ValueError(f"no run {run_id!r} on this server")
-        if run.client_attached:
+        if run.client_attached and not run.terminal:  # an ended run says it has ended
             raise ValueError(f"run {run_id} already has a coupling client")
         if run.info.state not in (QUEUED, WAITING) or not _waits_for_client(run.request):
             raise ValueError(f"run {run_id} is {run.info.status}: it takes no coupling client")

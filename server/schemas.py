@@ -73,6 +73,10 @@ class RunInfo(BaseModel):
     resumed: int = 0            # how many times the run was resumed
     scene_hash: str
     gauges_file: str | None = None
+    # the serving process's TCP coupling port (PROTOCOL.md, Transports), set on the copy each
+    # reply sends: a property of the server, not of the run (null in meta.json)
+    tcp_port: int | None = Field(None, description="the server's TCP coupling port (null: the "
+                                 "port is disabled); WebSocket clients use /runs/{id}/couple")
 
 
 def canonical_scene(scene: Scene) -> bytes:

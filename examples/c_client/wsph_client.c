@@ -35,7 +35,7 @@ enum { WSPH_HELLO = 1, WSPH_WELCOME = 2, WSPH_GETNODES = 3, WSPH_NODES = 4, WSPH
 #define WSPH_VERSION 1
 #define WSPH_HEADER 16
 #define WSPH_MAX_PAYLOAD (16u * 1024u * 1024u)
-#define READ_TIMEOUT_S 120
+#define READ_TIMEOUT_S 600  /* 1.0 has no keep-alive: a fresh server compiles for minutes (PROTOCOL.md, section 6) */
 
 /* ---------- little-endian byte buffer ---------- */
 typedef struct { unsigned char *p; size_t len, cap; } buf_t;

@@ -26,7 +26,8 @@ async def couple_websocket(ws: WebSocket, run_id: str) -> None:
 
     def run_id_of(hello: Hello) -> str:
         if hello.run_id not in ("", run_id):
-            raise ProtocolError(ErrorCode.BUSY, f"HELLO.run_id {hello.run_id!r} differs from the URL's {run_id!r}")
+            raise ProtocolError(ErrorCode.BAD_VALUE, f"HELLO.run_id {hello.run_id[:64]!r} differs from "
+                                                     f"the URL's {run_id[:64]!r}")
         return run_id
 
     admitted = await admit(manager, transport, run_id_of)

@@ -23,6 +23,11 @@ EVENT_POLL_S = 0.25
 RETRY_AFTER_S = 30  # what a refused POST is told to wait: about one short run
 
 
+def _with_port(info: RunInfo, request: Request) -> RunInfo:
+    """``info`` as sent: with this server's TCP coupling port, so clients can find it."""
+    return info.model_copy(update={"tcp_port": getattr(request.app.state, "tcp_port", None)})
+
+
 def _queue_full(exc: QueueFull) -> HTTPException:
     return HTTPException(429, str(exc), headers={"Retry-After": str(RETRY_AFTER_S)})
 
@@ -111,7 +116,7 @@ async def create_run(request: Request, manager: Manager) -> RunInfo:
     except RequestInvalid as exc:
         raise HTTPException(422, exc.errors) from None
     try:
-        return manager.submit(body).info
+        return _with_port(manager.submit(body).info, request)
     except QueueFull as exc:
         raise _queue_full(exc) from None
     except OSError as exc:  # the store cannot write (disk full): say so, no 500
@@ -119,14 +124,15 @@ async def create_run(request: Request, manager: Manager) -> RunInfo:
 
 
 @router.get("", response_model=list[RunInfo])
-async def list_runs(manager: Manager) -> list[RunInfo]:
+async def list_runs(manager: Manager, request: Request) -> list[RunInfo]:
     """Every run this server knows, including finished runs of earlier server processes."""
-    return sorted((r.info for r in manager.runs.values()), key=lambda i: i.created)
+    return [_with_port(i, request) for i in sorted((r.info for r in manager.runs.values()),
+                                                   key=lambda i: i.created)]
 
 
 @router.get("/{run_id}", response_model=RunInfo, responses=NOT_FOUND)
-async def read_run(run: RunDep) -> RunInfo:
-    return run.info
+async def read_run(run: RunDep, request: Request) -> RunInfo:
+    return _with_port(run.info, request)
 
 
 @router.get("/{run_id}/scene", responses=NOT_FOUND)

@@ -133,7 +133,7 @@ def test_scene_hash_and_run_id_checked_zero_hash_accepted():
     assert exc.value.code is ErrorCode.SCENE_MISMATCH
     with pytest.raises(ProtocolError) as exc:
         Peer(make_session()).send(Hello(0, HASH, "r2"))
-    assert exc.value.code is ErrorCode.BUSY
+    assert exc.value.code is ErrorCode.BAD_VALUE
     peer = Peer(make_session())
     assert isinstance(peer.send(Hello(0)), Reply)  # zero hash, no run id: accepted
 
@@ -226,3 +226,55 @@ def test_any_message_sequence_gives_actions_or_protocol_errors(seq_msgs):
             decode_frame(s.result(action, result()))
         elif isinstance(action, Reply):
             decode_frame(action.data)
+
+
+def _refusal(s: SphSession, frame: bytes, max_payload: int | None = None) -> tuple[int, Error]:
+    """The ERROR (seq, message) the SPH side sends for ``frame``, as a door does it: decoding
+    and the session's check both refuse through ProtocolError."""
+    try:
+        s.receive(*decode_frame(frame, s.max_payload if max_payload is None else max_payload))
+    except ProtocolError as exc:
+        seq, msg = decode_frame(s.error_frame(exc))
+        assert isinstance(msg, Error)
+        return seq, msg
+    raise AssertionError("the frame was accepted")
+
+
+def _set_frame(seq: int, t0: float, t1: float, u0: float = 1.0) -> bytes:
+    from protocol import encode_frame
+
+    frame = bytearray(encode_frame(window(t0, t1), seq))
+    if u0 != 1.0:  # patched in: the encoder itself refuses NaN
+        import struct
+
+        struct.pack_into("<d", frame, 16 + 16 + 4, u0)
+    return bytes(frame)
+
+
+@pytest.mark.parametrize("frame_of, code", [
+    (lambda: _set_frame(3, 0.0, 0.05, u0=float("nan")), ErrorCode.BAD_VALUE),  # refused decoding
+    (lambda: _set_frame(3, 0.01, 0.05), ErrorCode.TIME_MISMATCH),             # refused by the session
+    (lambda: _set_frame(3, 0.0, 0.5), ErrorCode.BAD_VALUE),                   # window > window_max
+    (lambda: _set_frame(9, 0.0, 0.05), ErrorCode.OUT_OF_ORDER),               # a wrong seq: its own
+])
+def test_an_error_refusing_a_frame_carries_that_frames_seq(frame_of, code):
+    """PROTOCOL.md, section 3: the ERROR refusing a frame carries the seq of that frame (as sent,
+    a wrong one included), whether the bytes or the session refused it."""
+    s = make_session()
+    peer = Peer(s)
+    handshake(peer)
+    peer.send(GetNodes())                      # seq 2 accepted
+    frame = frame_of()
+    seq, err = _refusal(s, frame)
+    assert err.code == code, err.text
+    assert seq == int.from_bytes(frame[8:12], "little")
+
+
+def test_an_error_for_an_unreadable_header_carries_the_last_accepted_seq():
+    s = make_session()
+    handshake(Peer(s))
+    try:
+        decode_frame(b"XSPH" + bytes(12))
+    except ProtocolError as exc:
+        seq, err = decode_frame(s.error_frame(exc))
+    assert err.code == ErrorCode.MALFORMED and seq == 1

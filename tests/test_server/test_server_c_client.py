@@ -55,4 +55,4 @@ def test_c_client_gets_a_clear_error_for_an_unknown_run(srv, c_client):
     out = subprocess.run([str(c_client), "127.0.0.1", str(srv.tcp_port), "no-such-run", "3"],
                          capture_output=True, text=True, timeout=60)
     assert out.returncode == 3
-    assert "server error 13: no run 'no-such-run' on this server" in out.stderr
+    assert "server error 15: no run 'no-such-run' on this server" in out.stderr

@@ -113,7 +113,7 @@ def test_bad_input_on_the_tcp_door_gets_a_clear_error_and_the_server_keeps_servi
     # 3. a run that does not exist
     c = TcpClient(srv.tcp_port)
     c.request(Hello(0, bytes(32), "nope"))
-    assert "no run 'nope'" in _expect_error(c, ErrorCode.BUSY)
+    assert "no run 'nope'" in _expect_error(c, ErrorCode.NOT_FOUND)
     # 4. a scene the client did not expect: refused, and the run keeps waiting (issue 15: the
     #    spec says the server refuses the client, not that the run fails)
     c = TcpClient(srv.tcp_port)
