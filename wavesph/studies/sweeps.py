@@ -111,8 +111,11 @@ def accuracy_points(quick: bool = False, methods: Iterable[str] | None = None) -
     ratios = (2.0, 3.0) if quick else (3.0, 5.0, 8.0)          # H/dp of the wave cases
     flume_opts = {"periods": 1.0 if quick else 3.0, "ramp_periods": 1.0}
     for name in flumes:
-        h = float(cases[name]["H"])
-        pts += [Point(f"flume_{name}", m, round(h / r, 6), flume_opts) for m in methods for r in ratios]
+        h, d = float(cases[name]["H"]), float(cases[name]["d"])
+        # dp: the divisor of the depth nearest H / ratio (a scene whose particles miss the
+        # still-water level is refused: its gauges would read up to -dp/2 in still water)
+        pts += [Point(f"flume_{name}", m, round(d / round(d * r / h), 9), flume_opts)
+                for m in methods for r in ratios]
     a = 0.25 if quick else 0.5                                   # dam-break column width [m]
     db_ratios = (6, 9, 12) if quick else (10, 20, 40)           # column height 2a / dp
     pts += [Point("dambreak", m, round(2 * a / r, 6), {"a": a}) for m in methods for r in db_ratios]
