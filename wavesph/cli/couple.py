@@ -201,6 +201,7 @@ def main(args: argparse.Namespace) -> int:
     t = report.records[-1].t1 if n else float("nan")
     overhead = report.model_time / report.wall_time if report.wall_time > 0 else 0.0
     print(f"coupled {n} windows to t = {t:.6g} s in {report.wall_time:.2f} s "
-          f"(wave model {overhead:.1%} of wall time); gauges used {report.gauges}"
+          f"(wave model {overhead:.1%} of wall time); correction gauges: "
+          + (", ".join(f"{side} {name}" for side, name in report.gauge_names.items()) or "none")
           + (f"; series in {args.output}" if args.output else ""))
     return 0
