@@ -68,7 +68,12 @@ def test_sweep_csv_and_chart(swept, tmp_path):
     out, points, records = swept
     path = tmp_path / "accuracy.csv"
     sweeps.write_csv(records, path, command="wavesph bench accuracy --test")
-    assert path.read_text().startswith("# made by: wavesph bench accuracy --test")
+    assert path.read_text().startswith("case,method,")     # one header row, no # line
+    assert json.loads(path.with_suffix(".meta.json").read_text())["made_by"] == \
+        "wavesph bench accuracy --test"
+    import pandas
+
+    assert pandas.read_csv(path).shape == (3, len(ACCURACY_COLUMNS))
     rows = sweeps.read_csv(path)
     assert list(rows[0]) == ACCURACY_COLUMNS
     assert [r["status"] for r in rows] == ["ok", "ok", "failed"]
@@ -238,8 +243,8 @@ def test_run_warns_when_a_scene_costs_far_more_than_the_plan(tmp_path):
 def test_shipped_sweep_data_plans_the_demo():
     rows = planning.sweep_data()
     assert rows and set(ACCURACY_COLUMNS) <= set(rows[0])
-    text = (ROOT / "wavesph" / "cases" / planning.SWEEP_CSV).read_text()
-    assert text.startswith("# made by: wavesph bench accuracy")
+    meta = (ROOT / "wavesph" / "cases" / planning.SWEEP_CSV).with_suffix(".meta.json")
+    assert json.loads(meta.read_text())["made_by"].startswith("wavesph bench accuracy")
     from sph_core.scene import load_scene
 
     scene = load_scene(ROOT / "examples/scenes/demo_beach_flume.toml")
