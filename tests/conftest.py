@@ -22,7 +22,7 @@ TESTS = Path(__file__).resolve().parent
 # the quick tier, as paths under tests/ (a folder ends with "/"): each test measured under 1 s
 # (`pytest --durations=0`); kernel calls are checked by the hooks below (kernel_calls.py)
 UNIT: tuple[str, ...] = (
-    "test_protocol/", "test_server/", "test_cli.py", "test_layers.py",
+    "test_protocol/", "test_server/", "test_cli.py", "test_layers.py", "test_analysis.py",
     "test_wave_client/test_theories.py", "test_wave_client/test_client.py", "test_wave_client/test_client_absorption.py",
     "test_cases/test_particle_noise.py", "test_cases/test_wall_impact.py",
     "test_sph_core/test_scene.py", "test_sph_core/test_geometry.py",
