@@ -119,5 +119,6 @@ def test_every_example_previews_without_solving(tmp_path, name):
     assert meta["status"] == "preview" and meta["steps"] == 0
     assert piece(out / "snapshots" / "particles_00000.vtu", "NumberOfPoints") == meta["n_particles"]
     scene = load_scene(SCENES / name)
-    assert piece(out / "geometry.vtu", "NumberOfCells") == (
-        1 + len(scene.beds) + len(scene.structures) + len(scene.open_boundaries))
+    assert piece(out / "geometry.vtu", "NumberOfCells") == (   # one line cell per segment
+        3 + sum(len(b.points) - 1 for b in scene.beds) + 4 * len(scene.structures)
+        + len(scene.open_boundaries))
