@@ -49,6 +49,7 @@ class RunInfo(BaseModel):
     """GET /runs/{id}. ``status`` is ``state`` plus the reason, e.g. 'failed: client disconnected'."""
 
     id: str
+    name: str = ""              # the scene's name (runs of one scene share it; the id tells them apart)
     mode: str
     state: str
     status: str

@@ -46,6 +46,7 @@ NOT_UNIT: frozenset[str] = frozenset({  # "path" or "path::test_name" (any param
     "test_server/test_server_pages.py::test_particles_endpoint_serves_the_last_snapshot",
     "test_server/test_server_pages.py::test_page_in_a_real_browser_follows_a_run",
     "test_server/test_server_pages.py::test_api_docs_render_in_a_headless_browser",
+    "test_server/test_server_pages.py::test_page_errors_stay_as_sentences_and_the_form_takes_a_scene_file",
     # over 1 s (timeouts and delays scaled down, but still there)
     "test_server/test_server_ws_pings.py::test_a_client_busy_longer_than_the_ping_timeout_keeps_its_run",
     "test_server/test_server_ws_pings.py::test_a_client_dropped_by_an_opted_in_ping_timeout_keeps_its_data_and_resumes",
