@@ -40,11 +40,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def main(args: argparse.Namespace) -> int:
     try:
         scene = load_scene(args.scene)
-        refusal = open_end_refusal(args.scene, scene)
+        refusal = None if args.preview else open_end_refusal(args.scene, scene)  # no step: no waves
         if refusal:
             print(f"wavesph run: {refusal}", file=sys.stderr)
             return 2
-        if scene.open_boundaries:
+        if scene.open_boundaries and not args.preview:
             print("wavesph run: nothing drives the open boundaries here: they hold still water "
                   "(for waves: `wavesph submit` with a [source], or `wavesph couple --scene`)",
                   file=sys.stderr)
