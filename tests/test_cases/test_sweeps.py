@@ -368,3 +368,17 @@ def test_a_failed_coupled_point_keeps_its_run_directory(monkeypatch):
     assert (made[0] / "r1" / "meta.json").exists()
     import shutil
     shutil.rmtree(made[0])
+
+
+def test_plan_table_says_what_to_do_and_what_it_rests_on(tmp_path, capsys):
+    import wavesph.cli
+
+    data = _synthetic(tmp_path)
+    assert wavesph.cli.main(["plan", str(ROOT / "examples/scenes/demo_beach_flume.toml"),
+                             "--H", "0.04", "--T", "1.4", "--data", str(data)]) == 0
+    out = capsys.readouterr().out
+    assert not any(line.startswith("{") for line in out.splitlines())   # JSON only with --json
+    assert "Rests on: error = 0.3 (H/dp)^-1.00 fitted to 3 flume points" in out
+    assert "H/dp 2-8" in out and "c0 = 15.3 m/s" in out     # the scene's own c0
+    assert "To apply it, in the scene file:" in out and "    dp = 0.006667" in out
+    assert "flat + 3.4 structures" in out
