@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import threading
+
 import logging
 from contextlib import asynccontextmanager
 
@@ -51,6 +53,9 @@ def create_app(settings: Settings | None = None,
     app = FastAPI(title="wavesph", version="0.1.0", lifespan=lifespan,
                   description="SPH coupling server: HTTP run management, WebSocket and TCP coupling "
                               "(protocol/PROTOCOL.md).")
+    # set when the server is told to stop (server.asgi.Server): the page's event streams end at
+    # once instead of holding uvicorn's "Waiting for connections to close" until the run ends
+    app.state.stopping = threading.Event()
     app.include_router(runs.router)
     app.include_router(couple.router)
 

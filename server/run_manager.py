@@ -270,8 +270,9 @@ class RunManager:
         scene_bytes = canonical_scene(request.scene)
         from protocol import scene_hash
 
-        info = RunInfo(id=run_id, mode=request.mode, device=request.scene.run.device, state=QUEUED,
-                       status=QUEUED, created=time.time(), t_end=request.scene.t_end,
+        info = RunInfo(id=run_id, name=request.scene.name, mode=request.mode,
+                       device=request.scene.run.device, state=QUEUED, status=QUEUED,
+                       created=time.time(), t_end=request.scene.t_end,
                        scene_hash=scene_hash(scene_bytes).hex(),
                        gauges_file="gauges.csv" if _windowed(request) else "sph/probes.csv")
         run_dir = self.store.create(run_id, request.model_dump(mode="json"), scene_bytes)

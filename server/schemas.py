@@ -49,6 +49,7 @@ class RunInfo(BaseModel):
     """GET /runs/{id}. ``status`` is ``state`` plus the reason, e.g. 'failed: client disconnected'."""
 
     id: str
+    name: str = ""              # the scene's name (runs of one scene share it; the id tells them apart)
     mode: str
     device: str = "cpu"         # where the SPH steps run (the scene's [run] device)
     state: str

@@ -15,7 +15,8 @@ from __future__ import annotations
 import logging
 from pathlib import Path
 
-from protocol import MAX_PAYLOAD, Bye, Error, Message, Nodes, Result, Welcome, decode_frame
+from protocol import (MAX_PAYLOAD, Bye, Error, Gauges, Message, Nodes, Result, Welcome,
+                      decode_frame)
 from protocol.session import HELLO_LIMIT
 from wave_client.coupling import CouplingCore, CouplingOptions, GaugeLog
 
@@ -57,18 +58,27 @@ class TheoryClient:
             frames = [self.core.error_frame(exc)]
         self._out.extend(decode_frame(f, self.max_payload) for f in frames)
 
+    def _start(self) -> list[bytes]:
+        """The gauge log, then the first window."""
+        core = self.core
+        self._log = GaugeLog(self._log_path, "built-in theory source: gauges measured by SPH "
+                             "and the theory (<gauge>_eta_model)\nSI units; eta up from "
+                             "the still-water level; t is the SPH time")
+        self._log.labels = core.gauge_labels()
+        self._log.describe(core.metadata())
+        return core.next_window()
+
     def _answer(self, seq: int, msg: Message) -> list[bytes]:
         core = self.core
         if isinstance(msg, Welcome):
             return [core.on_welcome(seq, msg)]
         if isinstance(msg, Nodes):
             core.on_nodes(seq, msg)
-            self._log = GaugeLog(self._log_path, "built-in theory source: gauges measured by SPH "
-                                 "and the theory (eta_model_i)\nSI units; eta up from the "
-                                 "still-water level; t is the SPH time")
-            for line in core.describe():
-                self._log.note(line)
-            return core.next_window()
+            ask = core.gauges_request()   # the gauges' names for theory.csv's columns
+            return [ask] if ask is not None else self._start()
+        if isinstance(msg, Gauges):
+            core.on_gauges(seq, msg)
+            return self._start()
         if isinstance(msg, Result):
             record = core.on_result(seq, msg)
             if self._log is not None:

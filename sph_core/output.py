@@ -134,10 +134,12 @@ class RunWriter:
 
 
 def write_geometry_vtk(scene: Any, path: Path) -> Path:
-    """The scene's outlines as VTK polylines (``path`` without suffix; returns the .vtu): the
-    tank's inner faces, each bed's polyline, each structure's rectangle, each open end's face.
-    Cell data ``part``: 0 tank, 1 bed, 2 structure, 3 open end."""
-    from pyevtk.hl import polyLinesToVTK
+    """The scene's outlines as VTK line cells (``path`` without suffix; returns the .vtu): the
+    tank's inner faces, each bed's polyline, each structure's rectangle, each open end's face,
+    one two-point cell per segment. Cell data ``part``: 0 tank, 1 bed, 2 structure, 3 open end.
+    (Poly-line cells, VTK type 4, opened in ParaView but not in meshio 5.)"""
+    from pyevtk.hl import unstructuredGridToVTK
+    from pyevtk.vtk import VtkLine
 
     t = scene.tank
     lines: list[tuple[list[tuple[float, float]], int]] = [
@@ -148,9 +150,13 @@ def write_geometry_vtk(scene: Any, path: Path) -> Path:
     top = scene.still_water_level if scene.still_water_level is not None else t.z1
     lines += [([(x, t.z0), (x, top)], 3)
               for x in (t.x0 if o.side == "left" else t.x1 for o in scene.open_boundaries)]
-    x = np.array([p[0] for pts, _ in lines for p in pts], dtype=float)
-    z = np.array([p[1] for pts, _ in lines for p in pts], dtype=float)
-    counts = np.array([len(pts) for pts, _ in lines], dtype=np.int64)
-    out = polyLinesToVTK(str(path), x, np.zeros_like(x), z, pointsPerLine=counts,
-                         cellData={"part": np.array([k for _, k in lines], dtype=np.int32)})
+    segments = [(a, b, part) for pts, part in lines for a, b in zip(pts[:-1], pts[1:])]
+    x = np.array([p[0] for a, b, _ in segments for p in (a, b)], dtype=float)
+    z = np.array([p[1] for a, b, _ in segments for p in (a, b)], dtype=float)
+    n = len(segments)   # pyevtk's linesToVTK writes NumberOfCells="5.0", which meshio refuses
+    out = unstructuredGridToVTK(
+        str(path), x, np.zeros_like(x), z, connectivity=np.arange(2 * n, dtype=np.int64),
+        offsets=2 * np.arange(1, n + 1, dtype=np.int64),
+        cell_types=np.full(n, VtkLine.tid, dtype=np.uint8),
+        cellData={"part": np.array([k for _, _, k in segments], dtype=np.int32)})
     return Path(out)

@@ -508,6 +508,9 @@ class Scene(_Model):
                 raise ValueError(f"still_water_level: {swl} m, but the highest water block's top "
                                  f"is {max(tops)} m: the blocks hold the still water, so they "
                                  "should meet it (within dp/2)")
+            msg = datum_mismatch(swl, max(tops), t.z0, self.dp)
+            if msg:
+                raise ValueError(f"still_water_level: {msg}")
         dup = {n for n, k in Counter(p.name for p in self.probes).items() if k > 1}  # O(n)
         if dup:
             raise ValueError(f"probes: duplicate names {sorted(dup)}")
@@ -558,6 +561,33 @@ class Scene(_Model):
         """Speed of sound [m/s]: explicit, or c0_factor * sqrt(2 g H)."""
         c = self.constants
         return c.c0 if c.c0 is not None else c.c0_factor * math.sqrt(2.0 * c.g * self.water_height)
+
+
+def filled_surface(block_top: float, z0: float, dp: float) -> float:
+    """z [m] of the water surface the particles make in a block reaching ``block_top``: rows sit
+    at z0 + (j + 1/2) dp below the top (sph_core.geometry's lattice, anchored at the tank
+    floor ``z0``), each holding a layer dp thick."""
+    return z0 + dp * math.ceil((block_top - z0) / dp - 0.5 - 1e-9)
+
+
+def datum_mismatch(swl: float, block_top: float, z0: float, dp: float) -> str | None:
+    """Why the particles' surface would miss the still-water level, or None (with the highest
+    block's top within dp/2 of the level, it misses only if dp does not divide the depth
+    ``swl - z0``). Elevation gauges read eta = z_surface - still_water_level, so a surface dp/2
+    low reads -dp/2 in still water (a third of H at H/dp 1.5), and the open ends' depth
+    disagrees with the water's."""
+    if not math.isfinite((block_top - z0) / dp):   # dp 5e-324: the particle cap refuses it
+        return None
+    surface = filled_surface(block_top, z0, dp)
+    if abs(surface - swl) <= 1e-3 * dp:   # round-off of dp values such as H/3
+        return None
+    depth = swl - z0
+    rows = depth / dp
+    fine, coarse = depth / math.ceil(rows), depth / max(1, math.floor(rows))
+    return (f"{swl:g} m is {rows:.4g} dp above the tank floor z0 = {z0:g} m (dp = {dp:g} m): "
+            f"the particles would fill to {surface:.4g} m and every elevation gauge would read "
+            f"{surface - swl:+.3g} m in still water; pick a dp that divides the depth {depth:g} m, "
+            f"e.g. {fine:.4g} or {coarse:.4g} m")
 
 
 def _format_errors(exc: ValidationError) -> str:

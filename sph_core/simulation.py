@@ -45,6 +45,7 @@ from .geometry import build_layout
 from .kernels import w_of_q, wendland_alpha
 from .neighbours import CellGrid, compute_cells, counting_sort
 from .load_probes import LoadProbes
+from .open_boundary import INLET_IDLE
 from .open_ends import OpenBoundaries
 from .output import RunWriter
 from .particles import FLUID, INACTIVE, M, P, RHO, VX, VZ, WALL, X, Z, Checkpoint, ParticleSet
@@ -363,7 +364,9 @@ class Simulation:
         if self.writer is None:
             raise RuntimeError("write_snapshot: this simulation has no run_dir")
         ps = self.particles
-        sel = ps.kind[: ps.n] >= 0
+        # idle open-end buffer particles (kinds INLET_IDLE, OUTLET_IDLE: above the end's surface,
+        # held in place, in no pass) are left out: in ParaView and the page they hung in the air
+        sel = (ps.kind[: ps.n] >= 0) & (ps.kind[: ps.n] < INLET_IDLE)
         fld = {name: ps.field(row)[sel] for name, row in
                (("rho", RHO), ("pressure", P), ("vx", VX), ("vz", VZ))}
         fld["kind"] = ps.kind[: ps.n][sel].astype(np.int32)

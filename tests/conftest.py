@@ -22,7 +22,7 @@ TESTS = Path(__file__).resolve().parent
 # the quick tier, as paths under tests/ (a folder ends with "/"): each test measured under 1 s
 # (`pytest --durations=0`); kernel calls are checked by the hooks below (kernel_calls.py)
 UNIT: tuple[str, ...] = (
-    "test_protocol/", "test_server/", "test_cli.py", "test_layers.py",
+    "test_protocol/", "test_server/", "test_cli.py", "test_layers.py", "test_analysis.py",
     "test_wave_client/test_theories.py", "test_wave_client/test_client.py", "test_wave_client/test_client_absorption.py",
     "test_cases/test_particle_noise.py", "test_cases/test_wall_impact.py",
     "test_sph_core/test_scene.py", "test_sph_core/test_geometry.py",
@@ -45,6 +45,8 @@ NOT_UNIT: frozenset[str] = frozenset({  # "path" or "path::test_name" (any param
     "test_server/test_server_http.py::test_cancel_standalone_and_unknown_run",
     "test_server/test_server_pages.py::test_particles_endpoint_serves_the_last_snapshot",
     "test_server/test_server_pages.py::test_page_in_a_real_browser_follows_a_run",
+    "test_server/test_server_pages.py::test_api_docs_render_in_a_headless_browser",
+    "test_server/test_server_pages.py::test_page_errors_stay_as_sentences_and_the_form_takes_a_scene_file",
     # over 1 s (timeouts and delays scaled down, but still there)
     "test_server/test_server_ws_pings.py::test_a_client_busy_longer_than_the_ping_timeout_keeps_its_run",
     "test_server/test_server_ws_pings.py::test_a_client_dropped_by_an_opted_in_ping_timeout_keeps_its_data_and_resumes",

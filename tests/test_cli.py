@@ -232,4 +232,17 @@ def test_run_refuses_bad_scene_files_in_one_line(tmp_path, capsys, change, words
     assert wavesph.cli.main(["run", str(scene), "-o", str(tmp_path / "out")]) == 2
     err = capsys.readouterr().err.strip()
     assert err.startswith("wavesph run: ") and "\n" not in err and words in err, err
+
+
+@pytest.mark.parametrize("table, command", [('\n[source]\ntheory = "stokes"\nH = 0.04\nT = 1.4\n',
+                                             "wavesph submit"),
+                                            ('mode = "coupled"\n', "wavesph couple --scene")])
+def test_run_refuses_a_scene_whose_open_ends_a_server_drives(tmp_path, capsys, table, command):
+    # the same file makes waves through `submit`; `run` would step still water without a word
+    demo = (ROOT / "examples" / "scenes" / "demo_beach_flume.toml").read_text()
+    scene = tmp_path / "waves.toml"
+    scene.write_text(table + demo if table.startswith("mode") else demo + table)
+    assert wavesph.cli.main(["run", str(scene), "-o", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and command in err
     assert not (tmp_path / "out").exists()

@@ -4,6 +4,7 @@
     scene = wavesph.load_scene("examples/scenes/dambreak.toml")
     sim = wavesph.run_scene(scene, "runs/dambreak")        # as `wavesph run`
     df = wavesph.read_gauges("runs/dambreak/probes.csv")    # any wavesph gauge CSV
+    res = wavesph.analyse("runs/flume", t_from=3.0)        # Hm0, Tp, H1/3, Hmax; q; load peaks
 
 Subpackages: ``wavesph.cli`` (the `wavesph` command), ``wavesph.cases`` (named scenes and their
 references), ``wavesph.studies`` (sweeps over many runs on dask: accuracy, stability, `wavesph
@@ -23,7 +24,7 @@ if TYPE_CHECKING:
     from sph_core.scene import Scene
     from sph_core.simulation import Simulation
 
-__all__ = ["load_scene", "read_gauges", "run_scene"]
+__all__ = ["analyse", "load_scene", "read_gauges", "run_scene"]
 
 
 def load_scene(path: str | Path) -> "Scene":
@@ -54,3 +55,14 @@ def read_gauges(path: str | Path) -> "pandas.DataFrame":
     from sph_core.output import load_gauges
 
     return pandas.DataFrame(load_gauges(path))
+
+
+def analyse(run_dir: str | Path, t_from: float | None = None,
+            period: float | None = None) -> dict:
+    """A run directory's gauges analysed (as `wavesph analyse`): per elevation gauge Hm0, Tp,
+    H1/3, Hmax, Tm; per overtopping probe the mean discharge q [m^2/s]; per force and
+    pressure-line column the peaks (per wave ``period`` too). ``wavesph.analysis.analyse_run``;
+    the single-record functions are there too (wave_statistics, mean_overtopping, peaks)."""
+    from .analysis import analyse_run
+
+    return analyse_run(run_dir, t_from, period)

@@ -1,4 +1,7 @@
-"""Wave-record analysis for flume validation: RMSE against theory, reflection coefficient.
+"""Wave-record analysis: RMSE against theory, reflection coefficient (flume validation), and the
+post-processing of a run (wave height and period per gauge, mean overtopping discharge, load
+peaks: ``wave_statistics``, ``mean_overtopping``, ``peaks``, ``analyse_run``; the command
+`wavesph analyse RUN_DIR`).
 
 Reflection by least squares over two or more gauges (Goda & Suzuki 1976 for two gauges;
 Mansard & Funke 1980 for more): at the angular frequency omega each gauge j's complex amplitude
@@ -26,7 +29,9 @@ returned here.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import Any
 
 import numpy as np
 from scipy.optimize import minimize_scalar
@@ -140,3 +145,167 @@ def reflection_coefficient(t: np.ndarray, etas: np.ndarray, xs: np.ndarray, peri
     amplitudes are those at the centre of the gauge array."""
     s = separate_harmonics(t, etas, xs, period, [k], decay=decay)[0]
     return s.kr, s.a_incident, s.a_reflected
+
+
+# ---------------------------------------------------------------------------- post-processing
+# What an engineer reads off a run: wave height and period per gauge, the mean overtopping
+# discharge, force and pressure peaks. Functions of (t, series) arrays, and ``analyse_run`` on a
+# run directory (`wavesph analyse RUN_DIR`).
+
+@dataclass(frozen=True)
+class WaveStats:
+    """Wave statistics of one elevation record [m, s].
+
+    Hm0 = 4 sqrt(m0), m0 the variance of eta about its mean (the spectrum's zeroth moment);
+    Tp = 1 / the frequency of the periodogram's peak; from the zero-down-crossing waves
+    (each wave from one down-crossing of the mean level to the next, its height max - min):
+    H1_3 the mean of the highest third of heights, Hmax the highest, Tm the mean period.
+    H1_3, Hmax and Tm are None without one whole wave."""
+
+    Hm0: float
+    Tp: float
+    H1_3: float | None
+    Hmax: float | None
+    Tm: float | None
+    n_waves: int
+    t_from: float
+    t_to: float
+
+
+def _window(t: np.ndarray, y: np.ndarray, t_from: float | None, what: str
+            ) -> tuple[np.ndarray, np.ndarray]:
+    t = np.asarray(t, dtype=float)
+    y = np.asarray(y, dtype=float)
+    if t.shape != y.shape or t.ndim != 1:
+        raise ValueError(f"{what}: t and the series differ in shape ({t.shape}, {y.shape})")
+    sel = t >= (t[0] if t_from is None else t_from) - 1e-12
+    t, y = t[sel], y[sel]
+    if t.size < 3:
+        raise ValueError(f"{what}: fewer than 3 samples after t = {t_from} s")
+    return t, y
+
+
+def wave_statistics(t: np.ndarray, eta: np.ndarray, t_from: float | None = None) -> WaveStats:
+    """WaveStats of the record ``eta(t)`` [m] from ``t_from`` [s] on (skip the start-up ramp).
+
+    The record must be uniformly sampled (a probe's probe_every, a coupled run's windows) and
+    wet: a dry sample (NaN) raises ValueError, as no stand-in height would be right."""
+    t, eta = _window(t, eta, t_from, "eta")
+    if not np.all(np.isfinite(eta)):
+        raise ValueError(f"eta: {int(np.sum(~np.isfinite(eta)))} dry or non-finite samples "
+                         "(a gauge that runs dry has no wave height)")
+    dt = np.diff(t)
+    if np.ptp(dt) > 1e-6 * max(float(np.mean(dt)), 1e-300) + 1e-9:
+        raise ValueError("t: the record is not uniformly sampled")
+    e = eta - eta.mean()
+    hm0 = 4.0 * float(np.sqrt(np.mean(e ** 2)))
+    spec = np.abs(np.fft.rfft(e)) ** 2
+    freq = np.fft.rfftfreq(e.size, float(np.mean(dt)))
+    k = 1 + int(np.argmax(spec[1:]))     # not the mean (f = 0)
+    tp = float(1.0 / freq[k])
+    # zero-down-crossings: e >= 0 then < 0; crossing time by linear interpolation
+    i = np.flatnonzero((e[:-1] >= 0.0) & (e[1:] < 0.0))
+    tc = t[i] + e[i] / (e[i] - e[i + 1]) * (t[i + 1] - t[i])
+    heights = np.array([e[a:b + 1].max() - e[a:b + 1].min() for a, b in zip(i[:-1], i[1:])])
+    if heights.size == 0:
+        return WaveStats(hm0, tp, None, None, None, 0, float(t[0]), float(t[-1]))
+    top = np.sort(heights)[::-1][:max(1, heights.size // 3)]
+    return WaveStats(hm0, tp, float(top.mean()), float(heights.max()), float(np.mean(np.diff(tc))),
+                     int(heights.size), float(t[0]), float(t[-1]))
+
+
+def mean_overtopping(t: np.ndarray, volume: np.ndarray, t_from: float | None = None) -> float:
+    """Mean overtopping discharge q [m^2/s] (per metre of width) from ``t_from`` [s] to the
+    record's end: the change of an overtopping probe's cumulative ``<name>_volume`` [m^3/m]
+    over the time between."""
+    t, v = _window(t, volume, t_from, "volume")
+    ok = np.isfinite(v)
+    if ok.sum() < 2:
+        raise ValueError("volume: fewer than 2 recorded samples")
+    t, v = t[ok], v[ok]
+    return float((v[-1] - v[0]) / (t[-1] - t[0]))
+
+
+@dataclass(frozen=True)
+class Peaks:
+    """Extremes of a load record (force [N/m], moment [N m/m] or pressure [Pa]) and, given the
+    wave period, of its per-period maxima: their mean and the mean of their highest tenth."""
+
+    max: float
+    t_max: float
+    min: float
+    t_min: float
+    mean: float
+    mean_of_period_maxima: float | None = None
+    highest_tenth_mean: float | None = None
+    n_periods: int = 0
+
+
+def peaks(t: np.ndarray, y: np.ndarray, t_from: float | None = None,
+          period: float | None = None) -> Peaks:
+    """Peaks of ``y(t)`` from ``t_from`` [s] on; with ``period`` [s], also per-period maxima
+    (whole periods from the first sample; the last partial period left out). Empty samples
+    (NaN: no fluid near a pressure point) are left out."""
+    t, y = _window(t, y, t_from, "series")
+    ok = np.isfinite(y)
+    if not ok.any():
+        raise ValueError("series: no recorded sample")
+    t, y = t[ok], y[ok]
+    i, j = int(np.argmax(y)), int(np.argmin(y))
+    per_max = per_tenth = None
+    n = 0
+    if period is not None:
+        if not period > 0:
+            raise ValueError(f"period: must be > 0 s, got {period}")
+        n = int((t[-1] - t[0]) // period)
+        maxima = [y[(t >= t[0] + k * period) & (t < t[0] + (k + 1) * period)] for k in range(n)]
+        maxima = np.array([m.max() for m in maxima if m.size])
+        n = int(maxima.size)
+        if n:
+            top = np.sort(maxima)[::-1][:max(1, n // 10)]
+            per_max, per_tenth = float(maxima.mean()), float(top.mean())
+    return Peaks(float(y[i]), float(t[i]), float(y[j]), float(t[j]), float(y.mean()),
+                 per_max, per_tenth, n)
+
+
+RUN_CSVS = ("probes.csv", "gauges.csv", "sph/probes.csv")   # a `wavesph run` dir, a server run's
+
+
+def analyse_run(run_dir: str | Path, t_from: float | None = None,
+                period: float | None = None) -> dict[str, Any]:
+    """Every gauge of a run directory, analysed: {"waves": {gauge: WaveStats fields},
+    "overtopping": {probe: {"q_m2_s": ...}}, "loads": {column: Peaks fields}, "skipped":
+    {column: why}, "files": [...]}. Elevation from ``<g>_eta`` columns (gauges.csv first, then
+    probes.csv), overtopping from ``<name>_volume``, loads from force (``_fx``, ``_fz``,
+    ``_my``) and pressure-line (``_p<k>``) columns."""
+    from sph_core.output import load_gauges
+
+    run_dir = Path(run_dir)
+    files = [run_dir / f for f in RUN_CSVS if (run_dir / f).is_file()]
+    if not files:
+        raise ValueError(f"{run_dir}: no {', '.join(RUN_CSVS)} here (a run directory of "
+                         "`wavesph run` or of the server)")
+    out: dict[str, Any] = {"files": [str(f.relative_to(run_dir)) for f in files], "t_from": t_from,
+                           "period": period, "waves": {}, "overtopping": {}, "loads": {},
+                           "skipped": {}}
+    for f in files:
+        cols = load_gauges(f)
+        t = cols.get("t")
+        if t is None or t.size < 3:
+            continue
+        for name, y in cols.items():
+            try:
+                if name.endswith("_eta") and name[:-4] not in out["waves"]:
+                    out["waves"][name[:-4]] = asdict(wave_statistics(t, y, t_from))
+                elif name.endswith("_volume"):
+                    out["overtopping"][name[:-7]] = {"q_m2_s": mean_overtopping(t, y, t_from)}
+                elif _is_load(name) and name not in out["loads"]:
+                    out["loads"][name] = asdict(peaks(t, y, t_from, period))
+            except ValueError as exc:
+                out["skipped"][name] = str(exc)
+    return out
+
+
+def _is_load(name: str) -> bool:
+    stem, _, q = name.rpartition("_")
+    return bool(stem) and (q in ("fx", "fz", "my") or (q[:1] == "p" and q[1:].isdigit()))

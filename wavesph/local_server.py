@@ -42,6 +42,7 @@ class InProcessServer:
         return self
 
     def __exit__(self, *exc: object) -> None:
+        self.app.state.stopping.set()   # event streams end (as on Ctrl-C of `wavesph serve`)
         self.server.should_exit = True
         self.thread.join(timeout=30)
 

@@ -42,8 +42,9 @@ below; unknown keys are errors, and every error names its field path
 absolute (the tank floor is usually z = 0). A key whose default is "—" is optional and unset by
 default; "required" keys must be given. Tuples such as `(x, z)` are written as TOML arrays,
 `[4.6, 0.3]`. A file may also hold `mode`, `[coupling]` and `[source]` beside the scene: the
-server and `wavesph couple --scene` read them, `wavesph run` ignores them
-([running and coupling](running_and_coupling.md)).
+server (`wavesph submit`) reads them, `wavesph couple --scene` reads `[coupling]` (its own
+model replaces a `[source]`), and `wavesph run` refuses a scene whose open ends a `[source]` or
+`mode = "coupled"` drives ([running and coupling](running_and_coupling.md)).
 """
 
 

@@ -153,6 +153,20 @@ async def get_gauges(run: RunDep, format: Literal["csv", "json"] = Query("csv"))
     return Response(json.dumps({"columns": columns, "rows": rows}), media_type="application/json")
 
 
+@router.get("/{run_id}/probes", responses=NOT_FOUND)
+async def get_probes(run: RunDep, format: Literal["csv", "json"] = Query("csv")) -> Response:
+    """Every probe of the SPH side (sph_core probes.csv: elevation, point, front, force,
+    pressure-line and overtopping columns) as CSV or JSON; a coupled run restarted into
+    sph.<k>/ serves the newest. /gauges is the coupling gauges' record."""
+    paths = sorted(run.dir.glob("sph*/probes.csv"), key=lambda p: p.stat().st_mtime)
+    if not paths:
+        raise HTTPException(404, f"run {run.info.id} has no probe data yet")
+    if format == "csv":
+        return FileResponse(paths[-1], media_type="text/csv", filename=f"{run.info.id}-probes.csv")
+    columns, rows = await asyncio.to_thread(read_gauge_rows, paths[-1])
+    return Response(json.dumps({"columns": columns, "rows": rows}), media_type="application/json")
+
+
 @router.get("/{run_id}/bodies", responses=NOT_FOUND)
 async def get_bodies(run: RunDep, format: Literal["csv", "json"] = Query("csv")) -> Response:
     """Rigid-body series (sph_core bodies.csv: per body x, z, theta, u, w, omega, fx, fz, my) as
@@ -226,9 +240,11 @@ async def resume_run(run: RunDep, manager: Manager) -> RunInfo:
 
 
 @router.get("/{run_id}/events", responses=NOT_FOUND)
-async def run_events(run: RunDep) -> StreamingResponse:
+async def run_events(run: RunDep, request: Request) -> StreamingResponse:
     """Server-Sent Events: a `progress` event with the run record whenever it changes; the
-    stream ends after the event that shows a final state."""
+    stream ends after the event that shows a final state, or when the server is stopping (the
+    page reconnects to the next server)."""
+    stopping = getattr(request.app.state, "stopping", None)
 
     async def stream():
         last = None
@@ -237,7 +253,7 @@ async def run_events(run: RunDep) -> StreamingResponse:
             if data != last:
                 last = data
                 yield f"event: progress\ndata: {data}\n\n"
-            if run.info.state in TERMINAL:
+            if run.info.state in TERMINAL or (stopping is not None and stopping.is_set()):
                 return
             await asyncio.sleep(EVENT_POLL_S)
 

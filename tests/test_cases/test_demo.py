@@ -40,7 +40,11 @@ def test_demo_writes_a_finished_run_with_gauges_and_plot(tmp_path, transport, ca
     assert (out / "elevation.png").exists() == (transport == "ws")
     if transport == "ws":
         assert (out / "elevation.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
-    assert str(out.resolve()) in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert str(out.resolve()) in err and "None particles" not in err
+    # the VTK snapshots it lists: the first and the last (t_end 0.4 s < 1 s apart)
+    assert len(list((run_dir / "sph" / "snapshots").glob("*.vtu"))) == 2
+    assert (run_dir / "sph" / "run.pvd").exists() and "sph/run.pvd" in err
 
 
 def test_demo_with_a_body_in_the_sph_zone_writes_its_series(tmp_path, monkeypatch):

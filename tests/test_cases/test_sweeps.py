@@ -68,7 +68,12 @@ def test_sweep_csv_and_chart(swept, tmp_path):
     out, points, records = swept
     path = tmp_path / "accuracy.csv"
     sweeps.write_csv(records, path, command="wavesph bench accuracy --test")
-    assert path.read_text().startswith("# made by: wavesph bench accuracy --test")
+    assert path.read_text().startswith("case,method,")     # one header row, no # line
+    assert json.loads(path.with_suffix(".meta.json").read_text())["made_by"] == \
+        "wavesph bench accuracy --test"
+    import pandas
+
+    assert pandas.read_csv(path).shape == (3, len(ACCURACY_COLUMNS))
     rows = sweeps.read_csv(path)
     assert list(rows[0]) == ACCURACY_COLUMNS
     assert [r["status"] for r in rows] == ["ok", "ok", "failed"]
@@ -119,6 +124,9 @@ def test_stability_override_is_explicit():
 
 
 # ---------------------------------------------------------------------------- plan
+PLANNED = "wcsph_kdk_h2_wallav0"   # the scene defaults' method; wcsph_kdk is SUPERSEDED
+
+
 def _synthetic(tmp_path: Path, a: float = 0.3, p: float = 1.0, tp: float = 1.0e6) -> Path:
     """A sweep CSV whose flume points lie exactly on error = a (H/dp)^-p at throughput tp."""
     path = tmp_path / "sweep.csv"
@@ -126,7 +134,7 @@ def _synthetic(tmp_path: Path, a: float = 0.3, p: float = 1.0, tp: float = 1.0e6
         w = csv.DictWriter(fh, fieldnames=ACCURACY_COLUMNS)
         w.writeheader()
         for r in (2.0, 4.0, 8.0):
-            w.writerow({"case": "flume_V", "method": "wcsph_kdk", "dp": 0.06 / r, "H_over_dp": r,
+            w.writerow({"case": "flume_V", "method": PLANNED, "dp": 0.06 / r, "H_over_dp": r,
                         "error": a * r ** -p, "wall_s": 10.0, "particles": 1000,
                         "steps": int(tp * 10 / 1000), "status": "ok", "reason": ""})
     return path
@@ -134,34 +142,73 @@ def _synthetic(tmp_path: Path, a: float = 0.3, p: float = 1.0, tp: float = 1.0e6
 
 def test_plan_reaches_the_target_on_the_fitted_line(tmp_path):
     data = sweeps.read_csv(_synthetic(tmp_path))
-    fit = planning.fit_error(data, "wcsph_kdk")
+    fit = planning.fit_error(data, PLANNED)
     assert fit["a"] == pytest.approx(0.3) and fit["p"] == pytest.approx(1.0)
+    assert (fit["H_over_dp_min"], fit["H_over_dp_max"]) == pytest.approx((2.0, 8.0))
     req = planning.PlanRequest(height=0.06, period=2.0, depth=0.3, duration=10.0, target_error=0.05)
     plan = planning.make_plan(req, data)
-    assert plan.method == "wcsph_kdk"          # the only method with data
+    assert plan.method == PLANNED              # the only method with data
     assert plan.dp == pytest.approx(0.01)      # H/dp = 0.3 / 0.05 = 6
-    assert plan.expected_error == pytest.approx(0.05, rel=1e-3)
+    assert plan.expected_error == pytest.approx(0.05, rel=1e-3) and plan.meets_target
     assert plan.zone_length_m == pytest.approx(plan.wavelength_m, abs=0.01)   # no structure
-    dt = planning.step_estimate(0.01, 0.3, 0.06, 2.0, "wcsph_kdk")
+    dt = planning.step_estimate(0.01, 0.3, 0.06, 2.0, PLANNED)
     assert plan.steps == math.ceil(10.0 / dt)
     assert plan.expected_wall_s == pytest.approx(plan.particles * plan.steps / 1.0e6, rel=1e-3)
     assert plan.window_steps == round(2.0 / 50 / dt)
+    # 0.025 needs H/dp 12, beyond the measured 8: the finest measured, and said not to meet it
     finer = planning.make_plan(req.__class__(**{**req.__dict__, "target_error": 0.025}), data)
-    assert finer.dp == pytest.approx(0.005) and finer.expected_wall_s > 3 * plan.expected_wall_s
+    assert finer.dp == pytest.approx(0.0075) and not finer.meets_target
+    assert finer.expected_error == pytest.approx(0.3 / 8, rel=1e-3)
+    # 0.2 would be H/dp 1.5, below the measured 2: no coarser than measured
+    coarse = planning.make_plan(req.__class__(**{**req.__dict__, "target_error": 0.2}), data)
+    assert coarse.dp == pytest.approx(0.03) and coarse.meets_target
+
+
+def test_plan_dp_divides_the_depth_and_counts_steps_at_the_scenes_c0(tmp_path):
+    data = sweeps.read_csv(_synthetic(tmp_path))
+    # H/dp 6 asks for dp 0.04 / 6 = 0.00667 in 0.25 m (37.5 rows): the next divisor is 0.25 / 38
+    req = planning.PlanRequest(height=0.04, period=2.0, depth=0.25, duration=10.0)
+    plan = planning.make_plan(req, data)
+    assert round(0.25 / plan.dp, 3) == 38 and plan.expected_error <= 0.05
+    # a scene's default c0 is 10 sqrt(2 g d), sqrt 2 that of the plan's own flumes: as many more
+    # steps (the review measured x1.49 more than `plan` predicted)
+    fast = planning.make_plan(req, data, dp=0.01)
+    slow = planning.make_plan(req.__class__(**{**req.__dict__, "c0": math.sqrt(2) * fast.c0}),
+                              data, dp=0.01)
+    assert slow.steps / fast.steps == pytest.approx(math.sqrt(2), rel=0.03)
+
+
+def test_plan_of_a_scene_stays_inside_it_and_never_proposes_a_superseded_method(tmp_path):
+    from sph_core.scene import load_scene
+
+    data = sweeps.read_csv(_synthetic(tmp_path))
+    old = [{**r, "method": "wcsph_kdk", "error": 0.5 * r["error"], "steps": 10 * r["steps"]}
+           for r in data]                       # better and faster, but the pre-study defaults
+    scene = load_scene(ROOT / "examples/scenes/demo_beach_flume.toml")
+    short = scene.model_copy(update={"beds": [scene.beds[0].model_copy(update={
+        "points": [(1.0, 0.0), (5.4, 0.44)]})]})      # only 1 m of flat: less than a wavelength
+    plan = planning.make_plan(planning.request_from_scene(short, 0.04, 1.4), data + old)
+    assert plan.method == PLANNED
+    assert plan.flat_m == pytest.approx(1.0) and plan.structures_m == pytest.approx(4.4)
+    assert plan.zone_length_m <= short.tank.x1 - short.tank.x0 + plan.dp
 
 
 def test_plan_skips_unstable_and_barely_converging_methods(tmp_path):
     """A method whose flume points ended unstable is not planned; one whose fit barely
-    converges (p 0.04 asked for dp ~1e-5 m, and a lattice of terabytes) is skipped, not built."""
+    converges (p 0.04 asked for dp ~1e-5 m, and a lattice of terabytes, before the plan kept to
+    the measured H/dp) is proposed only at its finest measured H/dp, as missing the target."""
     good = sweeps.read_csv(_synthetic(tmp_path))
     flat = [{**r, "method": "riemann_muscl", "error": 0.3 * r["H_over_dp"] ** -0.04} for r in good]
     shaky = [{**r, "method": "isph_bicgstab", "error": 0.2 * r["H_over_dp"] ** -2.0} for r in good]
     shaky[-1] = {**shaky[-1], "status": "unstable", "error": None}
     req = planning.PlanRequest(height=0.06, period=2.0, depth=0.3, duration=10.0, target_error=0.05)
     plan = planning.make_plan(req, good + flat + shaky)
-    assert plan.method == "wcsph_kdk" and plan.dp == pytest.approx(0.01)
+    assert plan.method == PLANNED and plan.dp == pytest.approx(0.01)
+    alone = planning.make_plan(req, flat + shaky)
+    assert alone.method == "riemann_muscl" and alone.H_over_dp == pytest.approx(8.0)
+    assert not alone.meets_target and alone.expected_error > 0.2
     with pytest.raises(ValueError):
-        planning.make_plan(req, flat + shaky)
+        planning.make_plan(req, shaky)
 
 
 def test_plan_cli_json_for_the_demo_scene(tmp_path):
@@ -196,8 +243,8 @@ def test_run_warns_when_a_scene_costs_far_more_than_the_plan(tmp_path):
 def test_shipped_sweep_data_plans_the_demo():
     rows = planning.sweep_data()
     assert rows and set(ACCURACY_COLUMNS) <= set(rows[0])
-    text = (ROOT / "wavesph" / "cases" / planning.SWEEP_CSV).read_text()
-    assert text.startswith("# made by: wavesph bench accuracy")
+    meta = (ROOT / "wavesph" / "cases" / planning.SWEEP_CSV).with_suffix(".meta.json")
+    assert json.loads(meta.read_text())["made_by"].startswith("wavesph bench accuracy")
     from sph_core.scene import load_scene
 
     scene = load_scene(ROOT / "examples/scenes/demo_beach_flume.toml")
@@ -321,3 +368,17 @@ def test_a_failed_coupled_point_keeps_its_run_directory(monkeypatch):
     assert (made[0] / "r1" / "meta.json").exists()
     import shutil
     shutil.rmtree(made[0])
+
+
+def test_plan_table_says_what_to_do_and_what_it_rests_on(tmp_path, capsys):
+    import wavesph.cli
+
+    data = _synthetic(tmp_path)
+    assert wavesph.cli.main(["plan", str(ROOT / "examples/scenes/demo_beach_flume.toml"),
+                             "--H", "0.04", "--T", "1.4", "--data", str(data)]) == 0
+    out = capsys.readouterr().out
+    assert not any(line.startswith("{") for line in out.splitlines())   # JSON only with --json
+    assert "Rests on: error = 0.3 (H/dp)^-1.00 fitted to 3 flume points" in out
+    assert "H/dp 2-8" in out and "c0 = 15.3 m/s" in out     # the scene's own c0
+    assert "To apply it, in the scene file:" in out and "    dp = 0.006667" in out
+    assert "flat + 3.4 structures" in out

@@ -30,8 +30,9 @@ def scene(**overrides) -> dict:
 
 def open_flume(name: str, t_end: float, depth: float) -> dict:
     """A 1.2 m flume with open ends, both absorbing (the left's elevation imposed, the right's
-    extrapolated), dp 0.04 m, one elevation gauge g1 at x = 0.6 m."""
-    return {"name": name, "dp": 0.04, "t_end": t_end, "still_water_level": depth,
+    extrapolated), dp = depth / 8 (whole rows: the particles fill to the still-water level),
+    one elevation gauge g1 at x = 0.6 m."""
+    return {"name": name, "dp": depth / 8, "t_end": t_end, "still_water_level": depth,
             "tank": {"x0": 0.0, "x1": 1.2, "z0": 0.0, "z1": 0.45},
             "water_blocks": [{"x0": 0.0, "x1": 1.2, "z0": 0.0, "z1": depth}],
             "open_boundaries": [{"side": "left", "elevation": "imposed", "absorb": True},

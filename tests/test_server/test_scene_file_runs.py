@@ -66,3 +66,21 @@ def test_couple_scene_creates_the_run_and_couples_to_it(srv, tmp_path, capsys):
     assert _request(srv, run_id).coupling.z_ref == -0.12
     assert log.read_text().startswith("t,steps,")     # one header row, no comment lines
     assert log.with_suffix(".meta.json").exists()
+
+
+def test_couple_scene_takes_the_file_submit_runs(srv, tmp_path, capsys):
+    # one file for both: `submit` runs its [source]; `couple --scene` leaves the source and mode
+    # out (its --model drives the run) and says so, instead of the server's 422
+    both = tmp_path / "both.toml"
+    both.write_text('mode = "standalone"\n' + DEMO.read_text()
+                    + '\n[source]\ntheory = "stokes"\nH = 0.04\nT = 1.4\norder = 2\n')
+    assert wavesph.cli.main(["submit", str(both), "--url", srv.url]) == 0
+    assert "(standalone" in capsys.readouterr().out
+    code = wavesph.cli.main(["couple", "--scene", str(both), "--url", srv.url, "--model", "linear",
+                             "--H", "0.01", "--T", "1.4", "--t-end", "0.2", "--no-progress"])
+    err = capsys.readouterr().err
+    assert code == 0, err
+    assert "mode and source left out" in err
+    run_id = re.search(r"created run (\S+) from", err).group(1)
+    req = _request(srv, run_id)
+    assert req.mode == "coupled" and req.source is None and req.coupling.z_ref == -0.12

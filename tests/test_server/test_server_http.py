@@ -106,6 +106,9 @@ def test_standalone_run_with_sph_core(srv):
     assert csv[0].startswith("t,step,") and len(csv) == 1 + 5  # t = 0, 0.05, ..., 0.2
     rows = srv.http.get(f"/runs/{run['id']}/gauges", params={"format": "json"}).json()["rows"]
     assert rows[-1]["t"] == pytest.approx(0.2)
+    # /probes: the SPH side's probes.csv (here the same file as the gauges)
+    probes = srv.http.get(f"/runs/{run['id']}/probes", params={"format": "json"}).json()
+    assert probes["rows"] == rows and "g_mid_eta" in probes["columns"]
 
 
 def test_cancel_standalone_and_unknown_run(srv):
@@ -248,3 +251,41 @@ def test_the_servers_default_device_is_each_runs_unless_its_scene_says(tmp_path,
         assert stored["scene"]["run"]["device"] == "cuda"
     with live_server(tmp_path / "cpu", factory) as srv:
         assert srv.create()["device"] == "cpu"
+
+
+def test_runs_carry_their_scene_name(srv):
+    a = srv.create(name="seawall")
+    b = srv.create(name="seawall")
+    listed = {r["id"]: r["name"] for r in srv.http.get("/runs").json()}
+    assert listed[a["id"]] == listed[b["id"]] == "seawall" and a["id"] != b["id"]
+    assert srv.http.get(f"/runs/{a['id']}/probes").status_code == 404   # no SPH data yet
+
+
+def test_event_stream_ends_when_the_server_is_stopping(srv):
+    """Ctrl-C on `wavesph serve` waited on the page's open stream of a running run (~20 s, the
+    run stepping on): the stream ends as soon as the server is told to stop."""
+    run = srv.create()
+    srv.wait_state(run["id"], "waiting_for_client")
+    events = []
+    with srv.http.stream("GET", f"/runs/{run['id']}/events", timeout=30) as stream:
+        for line in stream.iter_lines():
+            if line.startswith("data: "):
+                events.append(json.loads(line[6:]))
+                srv.app.state.stopping.set()      # what Ctrl-C does (server.asgi.Server)
+    assert len(events) == 1 and events[0]["state"] == "waiting_for_client"   # not a final state
+    srv.app.state.stopping.clear()
+
+
+def test_ctrl_c_tells_the_app_it_is_stopping(tmp_path):
+    import signal
+
+    from server.asgi import server
+    from server.main import create_app
+    from server.settings import Settings
+
+    settings = Settings(host="127.0.0.1", port=0, tcp_port=0, runs_dir=tmp_path)
+    app = create_app(settings)
+    srv = server(app, settings)
+    assert not app.state.stopping.is_set()
+    srv.handle_exit(signal.SIGINT, None)
+    assert app.state.stopping.is_set() and srv.should_exit

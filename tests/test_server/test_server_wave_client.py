@@ -90,7 +90,11 @@ def test_wave_client_names_its_log_columns_from_gauges(srv, engines, tmp_path):
     server_gauges = sorted({c[: -len("_eta")] for c in names if c.endswith("_eta")})
     text = log.read_text()
     header = next(ln for ln in text.splitlines() if not ln.startswith("#")).split(",")
-    assert sorted(c[len("eta_model_"):] for c in header if c.startswith("eta_model_")) == server_gauges
-    assert "eta_0" not in header and "#" not in text   # one header row, no comment lines
-    notes = json.loads(log.with_suffix(".meta.json").read_text())["notes"]
-    assert any(n.startswith("gauges: ") for n in notes)   # the run's metadata, beside the CSV
+    # <gauge>_<quantity>, the rule of gauges.csv and probes.csv
+    assert sorted(c[: -len("_eta_model")] for c in header if c.endswith("_eta_model")) == server_gauges
+    assert {f"{g}_{q}" for g in server_gauges for q in ("eta", "u_ref", "w_ref")} <= set(header)
+    assert "0_eta" not in header and "#" not in text   # one header row, no comment lines
+    meta = json.loads(log.with_suffix(".meta.json").read_text())
+    assert sorted(g["name"] for g in meta["gauges"]) == server_gauges   # fields beside the CSV
+    assert meta["model"] == {"name": "AiryWave", "parameters": meta["model"]["parameters"]}
+    assert meta["model"]["parameters"]["height"] == 0.02 and " at 0x" not in json.dumps(meta)

@@ -55,7 +55,7 @@ def test_standalone_theory_run_equals_the_coupled_run(tmp_path):
     tb = rows(tmp_path / "client.csv")
     model_a = [r for r in ta if not r[0].startswith("#")]
     model_b = [r for r in tb if not r[0].startswith("#")]
-    col = model_a[0].index("eta_model_2")
+    col = model_a[0].index("g1_eta_model")   # named after the server's gauge, as the client's
     np.testing.assert_allclose([float(r[col]) for r in model_a[1:]],
                                [float(r[col]) for r in model_b[1:]], rtol=1e-12, atol=1e-15)
     assert alone["particles"] == coupled["particles"] and alone["steps"] == coupled["steps"]

@@ -4,6 +4,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -82,3 +84,21 @@ def test_sloping_bed_rows_share_the_bottom_spacing_near_the_right_wall():
     assert d.min(axis=1).max() < 1.01 * dp   # every particle has a neighbour one spacing away
     bed_right = np.sort(x[np.isclose(z, 0.095) & (x < L)])   # a dummy row just below the bed top
     assert bed_right.size and L - bed_right[-1] < 0.51 * dp + 1e-12
+
+
+def test_geometry_vtu_is_line_cells_that_meshio_reads(tmp_path):
+    """geometry.vtu (`wavesph run --preview`): poly-line cells and pyevtk's NumberOfCells="5.0"
+    made meshio refuse it; two-point line cells (VTK type 3) with integer counts open anywhere."""
+    import re
+
+    from sph_core.output import write_geometry_vtk
+    from sph_core.scene import load_scene
+
+    scene = load_scene(Path(__file__).resolve().parents[2] / "examples/scenes/demo_beach_flume.toml")
+    path = write_geometry_vtk(scene, tmp_path / "geometry")
+    head = path.read_bytes().split(b"<AppendedData")[0].decode()
+    assert re.search(r'NumberOfCells="5"', head)   # tank 3 segments, the bed 1, the inlet 1
+    meshio = pytest.importorskip("meshio")
+    mesh = meshio.read(path)
+    assert [c.type for c in mesh.cells] == ["line"] and len(mesh.cells[0].data) == 5
+    assert mesh.cell_data["part"][0].ravel().tolist() == [0, 0, 0, 1, 3]

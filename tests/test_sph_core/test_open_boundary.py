@@ -233,3 +233,16 @@ def test_inlet_with_a_beach_and_a_structure_keeps_running_and_counting(scheme):
     below = (st["x"] > 0.8) & (st["z"] < 0.25 * (st["x"] - 0.8) - 0.5 * DP)
     assert not inside.any() and not below.any()
     assert np.hypot(st["vx"], st["vz"]).max() > 0.05  # the wave is there
+
+
+def test_snapshots_leave_out_idle_buffer_particles(tmp_path):
+    # idle buffer particles (above the end's surface, in no pass) hung in the air in ParaView
+    # and on the page: snapshots hold kinds 0-3 only
+    sim = Simulation(flume_scene(), run_dir=tmp_path)
+    kinds = set(sim.particles.kind[: sim.particles.n].tolist())
+    assert kinds & {4, 5}, kinds          # the buffers have idle particles above the surface
+    sim.write_snapshot()
+    sim.close()
+    snap = np.load(tmp_path / "snapshots" / "last.npz")
+    assert set(snap["kind"].astype(int).tolist()) <= {0, 1, 2, 3}
+    assert snap["z"][snap["kind"] >= 2].max() < D

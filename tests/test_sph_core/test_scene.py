@@ -70,3 +70,17 @@ def test_still_water_level_is_checked_against_the_tank_and_the_water_blocks(swl,
         make_scene(scene)
     make_scene({**scene, "still_water_level": 0.2, "water_blocks": [
         {"x0": 0.0, "x1": 1.0, "z0": 0.0, "z1": 0.2}]})   # consistent: accepted
+
+
+def test_a_dp_that_does_not_divide_the_depth_is_refused_with_divisors_to_pick():
+    # 0.3 m at dp 0.04 is 7.5 rows: the particles fill to 0.28 m and every elevation gauge
+    # would read -0.02 m in still water (a third of H = 0.06)
+    scene = {"dp": 0.04, "t_end": 1.0, "still_water_level": 0.3,
+             "tank": {"x0": 0.0, "x1": 2.0, "z0": 0.0, "z1": 0.6},
+             "water_blocks": [{"x0": 0.0, "x1": 2.0, "z0": 0.0, "z1": 0.3}]}
+    with pytest.raises(SceneError, match=r"still_water_level: 0\.3 m is 7\.5 dp .* fill to 0\.28 m"
+                                         r".* read -0\.02 m .* e\.g\. 0\.0375 or 0\.04286 m"):
+        make_scene(scene)
+    for dp in (0.0375, 0.04286, 0.03, 0.1 / 3):   # divisors (the last one as a float)
+        assert make_scene({**scene, "dp": dp}).dp == dp
+

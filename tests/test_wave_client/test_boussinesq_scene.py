@@ -72,6 +72,13 @@ def test_scene_errors_name_the_field(tmp_path):
         load_wave_scene(p)
 
 
+def test_wave_height_and_period_are_spelled_H_and_T_as_everywhere(tmp_path):
+    p = tmp_path / "ht.toml"
+    p.write_text(FLAT.format(wave='kind = "regular"\nH = 0.01\nT = 2.0\nx_source = 0.0'))
+    wave = load_wave_scene(p).wave
+    assert (wave.height, wave.period) == (0.01, 2.0)
+
+
 def test_cli_writes_gauge_csv_and_reports_bad_scene(tmp_path, capsys):
     scene = tmp_path / "flat.toml"
     scene.write_text(FLAT.format(wave='kind = "regular"\nheight = 0.004\nperiod = 2.0\nx_source = 0.0')

@@ -11,7 +11,7 @@ from pathlib import Path
 from typing import Annotated, Literal
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+from pydantic import AliasChoices, BaseModel, ConfigDict, Field, ValidationError, model_validator
 
 from wave_client.theories.linear import wavenumber
 
@@ -61,8 +61,11 @@ class Bathymetry(_Strict):
 
 class RegularWave(_Strict):
     kind: Literal["regular"]
-    height: float = Field(gt=0, description="wave height H [m]")
-    period: float = Field(gt=0, description="wave period T [s]")
+    # H and T as everywhere else in wavesph (CLI, [source], HTTP); height/period kept
+    height: float = Field(gt=0, validation_alias=AliasChoices("H", "height"),
+                          description="wave height H [m] (`H` or `height`)")
+    period: float = Field(gt=0, validation_alias=AliasChoices("T", "period"),
+                          description="wave period T [s] (`T` or `period`)")
     x_source: float = Field(description="centre of the source function [m] (flat bed around it)")
     ramp_periods: float = Field(default=3.0, ge=0, description="start-up ramp [periods]")
     delta: float = Field(default=0.5, gt=0, description="source width parameter of Wei et al. (1999)")

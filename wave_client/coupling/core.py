@@ -41,7 +41,7 @@ import math
 import warnings
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import TypeVar
+from typing import Any, TypeVar
 
 import numpy as np
 
@@ -277,23 +277,48 @@ class CouplingCore:
             ok = own < abs(gx - self.nodes.x[self._sides[other_side].index].mean())
         return int(np.flatnonzero(ok)[np.argmin(own[ok])]) if ok.any() else None
 
-    def describe(self) -> list[str]:
-        """Run metadata as text lines (for the log header), after the handshake."""
+    def metadata(self) -> dict[str, Any]:
+        """Run metadata as JSON fields (the gauge log's ``.meta.json``), after the handshake:
+        names and numbers, short (0.028, not 0.027999999999999997), no Python reprs."""
         w, n = self.welcome, self.nodes
         assert w is not None and n is not None
+        labels = self.gauge_labels()
+        gauges = self.gauges
+        return {
+            "model": model_description(self.model),
+            "run_id": w.run_id, "server": w.server,
+            "g_m_s2": _short(w.g), "depth_m": _short(w.depth),
+            "still_water_level_m": _short(w.still_water_level),   # absolute SPH z
+            "z_ref_m": _short(w.z_ref),                           # up from still water
+            "window_s": _short(self.window), "windows": int(self.times.size),
+            "t_start_s": _short(w.t_start), "t_end_s": _short(float(self.times[-1])),
+            "gauges": [{"name": name, "x_m": _short(float(x))} for name, x in zip(labels, n.gauge_x)],
+            "gauges_named_by": "server" if self.gauge_info is not None else "index (a 1.0 server)",
+            "correction": {"on": bool(self.options.absorb),
+                           "low_pass_tau_s": _short(self.filter_tau) if self.options.absorb else None,
+                           **{f"{side}_gauge": None if i is None else labels[i]
+                              for side, i in gauges.items()}},
+            "model_x_minus_sph_x_m": _short(self.x_offset),
+        }
+
+    def describe(self) -> list[str]:
+        """Run metadata as text lines (for a person), after the handshake."""
+        m = self.metadata()
+        c = m["correction"]
         return [
-            f"model: {self.model!r}",
-            f"run_id: {w.run_id}; server: {w.server}",
-            f"g = {w.g} m/s^2; depth = {w.depth} m; still_water_level = {w.still_water_level} m "
-            f"(absolute SPH z); z_ref = {w.z_ref} m (up from still water)",
-            f"windows: {self.times.size} of {self.window} s from t = {w.t_start} s to {self.times[-1]} s",
-            f"gauge_x [m]: {' '.join(f'{x:.6g}' for x in n.gauge_x)}",
-            f"gauges: {' '.join(self.gauge_labels())}"
-            + ("" if self.gauge_info is not None else " (indices: a 1.0 server names none)"),
+            f"model: {m['model']['name']} "
+            + " ".join(f"{k}={v}" for k, v in m["model"]["parameters"].items()),
+            f"run_id: {m['run_id']}; server: {m['server']}",
+            f"g = {m['g_m_s2']} m/s^2; depth = {m['depth_m']} m; still_water_level = "
+            f"{m['still_water_level_m']} m (absolute SPH z); z_ref = {m['z_ref_m']} m (up from "
+            "still water)",
+            f"windows: {m['windows']} of {m['window_s']} s from t = {m['t_start_s']} s to "
+            f"{m['t_end_s']} s",
+            "gauges: " + " ".join(f"{g['name']} (x = {g['x_m']} m)" for g in m["gauges"]),
             f"client-side correction (seed 002): "
-            f"{f'on, low-pass tau = {self.filter_tau:.4g} s' if self.options.absorb else 'off'}, "
-            f"gauges {self.gauges}; "
-            f"model x = SPH x + {self.x_offset} m",
+            + (f"on, low-pass tau = {c['low_pass_tau_s']} s" if c["on"] else "off")
+            + f", inlet gauge {c.get('inlet_gauge')}, outlet gauge {c.get('outlet_gauge')}; "
+            f"model x = SPH x + {m['model_x_minus_sph_x_m']} m",
         ]
 
     @property
@@ -425,3 +450,26 @@ class CouplingCore:
         else:
             code, text = ErrorCode.INTERNAL, f"client: {type(exc).__name__}: {exc}"
         return self.session.request(Error(int(code), text.encode()[:4000].decode(errors="ignore")))
+
+
+def _short(v: float) -> float:
+    """A float printed short in JSON: 9 significant digits (0.028, not 0.027999999999999997)."""
+    return float(f"{v:.9g}")
+
+
+def model_description(model: object) -> dict[str, Any]:
+    """A wave model as {"name": its class, "parameters": its public scalar settings} (numbers
+    short): what a meta file can hold instead of ``<... object at 0x7f...>``."""
+    params: dict[str, Any] = {}
+    for k, v in vars(model).items() if hasattr(model, "__dict__") else ():
+        if k.startswith("_"):
+            continue
+        if isinstance(v, bool):
+            params[k] = v
+        elif isinstance(v, (int, np.integer)):
+            params[k] = int(v)
+        elif isinstance(v, (float, np.floating)) and math.isfinite(v):
+            params[k] = _short(float(v))
+        elif isinstance(v, str) and len(v) <= 80:
+            params[k] = v
+    return {"name": type(model).__name__, "parameters": params}

@@ -22,7 +22,7 @@ import sys
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TextIO
+from typing import Any, TextIO
 
 import numpy as np
 from tqdm import tqdm
@@ -55,7 +55,8 @@ class CouplingReport:
     """What a coupled run did: every window's record, and where the wall time went."""
 
     welcome: Welcome | None = None
-    gauges: dict[str, int | None] = field(default_factory=dict)
+    gauges: dict[str, int | None] = field(default_factory=dict)        # side -> gauge index
+    gauge_names: dict[str, str | None] = field(default_factory=dict)   # side -> gauge name
     records: list[WindowRecord] = field(default_factory=list)
     wall_time: float = 0.0     # s, whole run
     model_time: float = 0.0    # s, spent in the wave model (advance + sampling + feedback)
@@ -74,8 +75,9 @@ class CouplingReport:
 class GaugeLog:
     """CSV of the gauge series, one row per window, flushed as it comes (nothing lost on a crash).
 
-    Columns: t [s], steps, then per gauge i (its name from a 1.1 server, else its index):
-    eta_i [m] (measured), wet_i, u_ref_i, w_ref_i [m/s], eta_model_i [m]; finally du_inlet,
+    Columns: t [s], steps, then per gauge g (its name from a 1.1 server, else its index), named
+    ``<gauge>_<quantity>`` as in every wavesph CSV: g_eta [m] (measured), g_wet, g_u_ref, g_w_ref
+    [m/s], g_eta_model [m]; finally du_inlet,
     du_outlet [m/s] (the seed 002 corrections applied). One header row, no comment lines (the
     README's CSV dialect): the run's metadata goes to ``<stem>.meta.json`` beside it.
     """
@@ -91,13 +93,15 @@ class GaugeLog:
         except OSError as exc:
             raise ValueError(f"log_path {self.path}: cannot create it ({exc.strerror})") from exc
         self.notes: list[str] = header.splitlines()
+        self.fields: dict[str, Any] = {}
         self._write_meta()
         self._columns_written = False
         self.labels: list[str] | None = None  # gauge names (1.1 server) or indices, per column
 
     def _write_meta(self) -> None:
         tmp = self.meta_path.with_name(self.meta_path.name + ".tmp")
-        tmp.write_text(json.dumps({"csv": self.path.name, "notes": self.notes}, indent=1))
+        tmp.write_text(json.dumps({"csv": self.path.name, "notes": self.notes, **self.fields},
+                                  indent=1))
         os.replace(tmp, self.meta_path)
 
     def note(self, line: str) -> None:
@@ -105,13 +109,19 @@ class GaugeLog:
         self.notes.append(line)
         self._write_meta()
 
+    def describe(self, fields: dict[str, Any]) -> None:
+        """The run's metadata as JSON fields (CouplingCore.metadata) into ``<stem>.meta.json``."""
+        self.fields.update(fields)
+        self._write_meta()
+
     def write(self, r: WindowRecord) -> None:
         n = r.eta.size
         if not self._columns_written:
             cols = ["t", "steps"]
+            # <gauge>_<quantity>, as gauges.csv and probes.csv
             for label in (self.labels or [str(i) for i in range(n)]):
-                cols += [f"eta_{label}", f"wet_{label}", f"u_ref_{label}", f"w_ref_{label}",
-                         f"eta_model_{label}"]
+                cols += [f"{label}_eta", f"{label}_wet", f"{label}_u_ref", f"{label}_w_ref",
+                         f"{label}_eta_model"]
             self._f.write(",".join(cols + ["du_inlet", "du_outlet"]) + "\n")
             self._columns_written = True
         row = [f"{r.t1:.12g}", str(r.steps)]
@@ -170,10 +180,11 @@ async def run_coupling(url: str, model: ModelSource, options: CouplingOptions | 
             await transport.send([ask])
             core.on_gauges(*await transport.recv(timeout))
         report.welcome, report.gauges = core.welcome, core.gauges
+        labels = core.gauge_labels()
+        report.gauge_names = {side: None if i is None else labels[i] for side, i in core.gauges.items()}
         if log is not None:
             log.labels = core.gauge_labels()
-            for line in core.describe():
-                log.note(line)
+            log.describe(core.metadata())
         bar = tqdm(total=core.windows_left, unit="window", desc="coupling", disable=not progress,
                    mininterval=TQDM_INTERVAL)
         while core.windows_left:

@@ -66,14 +66,42 @@ def scene_file_body(path: str | Path, mode: str | None = None,
     return (head + text + tail).encode()
 
 
+# what a coupling client replaces in a scene file: the run is coupled, and the client's model
+# drives the open ends instead of a built-in [source]
+CLIENT_REPLACES = ("mode", "source")
+
+
+def coupled_run_body(path: str | Path) -> tuple[bytes, list[str]]:
+    """The file as a coupled run's JSON body (POST /runs) for a client that brings its own wave
+    model (`wavesph couple --scene`), and the names of CLIENT_REPLACES the file had: the same
+    file that `wavesph submit` runs with its [source] couples as it is."""
+    import json
+
+    try:
+        data = tomllib.loads(Path(path).read_text())
+    except OSError as exc:
+        raise ValueError(f"scene file {path}: {exc.strerror}") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise ValueError(f"{path}: not valid TOML ({exc})") from None
+    dropped = [k for k in CLIENT_REPLACES if k in data]
+    body: dict[str, Any] = {"scene": {k: v for k, v in data.items()
+                                      if k not in (*CLIENT_REPLACES, "coupling")},
+                            "mode": "coupled"}
+    if "coupling" in data:
+        body["coupling"] = data["coupling"]
+    return json.dumps(body).encode(), dropped
+
+
 def submit_scene_file(server: str, path: str | Path, *, mode: str | None = None,
                       source: dict[str, Any] | None = None, token: str | None = None,
-                      timeout: float = 30.0) -> dict[str, Any]:
-    """POST the scene file to ``server``; the created run's record (id, state, ...)."""
+                      timeout: float = 30.0, body: bytes | None = None) -> dict[str, Any]:
+    """POST the scene file to ``server``; the created run's record (id, state, ...). ``body``:
+    a JSON body made from the file already (``coupled_run_body``), sent instead of the file."""
     import httpx
 
-    body = scene_file_body(path, mode, source)
-    headers = {"Content-Type": "application/toml"}
+    headers = {"Content-Type": "application/json" if body is not None else "application/toml"}
+    if body is None:
+        body = scene_file_body(path, mode, source)
     if token:
         headers["Authorization"] = f"Bearer {token}"
     base = http_base(server)

@@ -75,6 +75,9 @@ def demo_body(kind: str, dp: float) -> dict[str, Any]:
     raise ValueError(f"body: one of {BODIES}, got {kind!r}")
 
 
+SNAPSHOT_EVERY = 1.0   # s
+
+
 def demo_scene(dp: float, t_end: float, body: str | None = None) -> dict[str, Any]:
     """The flume as a server scene (plain dict, validated by the server); ``body``: None, or one
     of BODIES placed on the flat bed (``demo_body``)."""
@@ -89,7 +92,8 @@ def demo_scene(dp: float, t_end: float, body: str | None = None) -> dict[str, An
         "beds": [{"points": [[X_TOE, 0.0], [x1, SLOPE * (x1 - X_TOE)]]}],
         # c0 = 10 sqrt(g d) bounds orbital speeds x10; free slip: the theory is inviscid
         "constants": {"c0": 10.0 * math.sqrt(9.81 * d), "wall_slip": "free_slip"},
-        "output": {"probe_every": PERIOD / 20},
+        # VTK snapshots every second (sph/snapshots/, sph/run.pvd), at least the first and last
+        "output": {"probe_every": PERIOD / 20, "snapshot_every": min(SNAPSHOT_EVERY, t_end)},
         "probes": [{"kind": "elevation", "name": n, "x": x} for n, x in GAUGES.items()],
         "open_boundaries": [{"side": "left", "elevation": "imposed", "absorb": True}],
         **({"bodies": [demo_body(body, dp)]} if body else {}),
@@ -123,7 +127,8 @@ def _couple(srv: InProcessServer, scene: dict, transport: str, out: Path) -> tup
         info = wait_for_state(http, run["id"], {"waiting_for_client", "failed"}, timeout=120)
         if info["state"] == "failed":
             return info, None
-        print(f"wavesph demo: {info['particles']} particles, dp = {scene['dp']} m, "
+        count = f"{info['particles']} particles, " if info.get("particles") else ""
+        print(f"wavesph demo: {count}dp = {scene['dp']} m, "
               f"{scene['t_end']} s of Stokes-2 waves (H = {HEIGHT} m, T = {PERIOD} s, depth "
               f"{scene['still_water_level']:.4g} m) onto a 1:{1 / SLOPE:g} beach; server on {base}, coupling over "
               f"{'WebSocket' if transport == 'ws' else 'TCP'}", file=sys.stderr)

@@ -64,7 +64,10 @@ def standing_wave_decay(*, dp: float, depth: float = 0.24, length: float = 1.0,
                         g: float = 9.81, scheme: dict | None = None,
                         **constants: Any) -> StandingWaveDecay:
     """Run the closed tank (``constants`` override the scene's, e.g. h_over_dp, alpha;
-    c0 = c0_factor sqrt(g d); ``scheme`` the scene's [scheme] table) and fit its losses."""
+    c0 = c0_factor sqrt(g d); ``scheme`` the scene's [scheme] table) and fit its losses. The
+    depth is rounded to whole rows of dp (the particles fill whole rows: at dp 0.025 the water of
+    0.24 m stood at 0.25 m, and the wave's frequency must use the water's depth)."""
+    depth = dp * round(depth / dp)
     k = math.pi / length
     omega = math.sqrt(g * k * math.tanh(k * depth))
     period = 2.0 * math.pi / omega

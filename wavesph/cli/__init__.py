@@ -25,6 +25,8 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "waves": ("wavesph.cli.waves", "run the Boussinesq wave model alone"),
     "bench": ("wavesph.cli.bench", "speed-accuracy sweep and stability suite on dask "
                                    "(accuracy | stability)"),
+    "analyse": ("wavesph.cli.analyse", "wave height and period per gauge, mean overtopping "
+                                       "discharge and load peaks of a run directory"),
     "plan": ("wavesph.cli.plan", "propose dp, SPH zone, coupling window and method for a scene, "
                                  "with predicted error and wall time"),
 }

@@ -31,7 +31,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         "with --scene: the server, http://HOST:PORT (default http://127.0.0.1:8765)")
     p.add_argument("--scene", type=Path, default=None,
                    help="scene file (TOML) to create the coupled run from first (its [coupling] "
-                        "table: window_max, z_ref)")
+                        "table: window_max, z_ref; its mode and [source] are left out: --model "
+                        "drives the run)")
     p.add_argument("--token", default=None,
                    help="API token for --scene (default: WAVESPH_TOKEN)")
     p.add_argument("--model", required=True, choices=THEORY_MODELS + ("boussinesq",),
@@ -131,13 +132,18 @@ def _create_run(args: argparse.Namespace) -> str:
     """POST the scene file as a coupled run; the WebSocket url to couple to."""
     import os
 
-    from wave_client.coupling.server_runs import DEFAULT_SERVER, SubmitError, http_base, submit_scene_file
+    from wave_client.coupling.server_runs import (DEFAULT_SERVER, SubmitError, coupled_run_body,
+                                                  http_base, submit_scene_file)
 
     server = args.url or DEFAULT_SERVER
     if server.startswith("tcp://") or "/runs/" in server:
         raise ValueError("with --scene, --url is the server (http://HOST:PORT), not a run")
+    body, dropped = coupled_run_body(args.scene)
+    if dropped:
+        print(f"wavesph couple: the file's {' and '.join(dropped)} left out: this client's "
+              f"--model drives the run ({args.scene} as it is: `wavesph submit`)", file=sys.stderr)
     try:
-        info = submit_scene_file(server, args.scene, mode="coupled",
+        info = submit_scene_file(server, args.scene, body=body,
                                  token=args.token or os.environ.get("WAVESPH_TOKEN"))
     except SubmitError as exc:
         raise CoupleSetupError(str(exc)) from None
@@ -195,6 +201,7 @@ def main(args: argparse.Namespace) -> int:
     t = report.records[-1].t1 if n else float("nan")
     overhead = report.model_time / report.wall_time if report.wall_time > 0 else 0.0
     print(f"coupled {n} windows to t = {t:.6g} s in {report.wall_time:.2f} s "
-          f"(wave model {overhead:.1%} of wall time); gauges used {report.gauges}"
+          f"(wave model {overhead:.1%} of wall time); correction gauges: "
+          + (", ".join(f"{side} {name}" for side, name in report.gauge_names.items()) or "none")
           + (f"; series in {args.output}" if args.output else ""))
     return 0

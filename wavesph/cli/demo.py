@@ -3,7 +3,8 @@
 
 Writes into the run directory (default ./runs/demo-<UTC time>):
 
-    <run id>/            the server's run record: meta.json, gauges.csv (SPH-measured), sph/...
+    <run id>/            the server's run record: meta.json, gauges.csv (SPH-measured), sph/
+                         (probes.csv, VTK snapshots every second: sph/run.pvd, sph/snapshots/)
     client_gauges.csv    the client's log: measured and theoretical elevation per window
     elevation.png        SPH-measured vs theoretical elevation at the gauges, and the flume
     summary.json         the figures printed at the end
@@ -117,6 +118,7 @@ def main(args: argparse.Namespace) -> int:
           f"  {info['id']}/meta.json    run record ({info['status']})\n"
           f"  client_gauges.csv          measured and theoretical elevation per window\n"
           + ("" if args.no_plot else "  elevation.png              measured vs theory\n")
+          + f"  {info['id']}/sph/run.pvd    VTK particle snapshots (sph/snapshots/) for ParaView\n"
           + (f"  {info['id']}/sph/bodies.csv the {args.body}'s motion and loads\n"
              if args.body else "")
           + "  summary.json               these figures", file=sys.stderr)

@@ -8,8 +8,9 @@ import json
 import sys
 from pathlib import Path
 
-from wavesph.studies.planning import (DEFAULT_TARGET, make_plan, request_from_scene, scene_cost,
-                                      sweep_data)
+from wavesph.studies.planning import (DEFAULT_TARGET, Plan, make_plan, request_from_scene,
+                                      scene_cost, sweep_data)
+from wavesph.studies.sweeps import METHODS
 from sph_core.scene import SceneError, load_scene
 
 
@@ -45,23 +46,61 @@ def main(args: argparse.Namespace) -> int:
     if args.json:
         print(json.dumps(out))
         return 0
+    # a table for a person; the JSON only with --json
     rows = [("", "plan", "scene as written"),
             ("method", plan.method, own["method"]),
             ("dp [m]", f"{plan.dp:g}", f"{scene.dp:g}"),
             ("H/dp", f"{plan.H_over_dp:g}", f"{args.height / scene.dp:.3g}"),
-            ("SPH zone [m]", f"{plan.zone_length_m:g}", f"{scene.tank.x1 - scene.tank.x0:g}"),
+            ("SPH zone [m]", f"{plan.zone_length_m:.3g} = {plan.flat_m:.3g} flat + "
+                             f"{plan.structures_m:.3g} structures", f"{scene.tank.x1 - scene.tank.x0:g}"),
             ("window", f"{plan.window_s:.4g} s = {plan.window_steps} steps", ""),
             ("particles", f"{plan.particles}", f"{own['particles']}"),
             ("steps", f"{plan.steps}", f"{own['steps']}"),
             ("expected RMSE/H", f"{plan.expected_error:.3g}", _fmt(own["expected_error"])),
             ("expected wall [s]", f"{plan.expected_wall_s:.3g}", _fmt(own["expected_wall_s"]))]
     for a, b, c in rows:
-        print(f"{a:<18} {b:<26} {c}")
-    print(f"(fit error = {plan.fit['a']:.3g} (H/dp)^-{plan.fit['p']:.2f} over {plan.fit['n']} "
-          f"sweep points, level of {plan.fit.get('case', 'all cases')}; throughput "
-          f"{plan.throughput:.3g} particle-steps/s)")
-    print(json.dumps(out))
+        print(f"{a:<18} {b:<34} {c}")
+    print()
+    print(verdict(plan, own))
+    print(f"SPH zone: {plan.flat_m:.3g} m of flat bed before the structure region (at most one "
+          f"wavelength, {plan.wavelength_m:.3g} m: the inlet's wave settles and its absorber needs "
+          f"room) + {plan.structures_m:.3g} m from the first bed or structure to the tank's end.")
+    print(f"Rests on: error = {plan.fit['a']:.3g} (H/dp)^-{plan.fit['p']:.2f} fitted to "
+          f"{plan.fit['n']} flume points (RMSE/H against theory) of {plan.method} measured at "
+          f"H/dp {plan.fit['H_over_dp_min']:.3g}-{plan.fit['H_over_dp_max']:.3g} (level of "
+          f"{plan.fit.get('case', 'all cases')}; {args.data or 'the shipped sweep, wavesph/cases/data/accuracy_sweep.csv'}); "
+          f"steps of dt = cfl h / (c0 + orbital u) with the scene's c0 = {plan.c0:.3g} m/s; "
+          f"wall = particles x steps / {plan.throughput:.3g} particle-steps/s "
+          f"({'--throughput' if args.throughput else 'median of the sweep points, on the machine that measured them'}).")
+    print("To apply it, in the scene file:")
+    print(toml_snippet(plan))
     return 0
+
+
+def verdict(plan: Plan, own: dict) -> str:
+    """One sentence: keep the scene, or take the plan, and whether the target is met."""
+    target = plan.target_error
+    if not plan.meets_target:
+        return (f"No measured resolution reaches RMSE/H {target:g}: the plan is the finest H/dp the "
+                f"sweep measured ({plan.fit['H_over_dp_max']:.3g}); finer spacings need a sweep "
+                "that covers them (`wavesph bench accuracy`).")
+    err, wall = own["expected_error"], own["expected_wall_s"]
+    if err is not None and wall is not None and err <= target and wall <= plan.expected_wall_s:
+        return (f"The scene as written already meets RMSE/H {target:g} (expected {err:.3g}) at no "
+                f"more cost than the plan: keep it.")
+    return f"The plan is the cheapest measured way to RMSE/H {target:g}."
+
+
+def toml_snippet(plan: Plan) -> str:
+    """The scene-file lines that make a scene run the plan's dp and method."""
+    opts = dict(METHODS[plan.method])
+    scheme = opts.pop("scheme", None)
+    lines = [f"dp = {plan.dp:g}"]
+    if scheme:
+        lines += ["[scheme]"] + [f"{k} = {json.dumps(v)}" for k, v in scheme.items()]
+    if opts:
+        lines += ["[constants]"] + [f"{k} = {json.dumps(v)}" for k, v in opts.items()]
+    return "\n".join("    " + ln for ln in lines)
 
 
 def _fmt(v: float | None) -> str:

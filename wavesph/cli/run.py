@@ -5,10 +5,11 @@ from __future__ import annotations
 import argparse
 import sys
 import time
+import tomllib
 from pathlib import Path
 
 from sph_core.progress import advance_with_progress
-from sph_core.scene import SceneError, load_scene, make_scene
+from sph_core.scene import Scene, SceneError, load_scene, make_scene, split_scene_file
 from sph_core.simulation import DeviceError, Simulation
 
 from ._common import add_device_argument, positive_float, refuse_non_empty
@@ -45,6 +46,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def main(args: argparse.Namespace) -> int:
     try:
         scene = load_scene(args.scene)
+        refusal = None if args.preview else open_end_refusal(args.scene, scene)  # no step: no waves
+        if refusal:
+            print(f"wavesph run: {refusal}", file=sys.stderr)
+            return 2
+        if scene.open_boundaries and not args.preview:
+            print("wavesph run: nothing drives the open boundaries here: they hold still water "
+                  "(for waves: `wavesph submit` with a [source], or `wavesph couple --scene`)",
+                  file=sys.stderr)
         data = scene.model_dump(mode="json")
         if args.t_end is not None:
             data["t_end"] = args.t_end      # meta.json records the real end
@@ -106,6 +115,26 @@ def main(args: argparse.Namespace) -> int:
               f"({sim.n_particles * sim.steps / max(sim.wall_time, 1e-9) / 1e6:.2f} M particle-steps/s); "
               f"results in {out}", file=sys.stderr)
     return code
+
+
+def open_end_refusal(path: Path, scene: Scene) -> str | None:
+    """Why `wavesph run` refuses ``scene`` (read from ``path``), or None. `run` steps the SPH
+    alone: nothing drives its open ends, so they hold still water. A scene whose file drives them
+    (a `[source]` or `mode = "coupled"`) would silently simulate still water here, while the
+    same file makes waves on a server (the driving code is the server's, through its coupling
+    door: server/theory_client.py)."""
+    if not scene.open_boundaries:
+        return None
+    run = split_scene_file(tomllib.loads(path.read_text()))[1]
+    if "source" in run:
+        return (f"{path} drives its open boundaries with a [source], which `wavesph run` does not "
+                f"do (it would simulate still water): start `wavesph serve`, then `wavesph submit "
+                f"{path}`")
+    if run.get("mode") == "coupled":
+        return (f"{path} is a coupled scene (mode = \"coupled\"): its open boundaries wait for a "
+                f"wave model, which `wavesph run` has not: start `wavesph serve`, then `wavesph "
+                f"couple --scene {path} --model ...`")
+    return None
 
 
 def _preview(sim: Simulation, out: Path) -> int:

@@ -41,9 +41,7 @@ def port_in_use(host: str, port: int) -> str | None:
 
 
 def main(args: argparse.Namespace) -> int:
-    import uvicorn
-
-    from server.asgi import uvicorn_config
+    from server.asgi import server
     from server.main import create_app
 
     try:
@@ -77,5 +75,5 @@ def main(args: argparse.Namespace) -> int:
     host = f"[{settings.host}]" if ":" in settings.host else settings.host  # an IPv6 URL
     print(f"wavesph serve: http://{host}:{settings.port} (docs at /docs), TCP coupling "
           f"port {settings.tcp_port}, runs in {settings.runs_dir.resolve()}", file=sys.stderr)
-    uvicorn.Server(uvicorn_config(app, settings, log_level="info")).run()
+    server(app, settings, log_level="info").run()   # Ctrl-C ends the page's event streams
     return 0

@@ -5,16 +5,22 @@
     plan = make_plan(req, data=read_csv(path), throughput=2.0e6)
 
 What is proposed and why:
-  SPH zone   the structure (beach, structure: what a wave model cannot do) plus one wavelength of
-             flat bed before it (the inlet's wave settles and its absorber needs room: the demo's
-             and the coupled flume's layout); the far field is the wave model's.
+  SPH zone   the structure region (beach, structures: what a wave model cannot do) plus at most
+             one wavelength of flat bed before it (the inlet's wave settles and its absorber
+             needs room: the demo's and the coupled flume's layout); the far field is the wave
+             model's. From a scene, both parts are the scene's own, so the zone is never longer
+             than the scene.
   dp, method for each method of the sweep data, error = a (H/dp)^-p fitted (least squares in
              log-log, one slope, a per case; a of the case nearest the waves in kd and H/L) to
-             its flume-case points (RMSE/H against theory); the dp reaching
-             ``target_error`` (kept to >= 4 rows of the depth), then the method of the smallest
-             predicted wall time.
+             its flume-case points (RMSE/H against theory); the dp reaching ``target_error``
+             within the H/dp range the sweep measured (no extrapolation: beyond it the plan
+             proposes the finest measured H/dp and says the target is not met), at least 4 rows
+             of the depth, then rounded down to a divisor of the depth (the particles must fill
+             to the still-water level, sph_core.scene.datum_mismatch); then the method of the
+             smallest predicted wall time. Methods of the pre-study defaults (h/dp sqrt 2 and
+             artificial viscosity against walls, SUPERSEDED) are not proposed unless asked for.
   window     T/50 (what `wavesph couple` takes), in SPH steps of dt = cfl h / (c0 + u_orbital),
-             c0 = 10 sqrt(g d) as every flume scene.
+             c0 the scene's (c0_factor sqrt(2 g d) by default), else 10 sqrt(g d).
   wall       particles x steps / throughput: particles counted on the zone's own lattice
              (sph_core.geometry.build_layout, plus the inlet buffer), steps = duration / dt,
              throughput (particle-steps/s)
@@ -44,6 +50,10 @@ WINDOWS_PER_PERIOD = 50
 MIN_DEPTH_ROWS = 4
 DEFAULT_TARGET = 0.05          # RMSE/H: seed 002's accuracy (<= 4.3 %), issue 3's goal (5 %)
 EXPENSIVE_FACTOR = 3.0         # `wavesph run` warns past this cost ratio to the plan
+# the pre-study defaults (sweeps.OLD_DEFAULTS: h/dp sqrt 2, wall artificial viscosity on), which
+# the wave-decay study replaced (docs/studies/wave_decay_study.md): kept in the sweep data to
+# compare against, never proposed by default
+SUPERSEDED = tuple(m for m, o in METHODS.items() if o.get("alpha_wall_factor") == 1.0)
 
 
 @dataclass(frozen=True)
@@ -59,6 +69,9 @@ class PlanRequest:
     duration: float = 10.0
     target_error: float = DEFAULT_TARGET
     beach_slope: float | None = None   # a beach (rising to 0.1 m above still water) or None
+    flat_length: float | None = None   # flat bed before the structure region [m]: the zone keeps
+    #                                    at most one wavelength of it (None: one wavelength)
+    c0: float | None = None            # speed of sound [m/s] of the runs (None: 10 sqrt(g d))
 
 
 @dataclass(frozen=True)
@@ -77,6 +90,10 @@ class Plan:
     fit: dict[str, Any]
     wavelength_m: float
     target_error: float
+    flat_m: float = 0.0              # the zone's parts [m]: flat bed before the structure region
+    structures_m: float = 0.0        # ... and the structure region (beach, structures)
+    meets_target: bool = True        # False: the sweep's finest H/dp does not reach the target
+    c0: float = 0.0                  # speed of sound [m/s] the steps were counted with
 
     def to_json(self) -> dict[str, Any]:
         return asdict(self)
@@ -120,7 +137,9 @@ def fit_error(rows: list[dict[str, Any]], method: str,
         la = log_a[case]
     else:
         la = sum(log_a.values()) / len(log_a)
+    xs = [x for v in by_case.values() for x, _ in v]
     return {"a": math.exp(la), "p": p, "n": sum(len(v) for v in by_case.values()),
+            "H_over_dp_min": math.exp(min(xs)), "H_over_dp_max": math.exp(max(xs)),
             **({"case": case} if case else {})}
 
 
@@ -156,16 +175,32 @@ def wavelength(period: float, depth: float) -> float:
 
 
 def step_estimate(dp: float, depth: float, height: float, period: float,
-                  method: str) -> float:
-    """dt [s] of the adaptive step at the wave's largest orbital speed (c0 = 10 sqrt(g d))."""
+                  method: str, c0: float | None = None) -> float:
+    """dt [s] of the adaptive step at the wave's largest orbital speed; ``c0`` [m/s] the runs'
+    speed of sound (default 10 sqrt(g d); a scene's default c0_factor sqrt(2 g d) is sqrt 2
+    larger, and its steps as many more: `plan` under-predicted them x1.5 before it used the
+    scene's)."""
     c = METHODS[method]
     h = c["h_over_dp"] * dp
     k = 2 * math.pi / wavelength(period, depth)
     u = math.pi * height / period / math.tanh(k * depth)
-    return c.get("cfl", 0.25) * h / (10.0 * math.sqrt(G * depth) + u)
+    c0 = 10.0 * math.sqrt(G * depth) if c0 is None else c0
+    return c.get("cfl", 0.25) * h / (c0 + u)
 
 
-def zone_scene(req: PlanRequest, dp: float, method: str = "wcsph_kdk") -> Any:
+def depth_divisor(depth: float, dp: float) -> float:
+    """The largest spacing <= ``dp`` that divides ``depth`` (whole rows of particles)."""
+    return depth / math.ceil(depth / dp - 1e-9)
+
+
+def zone_parts(req: PlanRequest) -> tuple[float, float]:
+    """(flat bed before the structure region, structure region) of the planned zone [m]."""
+    wl = wavelength(req.period, req.depth)
+    flat = wl if req.flat_length is None else min(wl, req.flat_length)
+    return flat, req.structure_length
+
+
+def zone_scene(req: PlanRequest, dp: float, method: str = "wcsph_kdk_h2_wallav0") -> Any:
     """The planned SPH zone as a scene: one wavelength of flat bed from an open inlet, then the
     structure region (a beach of ``beach_slope`` or flat bed ending in an outlet)."""
     from sph_core.scene import make_scene
@@ -173,23 +208,25 @@ def zone_scene(req: PlanRequest, dp: float, method: str = "wcsph_kdk") -> Any:
     from ..cases.coupled_flume import depth_for_case
 
     d = depth_for_case(req.depth, dp)
-    wl = wavelength(req.period, req.depth)
+    flat, structures = zone_parts(req)
     top = d + 2 * req.height + 4 * dp
     opts = dict(METHODS[method])
     scheme = opts.pop("scheme", None)          # a method's scheme is a scene table of its own
-    cst = {"c0": 10.0 * math.sqrt(G * d), **opts}
+    cst = {"c0": req.c0 or 10.0 * math.sqrt(G * d), **opts}
     extra = {"scheme": scheme} if scheme else {}
     if req.beach_slope:
-        x_toe = dp * round(wl / dp)
-        x1 = dp * round((x_toe + (d + 0.1) / req.beach_slope) / dp)
+        x_toe = dp * round(flat / dp)
+        run = structures if structures > 0 else (d + 0.1) / req.beach_slope   # a scene's own
+        x1 = dp * round((x_toe + run) / dp)
         return make_scene({
             "name": "plan-zone", "dp": dp, "t_end": req.duration, "still_water_level": d,
             "tank": {"x0": 0.0, "x1": x1, "z0": 0.0, "z1": max(top, d + 0.1 + 2 * dp)},
-            "water_blocks": [{"x0": 0.0, "x1": x_toe + d / req.beach_slope, "z0": 0.0, "z1": d}],
+            "water_blocks": [{"x0": 0.0, "x1": min(x1, x_toe + d / req.beach_slope), "z0": 0.0,
+                              "z1": d}],
             "beds": [{"points": [[x_toe, 0.0], [x1, req.beach_slope * (x1 - x_toe)]]}],
             "constants": cst, **extra,
             "open_boundaries": [{"side": "left", "elevation": "imposed", "absorb": True}]})
-    length = dp * round((wl + req.structure_length) / dp)
+    length = dp * round((flat + structures) / dp)
     return make_scene({
         "name": "plan-zone", "dp": dp, "t_end": req.duration, "still_water_level": d,
         "tank": {"x0": 0.0, "x1": length, "z0": 0.0, "z1": top},
@@ -230,25 +267,29 @@ def make_plan(req: PlanRequest, data: list[dict[str, Any]] | None = None,
     cheapest method at that dp). Raises ValueError if the data fits no method."""
     rows = sweep_data() if data is None else data
     wl = wavelength(req.period, req.depth)
+    flat, structures = zone_parts(req)
+    c0 = req.c0 or 10.0 * math.sqrt(G * req.depth)
     best: Plan | None = None
-    for m in methods or list(METHODS):
+    for m in methods or [m for m in METHODS if m not in SUPERSEDED]:
         fit = fit_error(rows, m, (req.height, req.period, req.depth))
         tp = throughput or median_throughput(rows, m)
         if fit is None or tp is None or fit["p"] <= 0 or _unstable_flumes(rows, m):
             continue
         if dp is None:
             ratio = (fit["a"] / req.target_error) ** (1.0 / fit["p"])
-            dp_m = min(req.height / max(ratio, 1.0), req.depth / MIN_DEPTH_ROWS)
-            dp_m = float(f"{dp_m:.2g}")    # a spacing a person would write
+            # inside the measured range: the fit says nothing about other resolutions
+            ratio = min(max(ratio, fit["H_over_dp_min"]), fit["H_over_dp_max"])
+            dp_m = min(req.height / ratio, req.depth / MIN_DEPTH_ROWS)
+            dp_m = float(f"{depth_divisor(req.depth, dp_m):.4g}")   # whole rows of the depth
         else:
             dp_m = dp
         # a fit that barely converges asks for a spacing no machine runs (p 0.04 gave dp 1e-5
         # m): judge it by the water's area before building its lattice
-        if req.depth * (wl + req.structure_length) / dp_m ** 2 > MAX_PLAN_PARTICLES:
+        if req.depth * (flat + structures) / dp_m ** 2 > MAX_PLAN_PARTICLES:
             continue
         scene = zone_scene(req, dp_m, m)
         n = count_particles(scene)
-        dt = step_estimate(dp_m, req.depth, req.height, req.period, m)
+        dt = step_estimate(dp_m, req.depth, req.height, req.period, m, c0)
         steps = int(math.ceil(req.duration / dt))
         wall = n * steps / tp    # tp is per step of this method: two passes cost in it
         window = req.period / WINDOWS_PER_PERIOD
@@ -258,8 +299,12 @@ def make_plan(req: PlanRequest, data: list[dict[str, Any]] | None = None,
                     window_steps=max(1, round(window / dt)), particles=n, steps=steps,
                     expected_error=round(err, 5), expected_wall_s=round(wall, 2),
                     throughput=round(tp), fit={k: (round(v, 4) if isinstance(v, float) else v) for k, v in fit.items()},
-                    wavelength_m=round(wl, 4), target_error=req.target_error)
-        if best is None or cand.expected_wall_s < best.expected_wall_s:
+                    wavelength_m=round(wl, 4), target_error=req.target_error,
+                    flat_m=round(flat, 4), structures_m=round(structures, 4),
+                    meets_target=err <= req.target_error * 1.001, c0=round(c0, 4))
+        # a method reaching the target beats one that does not, whatever their costs
+        if (best is None or (cand.meets_target, -cand.expected_wall_s)
+                > (best.meets_target, -best.expected_wall_s)):
             best = cand
     if best is None:
         raise ValueError("the sweep data has no method with >= 2 resolutions of flume points")
@@ -284,7 +329,7 @@ def request_from_scene(scene: Any, height: float, period: float,
     return PlanRequest(height=height, period=period, depth=depth, structure_length=t.x1 - x_s,
                        duration=scene.t_end - scene.t_start,
                        target_error=DEFAULT_TARGET if target_error is None else target_error,
-                       beach_slope=slope)
+                       beach_slope=slope, flat_length=x_s - t.x0, c0=scene.c0)
 
 
 def scene_cost(scene: Any, height: float, period: float,
@@ -302,7 +347,7 @@ def scene_cost(scene: Any, height: float, period: float,
     depth = scene.still_water_level - scene.tank.z0
     n = count_particles(scene)
     steps = math.ceil((scene.t_end - scene.t_start) / step_estimate(scene.dp, depth, height,
-                                                                   period, method))
+                                                                   period, method, scene.c0))
     err = fit["a"] * (height / scene.dp) ** (-fit["p"]) if fit else None
     return {"method": method, "dp": scene.dp, "particles": n, "steps": steps,
             "expected_error": err, "expected_wall_s": n * steps / tp if tp else None}

@@ -111,8 +111,11 @@ def accuracy_points(quick: bool = False, methods: Iterable[str] | None = None) -
     ratios = (2.0, 3.0) if quick else (3.0, 5.0, 8.0)          # H/dp of the wave cases
     flume_opts = {"periods": 1.0 if quick else 3.0, "ramp_periods": 1.0}
     for name in flumes:
-        h = float(cases[name]["H"])
-        pts += [Point(f"flume_{name}", m, round(h / r, 6), flume_opts) for m in methods for r in ratios]
+        h, d = float(cases[name]["H"]), float(cases[name]["d"])
+        # dp: the divisor of the depth nearest H / ratio (a scene whose particles miss the
+        # still-water level is refused: its gauges would read up to -dp/2 in still water)
+        pts += [Point(f"flume_{name}", m, round(d / round(d * r / h), 9), flume_opts)
+                for m in methods for r in ratios]
     a = 0.25 if quick else 0.5                                   # dam-break column width [m]
     db_ratios = (6, 9, 12) if quick else (10, 20, 40)           # column height 2a / dp
     pts += [Point("dambreak", m, round(2 * a / r, 6), {"a": a}) for m in methods for r in db_ratios]
@@ -390,11 +393,13 @@ def run_sweep(points: list[Point], out: Path, scheduler: str | None = None,
 def write_table(rows: list[dict[str, Any]], path: Path, columns: list[str],
                 formats: dict[str, str], command: str = "") -> None:
     """A CSV of ``columns``, one row per record; numbers in ``formats`` columns written with that
-    format spec (``command`` as a # header line). accuracy.csv and stability.csv both."""
+    format spec. accuracy.csv and stability.csv both. One header row and nothing else, as every
+    wavesph CSV (pandas.read_csv reads it): ``command`` goes to ``<stem>.meta.json`` beside it."""
     path.parent.mkdir(parents=True, exist_ok=True)
+    meta = path.with_suffix(".meta.json")
+    if command:
+        meta.write_text(json.dumps({"csv": path.name, "made_by": command}, indent=1) + "\n")
     with open(path, "w", newline="") as fh:
-        if command:
-            fh.write(f"# made by: {command}\n")
         w = csv.DictWriter(fh, fieldnames=columns, extrasaction="ignore")
         w.writeheader()
         for r in rows:
@@ -406,13 +411,14 @@ def write_table(rows: list[dict[str, Any]], path: Path, columns: list[str],
 
 
 def write_csv(records: list[dict[str, Any]], path: Path, command: str = "") -> None:
-    """accuracy.csv: ACCURACY_COLUMNS, one row per point (``command`` as a # header line)."""
+    """accuracy.csv: ACCURACY_COLUMNS, one row per point (``command`` in accuracy.meta.json)."""
     write_table(records, path, ACCURACY_COLUMNS,
                 {"error": ".6g", "wall_s": ".6g", "H_over_dp": ".6g"}, command)
 
 
 def read_csv(path: Path) -> list[dict[str, Any]]:
-    """Rows of an accuracy.csv with numbers parsed (empty cells: None)."""
+    """Rows of an accuracy.csv with numbers parsed (empty cells: None; files of earlier
+    versions began with a # line, skipped)."""
     with open(path) as fh:
         rows = list(csv.DictReader(ln for ln in fh if not ln.startswith("#")))
     num = {"dp": float, "H_over_dp": float, "error": float, "wall_s": float, "particles": int,
