@@ -444,8 +444,10 @@ class RunSettings(_Model):
 
     device: Literal["cpu", "cuda"] = Field(
         "cpu", description="cpu: the numba step on the CPU cores; cuda: the step on an NVIDIA GPU "
-                           "(numba-cuda; closed tanks with the kdk integrator and delta-SPH, "
-                           "docs/developer/gpu.md); `wavesph run --device` overrides it")
+                           "(numba-cuda: WCSPH and Riemann SPH with either integrator and "
+                           "shifting; open ends and bodies with kdk delta-SPH; not ISPH or "
+                           "float32 storage: docs/developer/gpu.md); `wavesph run --device` "
+                           "overrides it")
 
 
 class Scene(_Model):

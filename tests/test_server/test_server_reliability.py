@@ -147,7 +147,7 @@ def test_second_server_on_one_runs_dir_is_refused_with_one_line(tmp_path, factor
         reason = store_in_use(tmp_path / "runs")
         assert reason and "\n" not in reason and "--runs-dir" in reason
         args = argparse.Namespace(host=None, port=0, tcp_port=0, runs_dir=tmp_path / "runs",
-                                  max_runs=None, max_particles=None, token=None)
+                                  max_runs=None, max_particles=None, token=None, device=None)
         assert serve.main(args) == 1  # refused before it binds or touches a run
         assert srv.http.get(f"/runs/{run['id']}").json()["state"] == "waiting_for_client"
     assert store_in_use(tmp_path / "runs") is None  # released when the server stopped
