@@ -29,7 +29,9 @@ pytestmark = [
                        reason="numba-cuda is not installed (pip install numba-cuda)"),
 ]
 
-D, DP, LENGTH, WARM_T = 0.1, 0.02, 0.24, 0.3
+# WARM_T: the simulator's three windows of three steps (~0.0085 s) then span t = 0.30, a probe
+# time of the default cadence (0.01 s), so a probe cadence back in _flume fails there too
+D, DP, LENGTH, WARM_T = 0.1, 0.02, 0.24, 0.295
 
 
 class Oscillating:
@@ -57,6 +59,11 @@ def _flume():
         "tank": {"x0": 0.0, "x1": LENGTH, "z0": 0.0, "z1": D + 0.06},
         "water_blocks": [{"x0": 0.0, "x1": LENGTH, "z0": 0.0, "z1": D}],
         "constants": {"c0": 10.0 * math.sqrt(9.81 * D)},
+        # no output times: Simulation.advance_window (the CPU reference of test_windows_match_cpu)
+        # would otherwise stop at each probe time with a step shortened to land on it, where
+        # CudaStepper.advance_to runs straight to the window's end (the product path,
+        # Simulation._run_gpu, stops at them too: test_cuda_simulation.py)
+        "output": {"probe_every": 0.0, "snapshot_every": 0.0},
         "open_boundaries": [{"side": "left", "elevation": "imposed"},
                             {"side": "right", "elevation": "extrapolated"}]})
     return sc, {s: Oscillating(n) for s, n in flume_nodes(sc).items()}
@@ -225,7 +232,9 @@ def test_extrapolation_and_gauges_match_cpu(flume_factory):
 
 def test_windows_match_cpu(flume_factory):
     """A few coupling windows on the device (data in per window, gauges and counters out)
-    and on the CPU agree: particle count, ids, positions, velocities, gauges, counters."""
+    and on the CPU agree: step count and clock after every window, particle count, ids,
+    positions, velocities, gauges, counters. The CPU's advance_window takes one run to t1 here
+    (the flume has no output times: _flume)."""
     from sph_core.cuda import simulated
     from sph_core.wcsph import ST_REACHED_T
 
@@ -245,6 +254,7 @@ def test_windows_match_cpu(flume_factory):
         gsim.open.samples = end
         st.read_boundaries()
         cpu.advance_window(t1)
+        assert (st.steps0 + st.steps, st.t) == (cpu.steps, cpu.t), len(gauges)
         gauges.append((gsim.boundary_gauges(), cpu.boundary_gauges()))
     st.to_host()
     assert gsim.steps == cpu.steps and gsim.t == cpu.t
