@@ -52,7 +52,7 @@ def case_theory(theory: str, height: float, period: float, depth: float, ramp: f
 
 def run_flume_case(theory: str, height: float, period: float, depth: float, dp: float, periods: float,
                    ramp_periods: float = 1.0, absorb: bool = True, case: str | None = None,
-                   steady: bool = False, **constants) -> dict:
+                   steady: bool = False, device: str | None = None, **constants) -> dict:
     ramp = ramp_periods * period
     model = case_theory(theory, height, period, depth, ramp)
     if theory == "irregular":  # flume length and gauges from the peak wave
@@ -62,8 +62,8 @@ def run_flume_case(theory: str, height: float, period: float, depth: float, dp: 
     out = flume_case(model, height=height, period=period, depth=depth, wavelength=wavelength,
                      dp=dp, periods=periods, ramp=ramp, standing=theory == "standing",
                      absorb=(absorb, absorb), regular=theory != "irregular",
-                     name=f"flume_{case or theory}", steady=steady, **constants)
-    return {"case": case, "theory": theory, **constants, **out}
+                     name=f"flume_{case or theory}", steady=steady, device=device, **constants)
+    return {"case": case, "theory": theory, "device": device or "cpu", **constants, **out}
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -85,6 +85,8 @@ def main(argv: list[str] | None = None) -> int:
                          "and print reflection_steady over --periods periods after it")
     ap.add_argument("--h-over-dp", type=float, help="smoothing length / dp (default: the scene's)")
     ap.add_argument("--alpha-wall", type=float, help="wall viscosity factor (scene default)")
+    ap.add_argument("--device", choices=["cpu", "cuda"], default=None,
+                    help="where the SPH steps run (default: the scene's, cpu)")
     a = ap.parse_args(argv)
     constants = {k: v for k, v in (("h_over_dp", a.h_over_dp), ("alpha_wall_factor", a.alpha_wall))
                  if v is not None}
@@ -104,7 +106,7 @@ def main(argv: list[str] | None = None) -> int:
     dp = a.dp if a.dp else height / 10.0
     for period in periods_s:
         out = run_flume_case(theory, height, period, depth, dp, a.periods, a.ramp_periods,
-                             not a.no_absorb, a.case, a.steady, **constants)
+                             not a.no_absorb, a.case, a.steady, device=a.device, **constants)
         print(json.dumps(out), flush=True)
     return 0
 

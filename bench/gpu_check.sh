@@ -10,7 +10,8 @@
 # JSON lines go to stdout and $OUT/gpu.jsonl, the whole log to $OUT/gpu_check.log.
 # Every phase runs under `timeout`, capped by what is left of TOTAL_S, so the script ends in time.
 # Overrides (a rerun, or a dry run here): GPU_DPS, CPU_DP, CPU_STEPS, THREADS (empty: no CPU runs), TEST_S,
-# HOST_THREADS (16: pytest and the GPU runs' host side), TOTAL_S, PYTHON, SKIP_WHEELS, SKIP_TESTS,
+# FLUMES (non-empty: the H/dp 8 wave flumes on the GPU), HOST_THREADS (16: pytest and the GPU runs'
+# host side), TOTAL_S, PYTHON, SKIP_WHEELS, SKIP_TESTS,
 # NUMBA_ENABLE_CUDASIM.
 set -u
 cd "$(dirname "$0")/.."
@@ -89,5 +90,15 @@ if [ -n "$THREADS" ]; then
         NUMBA_NUM_THREADS=$t timeout "$(left 60)" $PY bench/step_stages.py --dp "$CPU_DP" \
             --steps 20 --model-threads "$TMAX" 2>>"$LOG" | tee -a "$JSONL" "$LOG"
     done
+fi
+if [ -n "${FLUMES:-}" ]; then
+    # the wave flumes at H/dp 8 on the GPU (minutes each): the long flume's loss per wavelength
+    # (H 0.04 m, dp 0.005 m) and seed 002's case II (H 0.02 m in 1 m of water, dp 0.0025 m, ~540k
+    # particles); each prints its JSON line with device, particles, wall_s (and wall_s_per_sim_s)
+    say "GPU wave flumes at H/dp 8"
+    NUMBA_NUM_THREADS=$HT timeout "$(left 400)" $PY bench/wave_decay.py --long --dp 0.005 \
+        --device cuda 2>>"$LOG" | tee -a "$JSONL" "$LOG"
+    NUMBA_NUM_THREADS=$HT timeout "$(left 400)" $PY bench/flume_accuracy.py --case II --dp 0.0025 \
+        --device cuda 2>>"$LOG" | tee -a "$JSONL" "$LOG"
 fi
 say "done: $(wc -l < "$JSONL") JSON lines in $JSONL"

@@ -84,6 +84,8 @@ def main(argv: list[str] | None = None) -> int:
                     help="outlet without the absorption correction (diagnostic: its reflection)")
     ap.add_argument("--inlet-pressure", choices=["hydrostatic", "extrapolated"],
                     help="inlet buffer pressure (scene default if unset)")
+    ap.add_argument("--device", choices=["cpu", "cuda"], default=None,
+                    help="where the SPH steps run (default: the scene's, cpu)")
     add_scheme_arguments(ap)
     a = ap.parse_args(argv)
     cst = constants_from_args(a)
@@ -100,11 +102,12 @@ def main(argv: list[str] | None = None) -> int:
                                  outlet_absorb=not a.no_outlet_absorb,
                                  gauge_wavelengths=a.gauge_wavelengths, n_gauges=a.n_gauges,
                                  wait_reflection=a.long, noise=a.noise,
-                                 c0=c0, scheme=scheme, **cst)
+                                 c0=c0, scheme=scheme, device=a.device, **cst)
         length = float(model.length)
         decays.append(prof.decay_per_m)
         sep_decay, sep_k, sep_kr = separated_decay(prof.x, prof.amp, prof.k)
         print(json.dumps({"H": a.H, "T": a.T, "d": a.d, "dp": dp, "H_over_dp": round(a.H / dp, 3),
+                          "device": a.device or "cpu",
                           "constants": cst, "scheme": scheme, "c0_factor": a.c0_factor,
                           "inlet_pressure": a.inlet_pressure, "settle_periods": a.settle_periods,
                           "outlet_absorb": not a.no_outlet_absorb,

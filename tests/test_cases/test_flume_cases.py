@@ -129,3 +129,16 @@ def test_filter_absorbs_a_kd_1_2_wave():
     res = flume_case(model, height=0.02, period=period, depth=0.2, wavelength=model.length,
                      dp=0.01, periods=2.0, ramp=period, h_over_dp=2.0, alpha_wall_factor=0.0)
     assert res["reflection"] < 0.04, res
+
+
+def test_flume_case_passes_its_device_to_the_simulation(monkeypatch):
+    """``flume_case(device=...)`` (the flume benches' --device) reaches the Simulation: asking for
+    cuda where none is found stops with the one-line DeviceError before a step is taken."""
+    import sph_core.cuda
+    from sph_core.simulation import DeviceError
+
+    monkeypatch.setattr(sph_core.cuda, "unavailable_reason", lambda: "no CUDA GPU (test)")
+    model = theories.build_theory("linear", height=0.02, period=1.0, depth=0.2, ramp_time=1.0)
+    with pytest.raises(DeviceError, match=r"^device cuda: no CUDA GPU \(test\)$"):
+        flume_case(model, height=0.02, period=1.0, depth=0.2, wavelength=float(model.length),
+                   dp=0.02, periods=1.0, ramp=1.0, device="cuda")

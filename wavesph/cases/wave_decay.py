@@ -72,7 +72,8 @@ def amplitude_profile(model: Any, *, ramp: float, height: float, period: float, 
                       flume_wavelengths: float = 1.0, inlet_pressure: str | None = None,
                       settle_periods: float = 0.0, outlet_absorb: bool = True,
                       gauge_wavelengths: float = 0.75, wait_reflection: bool = False,
-                      noise: bool = False, **constants: Any) -> AmplitudeProfile:
+                      noise: bool = False, device: str | None = None,
+                      **constants: Any) -> AmplitudeProfile:
     """Run the flume driven by ``model`` (its start-up ramp lasting ``ramp`` s) and measure
     the amplitude ratio along it (``constants`` override the scene's, e.g. alpha). The flume is
     ``flume_wavelengths`` long; the gauges stay within ``gauge_wavelengths`` of the inlet
@@ -106,7 +107,8 @@ def amplitude_profile(model: Any, *, ramp: float, height: float, period: float, 
         dke = noise_energy(st["x"], st["z"], st["vx"], st["vz"], st["m"], dp)
         noise_rec.append((sim.t, binned_noise(st["x"], dke, edges)))
 
-    res = run_wave_flume(scene, model, window=period / 50, sample=sample if noise else None)
+    res = run_wave_flume(scene, model, window=period / 50, sample=sample if noise else None,
+                         device=device)
     sel = np.nonzero(res.t >= t0 - 1e-9)[0]
     sel = sel[: int(round(periods * period / (res.t[1] - res.t[0])))]
     omega = 2.0 * math.pi / period

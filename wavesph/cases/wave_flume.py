@@ -89,8 +89,10 @@ class FlumeRun:
 def run_wave_flume(scene: Scene, model: Any, *, window: float, x_model_left: float = 0.0,
                    run_dir: str | Path | None = None, t_end: float | None = None,
                    keep_flume: bool = False,
-                   sample: Callable[[Simulation], None] | None = None) -> FlumeRun:
+                   sample: Callable[[Simulation], None] | None = None,
+                   device: str | None = None) -> FlumeRun:
     """Run ``scene`` driven at both ends by ``model``; return gauge records and model values.
+    ``device``: where the steps run (None: the scene's ``[run] device``).
     ``sample(flume)``, if given, is called at the start and every 10 windows (a diagnostic's
     hook; its time is not in ``wall_s``)."""
     nodes_x0 = scene.tank.x0
@@ -99,7 +101,7 @@ def run_wave_flume(scene: Scene, model: Any, *, window: float, x_model_left: flo
     sources = {side: WaveModelBoundary(model, nd, scene.still_water_level,
                                        x_model_left + (nd.x_face - nodes_x0))
                for side, nd in nodes.items()}
-    flume = Simulation(scene, sources=sources, run_dir=run_dir, window=window)
+    flume = Simulation(scene, sources=sources, run_dir=run_dir, window=window, device=device)
     t_end = scene.t_end if t_end is None else t_end
     n_fluid = [(flume.t, flume.n_fluid)]
     if sample is not None:
@@ -133,7 +135,7 @@ def flume_case(model: Any, *, height: float, period: float, depth: float, wavele
                dp: float, periods: float, ramp: float, standing: bool = False,
                absorb: tuple[bool, bool] = (True, True), window_per_period: int = 50,
                regular: bool = True, name: str = "wave_flume", steady: bool = False,
-               **constants: Any) -> dict[str, Any]:
+               device: str | None = None, **constants: Any) -> dict[str, Any]:
     """Run one wave case and score it: the figures of ``bench/flume_accuracy.py``.
 
     Flume one wavelength long (standing wave: half, faces at the nodes of eta, antinode
@@ -173,7 +175,8 @@ def flume_case(model: Any, *, height: float, period: float, depth: float, wavele
                              right_elevation="imposed" if standing else "extrapolated",
                              probe_every=period / 40, name=name, **constants)
     x_left = -0.5 * scene.tank.x1 if standing else 0.0
-    res = run_wave_flume(scene, model, window=period / window_per_period, x_model_left=x_left)
+    res = run_wave_flume(scene, model, window=period / window_per_period, x_model_left=x_left,
+                         device=device)
     sel = (res.t >= t_start - 1e-9) & (res.t <= t_start + periods * period + 1e-9)
     refl = refl_3g = refl_steady = None
     refl_h: list[float] | None = None
@@ -211,6 +214,7 @@ def flume_case(model: Any, *, height: float, period: float, depth: float, wavele
             "reflection_steady": refl_steady,
             "absorb": list(absorb), "kd": round(kd, 4),
             "wall_s": round(res.wall_s, 2),
+            "wall_s_per_sim_s": round(res.wall_s / max(float(res.t[-1]) - scene.t_start, 1e-9), 3),
             "particles": res.particles, "steps": res.steps,
             "particle_steps_per_s": round(res.particles * res.steps / max(res.wall_s, 1e-9)),
             "fluid_change": int(nf[-1, 1] - nf[0, 1]), "boundary_counts": res.counts,
