@@ -1,9 +1,10 @@
 """The WCSPH step on an NVIDIA GPU (numba-cuda): see docs/developer/gpu.md.
 
-Scope today: a closed tank (no open ends, no bodies), the kdk or symplectic_pc integrator,
-delta-SPH + Monaghan AV or Riemann SPH (with or without MUSCL), Lo & Shao viscosity, gravity,
-Adami walls, the no-penetration correction, the approach-gated wall tension, and Fickian or
-delta-plus shifting, from the same pair terms as the CPU step (``pairs.gather`` + ``terms.py``).
+Scope today: the kdk or symplectic_pc integrator, delta-SPH + Monaghan AV or Riemann SPH (with
+or without MUSCL), Lo & Shao viscosity, gravity, Adami walls, the no-penetration correction, the
+approach-gated wall tension, Fickian or delta-plus shifting; and with kdk delta-SPH, open ends
+(``gpu_open_ends.py``) and rigid bodies (``gpu_bodies.py``); from the same pair terms as the CPU
+step (``pairs.gather`` + ``terms.py``). Not ISPH, not float32 storage (``cuda_stepper.unsupported``).
 ``cuda_stepper.CudaStepper`` runs it. Its kernels call the CPU passes' per-particle
 functions (``wcsph.adami_state``, ``wcsph.fluid_rates`` and those ``gpu_schemes.py`` lists);
 the other per-particle bodies (``per_particle.py``) are plain ``@njit(inline="always")`` functions, which numba-cuda compiles
