@@ -33,6 +33,7 @@ from ..shifting import FS_ISOLATED, dplus_surface, dplus_tangential, fickian_shi
 from ..wcsph import pc_correct_particle, pc_predict_particle
 from .gpu_kernels import (DTS, N_BAD, N_BAND, N_OUT, STOP, V2, _block_max, _view, fluid_kernel,
                           permute_kernel)
+from .per_particle import clear_rows
 
 k_permute_pc = permute_kernel(
     "k_permute_pc", N_SORTED_PC,
@@ -77,9 +78,7 @@ def k_shift_fickian(buf, n, cells, prm, clk, ctl):
         return
     i = cuda.grid(1)
     if i < n:
-        f = buf[0]
-        for r in range(XN, RHON + 1):
-            f[r, i] = 0.0
+        clear_rows(buf[0], i, XN, RHON)
         if buf[1][i] == FLUID:
             ps = _view(buf)
             ps.xn[i], ps.zn[i], ps.rhon[i], ps.vxn[i], ps.vzn[i] = fickian_shift(
@@ -95,11 +94,8 @@ def k_dplus_surface(buf, n, cells, prm, clk, ctl):
         return
     i = cuda.grid(1)
     if i < n:
-        f = buf[0]
-        for r in range(XN, RHON + 1):
-            f[r, i] = 0.0
-        for r in range(GPX, GWZ + 1):
-            f[r, i] = 0.0
+        clear_rows(buf[0], i, XN, RHON)
+        clear_rows(buf[0], i, GPX, GWZ)
         if buf[1][i] == FLUID:
             ps = _view(buf)
             coef = prm.shift_a * prm.h * math.sqrt(clk[V2]) * clk[DTS]
