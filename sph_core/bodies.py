@@ -195,6 +195,17 @@ def bodies_advance(bd, t, dt, stage):
                 _set_prescribed(bd, b, t + dt, t + dt)
 
 
+@njit(cache=True, inline="always")
+def body_arm(bd, k):
+    """(body b, rx, rz) of body particle k: its offset from body b's reference point (rx, rz in
+    the body's frame) turned by the body's angle q[b, 2]."""
+    b = bd.owner[k]
+    th = bd.q[b, 2]
+    c = math.cos(th)
+    s = math.sin(th)
+    return b, c * bd.rx[k] - s * bd.rz[k], s * bd.rx[k] + c * bd.rz[k]
+
+
 @njit(cache=True)
 def bodies_v2max(bd):
     """Largest squared body-particle speed |V + omega x r|^2 (for the time step's CFL bound)."""
@@ -202,13 +213,8 @@ def bodies_v2max(bd):
     if not bd.active:
         return v2max
     for k in range(bd.npart):
-        b = bd.owner[k]
-        th = bd.q[b, 2]
+        b, rx, rz = body_arm(bd, k)
         om = bd.qd[b, 2]
-        c = math.cos(th)
-        s = math.sin(th)
-        rx = c * bd.rx[k] - s * bd.rz[k]
-        rz = s * bd.rx[k] + c * bd.rz[k]
         u = bd.qd[b, 0] - om * rz
         w = bd.qd[b, 1] + om * rx
         v2max = max(v2max, u * u + w * w)
@@ -222,14 +228,9 @@ def body_particle(i, ps, bd):
     k = ps.ids[i] - bd.id0
     if k < 0 or k >= bd.npart:
         return False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
-    b = bd.owner[k]
-    th = bd.q[b, 2]
+    b, rx, rz = body_arm(bd, k)
     om = bd.qd[b, 2]
     al = bd.acc[b, 2]
-    c = math.cos(th)
-    s = math.sin(th)
-    rx = c * bd.rx[k] - s * bd.rz[k]
-    rz = s * bd.rx[k] + c * bd.rz[k]
     return (True, bd.q[b, 0] + rx, bd.q[b, 1] + rz, bd.qd[b, 0] - om * rz, bd.qd[b, 1] + om * rx,
             bd.acc[b, 0] - al * rz - om * om * rx, bd.acc[b, 1] + al * rx - om * om * rz)
 

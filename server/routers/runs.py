@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import asyncio
 import json
+from pathlib import Path
 from typing import Literal
 
 from fastapi import APIRouter, HTTPException, Query, Request, Response
@@ -11,7 +12,7 @@ from fastapi.responses import FileResponse, StreamingResponse
 from starlette.requests import ClientDisconnect
 
 from ..deps import Auth, Manager, RunDep
-from ..run_manager import QueueFull
+from ..run_manager import QueueFull, Run
 from ..schemas import TERMINAL, RunInfo
 from ..store import read_gauge_rows
 from ..validation import BodyNotJson, RequestInvalid, parse_run_request
@@ -147,10 +148,24 @@ async def get_gauges(run: RunDep, format: Literal["csv", "json"] = Query("csv"))
     path = run.dir / (run.info.gauges_file or "gauges.csv")
     if not path.is_file():  # a directory in its place (a damaged store) is no data either
         raise HTTPException(404, f"run {run.info.id} has no gauge data yet")
+    return await _table(path, f"{run.info.id}-gauges.csv", format)
+
+
+async def _table(path: Path, filename: str, format: str) -> Response:
+    """A CSV record of the run as the file itself (``filename``) or as JSON columns and rows."""
     if format == "csv":
-        return FileResponse(path, media_type="text/csv", filename=f"{run.info.id}-gauges.csv")
+        return FileResponse(path, media_type="text/csv", filename=filename)
     columns, rows = await asyncio.to_thread(read_gauge_rows, path)
     return Response(json.dumps({"columns": columns, "rows": rows}), media_type="application/json")
+
+
+async def _newest_sph_table(run: Run, name: str, missing: str, format: str) -> Response:
+    """The SPH side's ``<name>.csv`` (a coupled run restarted into sph.<k>/ has several: the
+    newest) through _table; 404 "run <id> <missing>" where there is none."""
+    paths = sorted(run.dir.glob(f"sph*/{name}.csv"), key=lambda p: p.stat().st_mtime)
+    if not paths:
+        raise HTTPException(404, f"run {run.info.id} {missing}")
+    return await _table(paths[-1], f"{run.info.id}-{name}.csv", format)
 
 
 @router.get("/{run_id}/probes", responses=NOT_FOUND)
@@ -158,13 +173,7 @@ async def get_probes(run: RunDep, format: Literal["csv", "json"] = Query("csv"))
     """Every probe of the SPH side (sph_core probes.csv: elevation, point, front, force,
     pressure-line and overtopping columns) as CSV or JSON; a coupled run restarted into
     sph.<k>/ serves the newest. /gauges is the coupling gauges' record."""
-    paths = sorted(run.dir.glob("sph*/probes.csv"), key=lambda p: p.stat().st_mtime)
-    if not paths:
-        raise HTTPException(404, f"run {run.info.id} has no probe data yet")
-    if format == "csv":
-        return FileResponse(paths[-1], media_type="text/csv", filename=f"{run.info.id}-probes.csv")
-    columns, rows = await asyncio.to_thread(read_gauge_rows, paths[-1])
-    return Response(json.dumps({"columns": columns, "rows": rows}), media_type="application/json")
+    return await _newest_sph_table(run, "probes", "has no probe data yet", format)
 
 
 @router.get("/{run_id}/bodies", responses=NOT_FOUND)
@@ -172,13 +181,7 @@ async def get_bodies(run: RunDep, format: Literal["csv", "json"] = Query("csv"))
     """Rigid-body series (sph_core bodies.csv: per body x, z, theta, u, w, omega, fx, fz, my) as
     CSV or JSON; 404 if the scene has no bodies. A coupled run restarted into sph.<k>/ serves the
     newest."""
-    paths = sorted(run.dir.glob("sph*/bodies.csv"), key=lambda p: p.stat().st_mtime)
-    if not paths:
-        raise HTTPException(404, f"run {run.info.id} has no body data")
-    if format == "csv":
-        return FileResponse(paths[-1], media_type="text/csv", filename=f"{run.info.id}-bodies.csv")
-    columns, rows = await asyncio.to_thread(read_gauge_rows, paths[-1])
-    return Response(json.dumps({"columns": columns, "rows": rows}), media_type="application/json")
+    return await _newest_sph_table(run, "bodies", "has no body data", format)
 
 
 MAX_SCATTER = 40_000   # particles sent to the page's scatter (every k-th beyond it)

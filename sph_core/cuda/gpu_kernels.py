@@ -31,7 +31,7 @@ from . import simulated
 # twins of the two plain @njit helpers the fluid pass takes (the same source)
 _fluid_consts = njit(inline="always")(fluid_consts.py_func)
 _fluid_i = njit(inline="always")(fluid_i.py_func)
-from .per_particle import cell_of, kick_drift_particle, kick_particle
+from .per_particle import cell_of, kick_drift_particle, kick_particle, permute_slot
 
 T, DT, DTS, T_STOP, V2, A2, RMAX, V2LAST = range(8)
 N_CLK = 8
@@ -263,21 +263,29 @@ def k_cell_order(start, order, ncells, ctl):
             order[q + 1] = v
 
 
-@cuda.jit
-def k_permute(buf, buf2, order, n, ctl):
-    """neighbours.permute: gather the carried rows, kind, ids and cell into the twin."""
-    if ctl[STOP] != 0:
-        return
-    k = cuda.grid(1)
-    if k < n:
-        i = order[k]
-        f = buf[0]
-        f2 = buf2[0]
-        for r in range(N_SORTED_KDK):
-            f2[r, k] = f[r, i]
-        buf2[1][k] = buf[1][i]
-        buf2[2][k] = buf[2][i]
-        buf2[3][k] = buf[3][i]
+def _named_kernel(fn, name, doc):
+    """fn as the CUDA kernel ``name`` (its __name__, __qualname__ and docstring set first)."""
+    fn.__name__ = fn.__qualname__ = name
+    fn.__doc__ = doc
+    return cuda.jit(fn)
+
+
+def permute_kernel(name, nrows, doc):
+    """The kernel of neighbours.permute for buffers of ``nrows`` carried rows (k_permute,
+    gpu_schemes.k_permute_pc): sorted position k gathers slot order[k]'s rows, kind, ids and
+    cell from the buffer into its twin."""
+    def k_permute(buf, buf2, order, n, ctl):
+        if ctl[STOP] != 0:
+            return
+        k = cuda.grid(1)
+        if k < n:
+            permute_slot(buf, buf2, order[k], k, nrows)
+    return _named_kernel(k_permute, name, doc)
+
+
+k_permute = permute_kernel(
+    "k_permute", N_SORTED_KDK,
+    """neighbours.permute: gather the carried rows, kind, ids and cell into the twin.""")
 
 
 @cuda.jit
@@ -291,38 +299,32 @@ def k_wall(buf, n, cells, prm, ctl):
         ps.p[i], ps.rho[i], ps.vwx[i], ps.vwz[i] = adami_state(i, ps, cells, prm)
 
 
-@cuda.jit
-def k_fluid(buf, n, cells, prm, ctl):
-    """wcsph.fluid_pass (delta-SPH form)."""
-    if ctl[STOP] != 0:
-        return
-    i = cuda.grid(1)
-    if i < n and buf[1][i] == FLUID:
-        ps = _view(buf)
-        k = _fluid_consts(prm)
-        ps.ax[i], ps.az[i], ps.drho[i], ps.pw[i], ps.dvnx[i], ps.dvnz[i] = fluid_rates(
-            i, ps, cells, prm, None, k, _fluid_i(i, ps, k))
+def fluid_kernel(name, riemann, doc):
+    """The kernel of wcsph.fluid_pass with ``riemann`` None (delta-SPH, k_fluid) or True
+    (Riemann SPH, gpu_schemes.k_fluid_riemann): wcsph.fluid_rates of every fluid slot."""
+    def k_fluid(buf, n, cells, prm, ctl):
+        if ctl[STOP] != 0:
+            return
+        i = cuda.grid(1)
+        if i < n and buf[1][i] == FLUID:
+            ps = _view(buf)
+            k = _fluid_consts(prm)
+            ps.ax[i], ps.az[i], ps.drho[i], ps.pw[i], ps.dvnx[i], ps.dvnz[i] = fluid_rates(
+                i, ps, cells, prm, riemann, k, _fluid_i(i, ps, k))
+    return _named_kernel(k_fluid, name, doc)
 
 
-@cuda.jit
-def k_kick(buf, n, prm, clk, ctl):
-    """wcsph.kdk_kick: second half-kick, guard counts, block-reduced max |v|^2, |a|^2, rho."""
-    if ctl[STOP] != 0:
-        return
+k_fluid = fluid_kernel("k_fluid", None, """wcsph.fluid_pass (delta-SPH form).""")
+
+
+def _block_max_py(clk, v2, a2, r):
+    """Block max-reduction of each thread's (|v|^2, |a|^2, rho) in shared memory, thread 0's
+    result into clk[V2], clk[A2], clk[RMAX] (one atomic each per block): the kick's and the
+    corrector's reductions (every thread of the block calls it: it synchronises)."""
     sv = cuda.shared.array(TPB, float64)
     sa = cuda.shared.array(TPB, float64)
     sr = cuda.shared.array(TPB, float64)
     t = cuda.threadIdx.x
-    i = cuda.grid(1)
-    v2 = 0.0
-    a2 = 0.0
-    r = 0.0
-    if i < n and buf[1][i] == FLUID:
-        v2, a2, r, guard = kick_particle(i, _view(buf), clk[DTS], prm)
-        if guard == 1:
-            cuda.atomic.add(ctl, N_BAD, 1)
-        elif guard == 2:
-            cuda.atomic.add(ctl, N_BAND, 1)
     sv[t] = v2
     sa[t] = a2
     sr[t] = r
@@ -339,3 +341,28 @@ def k_kick(buf, n, prm, clk, ctl):
         cuda.atomic.max(clk, V2, sv[0])
         cuda.atomic.max(clk, A2, sa[0])
         cuda.atomic.max(clk, RMAX, sr[0])
+
+
+# Under the simulator a device function (the simulator gives it the block's shared memory and
+# barriers, as it does to _block_scan); on the GPU an inlined callee, the form compile_ptx
+# verifies without a GPU (docs/developer/gpu.md; k_kick and k_correct compile to sm_90 PTX).
+_block_max = (cuda.jit(device=True)(_block_max_py) if simulated()
+              else njit(inline="always")(_block_max_py))
+
+
+@cuda.jit
+def k_kick(buf, n, prm, clk, ctl):
+    """wcsph.kdk_kick: second half-kick, guard counts, block-reduced max |v|^2, |a|^2, rho."""
+    if ctl[STOP] != 0:
+        return
+    i = cuda.grid(1)
+    v2 = 0.0
+    a2 = 0.0
+    r = 0.0
+    if i < n and buf[1][i] == FLUID:
+        v2, a2, r, guard = kick_particle(i, _view(buf), clk[DTS], prm)
+        if guard == 1:
+            cuda.atomic.add(ctl, N_BAD, 1)
+        elif guard == 2:
+            cuda.atomic.add(ctl, N_BAND, 1)
+    _block_max(clk, v2, a2, r)

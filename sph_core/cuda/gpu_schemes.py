@@ -25,25 +25,19 @@ from __future__ import annotations
 
 import math
 
-from numba import cuda, float64
+from numba import cuda
 
 from ..particles import FLUID, GPX, GPZ, GUX, GUZ, GWX, GWZ, N_SORTED_PC, RHON, XN
 from ..riemann import muscl_gradients
 from ..shifting import FS_ISOLATED, dplus_surface, dplus_tangential, fickian_shift, move_particle
-from ..wcsph import fluid_rates, pc_correct_particle, pc_predict_particle
-from .gpu_kernels import (A2, DTS, N_BAD, N_BAND, N_OUT, RMAX, STOP, TPB, V2, _fluid_consts,
-                          _fluid_i, _view)
-from .per_particle import permute_slot
+from ..wcsph import pc_correct_particle, pc_predict_particle
+from .gpu_kernels import (DTS, N_BAD, N_BAND, N_OUT, STOP, V2, _block_max, _view, fluid_kernel,
+                          permute_kernel)
+from .per_particle import clear_rows
 
-
-@cuda.jit
-def k_permute_pc(buf, buf2, order, n, ctl):
-    """neighbours.permute with the symplectic step's rows (N_SORTED_PC: x..m and xn..rhon)."""
-    if ctl[STOP] != 0:
-        return
-    k = cuda.grid(1)
-    if k < n:
-        permute_slot(buf, buf2, order[k], k, N_SORTED_PC)
+k_permute_pc = permute_kernel(
+    "k_permute_pc", N_SORTED_PC,
+    """neighbours.permute with the symplectic step's rows (N_SORTED_PC: x..m and xn..rhon).""")
 
 
 @cuda.jit
@@ -61,10 +55,6 @@ def k_correct(buf, n, prm, clk, ctl):
     """wcsph.pc_correct: the corrector, guard counts, block-reduced max |v|^2, |a|^2, rho."""
     if ctl[STOP] != 0:
         return
-    sv = cuda.shared.array(TPB, float64)
-    sa = cuda.shared.array(TPB, float64)
-    sr = cuda.shared.array(TPB, float64)
-    t = cuda.threadIdx.x
     i = cuda.grid(1)
     v2 = 0.0
     a2 = 0.0
@@ -77,22 +67,7 @@ def k_correct(buf, n, prm, clk, ctl):
             cuda.atomic.add(ctl, N_BAND, 1)
         if out != 0:
             cuda.atomic.add(ctl, N_OUT, 1)
-    sv[t] = v2
-    sa[t] = a2
-    sr[t] = r
-    cuda.syncthreads()
-    half = TPB // 2
-    while half > 0:
-        if t < half:
-            sv[t] = max(sv[t], sv[t + half])
-            sa[t] = max(sa[t], sa[t + half])
-            sr[t] = max(sr[t], sr[t + half])
-        cuda.syncthreads()
-        half //= 2
-    if t == 0:
-        cuda.atomic.max(clk, V2, sv[0])
-        cuda.atomic.max(clk, A2, sa[0])
-        cuda.atomic.max(clk, RMAX, sr[0])
+    _block_max(clk, v2, a2, r)
 
 
 @cuda.jit
@@ -103,9 +78,7 @@ def k_shift_fickian(buf, n, cells, prm, clk, ctl):
         return
     i = cuda.grid(1)
     if i < n:
-        f = buf[0]
-        for r in range(XN, RHON + 1):
-            f[r, i] = 0.0
+        clear_rows(buf[0], i, XN, RHON)
         if buf[1][i] == FLUID:
             ps = _view(buf)
             ps.xn[i], ps.zn[i], ps.rhon[i], ps.vxn[i], ps.vzn[i] = fickian_shift(
@@ -121,11 +94,8 @@ def k_dplus_surface(buf, n, cells, prm, clk, ctl):
         return
     i = cuda.grid(1)
     if i < n:
-        f = buf[0]
-        for r in range(XN, RHON + 1):
-            f[r, i] = 0.0
-        for r in range(GPX, GWZ + 1):
-            f[r, i] = 0.0
+        clear_rows(buf[0], i, XN, RHON)
+        clear_rows(buf[0], i, GPX, GWZ)
         if buf[1][i] == FLUID:
             ps = _view(buf)
             coef = prm.shift_a * prm.h * math.sqrt(clk[V2]) * clk[DTS]
@@ -171,14 +141,6 @@ def k_muscl_gradients(buf, n, cells, prm, ctl):
          f[GWZ, i]) = muscl_gradients(i, _view(buf), cells, prm)
 
 
-@cuda.jit
-def k_fluid_riemann(buf, n, cells, prm, ctl):
-    """wcsph.fluid_pass with Riemann SPH's flux (terms.riemann_pair)."""
-    if ctl[STOP] != 0:
-        return
-    i = cuda.grid(1)
-    if i < n and buf[1][i] == FLUID:
-        ps = _view(buf)
-        k = _fluid_consts(prm)
-        ps.ax[i], ps.az[i], ps.drho[i], ps.pw[i], ps.dvnx[i], ps.dvnz[i] = fluid_rates(
-            i, ps, cells, prm, True, k, _fluid_i(i, ps, k))
+k_fluid_riemann = fluid_kernel(
+    "k_fluid_riemann", True,
+    """wcsph.fluid_pass with Riemann SPH's flux (terms.riemann_pair).""")

@@ -78,3 +78,10 @@ def permute_slot(buf, buf2, i, k, nrows):
     buf2[1][k] = buf[1][i]
     buf2[2][k] = buf[2][i]
     buf2[3][k] = buf[3][i]
+
+
+@njit(cache=True, inline="always")
+def clear_rows(f, i, r0, r1):
+    """Rows r0..r1 (inclusive) of slot i of the storage f set to zero (a pass's scratch rows)."""
+    for r in range(r0, r1 + 1):
+        f[r, i] = 0.0

@@ -1,8 +1,8 @@
 """Open ends in the CUDA step (sph_core/cuda/gpu_open_ends.py) against the CPU's open_boundary.py,
 kernel by kernel and over a few coupling windows.
 
-On a GPU when one is present, else under numba-cuda's simulator (set here, before numba.cuda is
-first imported); skipped without numba-cuda. The state is a tiny flume (dp 0.02 m, depth 0.1 m,
+On a GPU when one is present, else under numba-cuda's simulator (set by
+cuda_support, imported before numba.cuda); skipped without numba-cuda. The state is a tiny flume (dp 0.02 m, depth 0.1 m,
 0.24 m long, both ends open: imposed inlet, extrapolated outlet, absorbing) with an oscillating
 through-flow, warmed up on the CPU, so that the simulator (every CUDA thread a Python thread)
 stays within a minute.
@@ -10,24 +10,14 @@ stays within a minute.
 
 from __future__ import annotations
 
-import importlib.util
 import math
-import os
-import shutil
-import sys
 
 import numpy as np
 import pytest
+from cuda_support import (CUDA_TESTS, close, device_session, fluid_agrees, set_clock,
+                          skip_without_device, stepper)
 
-if "NUMBA_ENABLE_CUDASIM" not in os.environ and not (
-        os.path.exists("/dev/nvidia0") or shutil.which("nvidia-smi")):
-    os.environ["NUMBA_ENABLE_CUDASIM"] = "1"
-
-pytestmark = [
-    pytest.mark.cuda,
-    pytest.mark.skipif(importlib.util.find_spec("numba_cuda") is None,
-                       reason="numba-cuda is not installed (pip install numba-cuda)"),
-]
+pytestmark = CUDA_TESTS
 
 # WARM_T: the simulator's three windows of three steps (~0.0085 s) then span t = 0.30, a probe
 # time of the default cadence (0.01 s), so a probe cadence back in _flume fails there too
@@ -72,44 +62,20 @@ def _flume():
 @pytest.fixture(scope="module")
 def flume_factory():
     """Fresh Simulations of the tiny flume after WARM_T s on the CPU (flow through both ends)."""
-    from sph_core.cuda import unavailable_reason
-    reason = unavailable_reason()
-    if reason:
-        pytest.skip(reason)
-    from sph_core.simulation import Simulation
+    with device_session():
+        from sph_core.simulation import Simulation
 
-    old = sys.getswitchinterval()
-    sys.setswitchinterval(1e-4)
-    sc, src = _flume()
-    base = Simulation(sc, sources=src, window=0.02)
-    base.advance_to(WARM_T)
-    ck = base.checkpoint()
-
-    def make():
         sc, src = _flume()
-        s = Simulation(sc, sources=src, window=0.02)
-        s.restore(ck)
-        return s
-    yield make
-    sys.setswitchinterval(old)
+        base = Simulation(sc, sources=src, window=0.02)
+        base.advance_to(WARM_T)
+        ck = base.checkpoint()
 
-
-def _stepper(sim):
-    from sph_core.cuda.cuda_stepper import CudaStepper
-    return CudaStepper(sim)
-
-
-def _clock(st, t, dts):
-    from sph_core.cuda import gpu_kernels as K
-    clk = np.zeros(K.N_CLK)
-    clk[K.T], clk[K.DTS], clk[K.T_STOP] = t, dts, np.inf
-    st._put(st.clk, clk)
-    st._put(st.ctl, np.zeros(K.N_CTL, dtype=np.int64))
-
-
-def _close(gpu, cpu, rel=1e-12):
-    scale = max(float(np.abs(cpu).max()), 1e-300)
-    np.testing.assert_allclose(gpu, cpu, rtol=0.0, atol=rel * scale)
+        def make():
+            sc, src = _flume()
+            s = Simulation(sc, sources=src, window=0.02)
+            s.restore(ck)
+            return s
+        yield make
 
 
 def _window(sim, t1, t0=None):
@@ -152,7 +118,7 @@ def test_buffer_update_and_crossings_match_cpu(flume_factory):
         s.open.ends.eta_meas[:] = (0.003, -0.002)   # a mismatch: the correction acts
         _crossings(s)
         _window(s, s.t + 0.01)
-    st = _stepper(gsim)
+    st = stepper(gsim)
     st.open.load_window()
     dt = cpu.dt
     ps, n, e = cpu.particles, cpu.particles.n, cpu.open.ends
@@ -161,7 +127,7 @@ def test_buffer_update_and_crossings_match_cpu(flume_factory):
     e.next_id[0] = ps.next_id   # as Simulation._run sets it before a CPU run
     n_new = update_buffers(ps.view, n, cpu.t + dt, dt, e, cpu.prm)
     assert n_new == n + 2   # the two clones
-    _clock(st, gsim.t, dt)
+    set_clock(st, dt, t=gsim.t)
     for name, kernel, args in st._plan[0][1:8]:   # boundary .. apply (no kick, no sort)
         assert name in ("boundary", "buffers", "mark", "clone_scan_blocks", "clone_scan_sums",
                         "clone_scan_add", "apply"), name
@@ -171,8 +137,8 @@ def test_buffer_update_and_crossings_match_cpu(flume_factory):
     assert not np.array_equal(e.filt_x, filt0) and np.any(e.counters != counters0)
     np.testing.assert_array_equal(got["counters"], e.counters)
     assert got["next_id"][0] == e.next_id[0]
-    _close(got["zs"], e.zs)
-    _close(got["filt_x"], e.filt_x)
+    close(got["zs"], e.zs)
+    close(got["filt_x"], e.filt_x)
     buf = st.bufs[0]
     np.testing.assert_array_equal(st._to_host(buf[1])[:n_new], ps.kind[:n_new])
     np.testing.assert_array_equal(st._to_host(buf[2])[:n_new], ps.ids[:n_new])
@@ -180,7 +146,7 @@ def test_buffer_update_and_crossings_match_cpu(flume_factory):
     assert np.all(st._to_host(buf[1])[n_new:] == INACTIVE)
     f = st._to_host(buf[0])
     for r in range(f.shape[0]):
-        _close(f[r, :n_new], ps.f[r, :n_new])
+        close(f[r, :n_new], ps.f[r, :n_new])
     assert st._to_host(st.open.oe[G.OFF])[st.n] == 2
 
 
@@ -191,11 +157,11 @@ def test_capacity_overflow_stops_the_device(flume_factory):
 
     sim = flume_factory()
     _crossings(sim)
-    st = _stepper(sim)
+    st = stepper(sim)
     oei = st._to_host(st.open.oe[G.I])
     oei[G.N_LIVE] = st.n - 1          # one free slot left, two clones due
     st._put(st.open.oe[G.I], oei)
-    _clock(st, sim.t, sim.dt)
+    set_clock(st, sim.dt, t=sim.t)
     for _, kernel, args in st._plan[0][1:8]:
         kernel(*args)
     ctl = st._to_host(st.ctl)
@@ -208,12 +174,12 @@ def test_extrapolation_and_gauges_match_cpu(flume_factory):
     from sph_core.particles import INLET, OUTLET, P, RHO
 
     cpu, gsim = flume_factory(), flume_factory()
-    st = _stepper(gsim)
+    st = stepper(gsim)
     ps, n, e = cpu.particles, cpu.particles.n, cpu.open.ends
     e.eta_meas[:] = np.nan
     extrapolate_buffers(ps.view, n, cpu.cells, e, cpu.prm)
     measure_boundaries(ps.view, cpu.cells, e, cpu.prm)
-    _clock(st, gsim.t, gsim.dt)
+    set_clock(st, gsim.dt, t=gsim.t)
     plan = st._plan[1]   # an odd step's sorted state is buffer 0, where the state is
     names = [p[0] for p in plan]
     for name in ("extrapolate", "gauge_line", "gauge"):
@@ -221,12 +187,12 @@ def test_extrapolation_and_gauges_match_cpu(flume_factory):
         kernel(*args)
     got = st.open.read()
     assert np.all(np.isfinite(e.eta_meas))
-    _close(got["eta_meas"], e.eta_meas, rel=1e-13)
+    close(got["eta_meas"], e.eta_meas, rel=1e-13)
     f = st._to_host(st.bufs[0][0])
     buf = (ps.kind[:n] == INLET) | (ps.kind[:n] == OUTLET)
     assert buf.sum() > 0
     for row in (P, RHO):
-        _close(f[row, :n][buf], ps.f[row, :n][buf])
+        close(f[row, :n][buf], ps.f[row, :n][buf])
     assert st.open.n_live() == n
 
 
@@ -242,7 +208,7 @@ def test_windows_match_cpu(flume_factory):
     for s in (cpu, gsim):
         _crossings(s)   # every kind of crossing in the first step
     counts0 = cpu.boundary_counts()
-    st = _stepper(gsim)
+    st = stepper(gsim)
     windows, span = (3, 3) if simulated() else (10, 40)   # windows, steps per window
     t1 = cpu.t
     gauges = []
@@ -268,25 +234,19 @@ def test_windows_match_cpu(flume_factory):
     for g, c in gauges:
         for side in ("left", "right"):
             assert g[side] == pytest.approx(c[side], abs=1e-12)   # m
-    a, b = cpu.fluid_state(), gsim.fluid_state()
-    np.testing.assert_array_equal(a["id"], b["id"])
-    print({k: float(np.abs(b[k] - a[k]).max() / np.abs(a[k]).max()) for k in a if k != "id"},
-          cpu.boundary_counts())
-    for key in ("x", "z", "vx", "vz", "rho", "p"):
-        _close(b[key], a[key], rel=1e-10)
+    fluid_agrees(cpu, gsim, 1e-10, "max |gpu - cpu| / max |cpu|:", cpu.boundary_counts())
 
 
 def test_open_ends_with_a_floating_body_match_cpu():
     """Open ends and a rigid body in one step (the launch list of gpu_step_plan with both):
     a few steps from rest with a box released 1 cm below its equilibrium."""
-    from sph_core.cuda import simulated, unavailable_reason
+    from sph_core.cuda import simulated
     from sph_core.open_ends import flume_nodes
     from sph_core.scene import make_scene
     from sph_core.simulation import Simulation
     from sph_core.wcsph import ST_STEP_LIMIT
 
-    if unavailable_reason():
-        pytest.skip(unavailable_reason())
+    skip_without_device()
 
     def make():
         sc = make_scene({
@@ -303,7 +263,7 @@ def test_open_ends_with_a_floating_body_match_cpu():
 
     steps = 4 if simulated() else 100
     cpu, gsim = make(), make()
-    st = _stepper(gsim)
+    st = stepper(gsim)
     assert st.open is not None and st.bodies is not None
     assert st.advance_steps(steps) == ST_STEP_LIMIT
     st.to_host()
@@ -314,10 +274,7 @@ def test_open_ends_with_a_floating_body_match_cpu():
     for side in ("left", "right"):
         assert gsim.boundary_gauges()[side] == pytest.approx(cpu.boundary_gauges()[side],
                                                              abs=1e-12)
-    _close(gsim.bodies.state.q, cpu.bodies.state.q, rel=1e-12)
-    _close(gsim.bodies.state.qd, cpu.bodies.state.qd, rel=1e-9)
+    close(gsim.bodies.state.q, cpu.bodies.state.q, rel=1e-12)
+    close(gsim.bodies.state.qd, cpu.bodies.state.qd, rel=1e-9)
     assert abs(cpu.bodies.state.qd[0, 1]) > 0.0
-    a, b = cpu.fluid_state(), gsim.fluid_state()
-    np.testing.assert_array_equal(a["id"], b["id"])
-    for key in ("x", "z", "vx", "vz", "rho", "p"):
-        _close(b[key], a[key], rel=1e-10)
+    fluid_agrees(cpu, gsim)

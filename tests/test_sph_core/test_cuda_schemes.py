@@ -9,24 +9,14 @@ scene itself (moving fluid, the scene's own scratch rows).
 
 from __future__ import annotations
 
-import importlib.util
 import math
-import os
-import shutil
-import sys
 
 import numpy as np
 import pytest
+from cuda_support import (CUDA_TESTS, close, device_session, fluid_agrees, set_clock, short_run,
+                          stepper)
 
-if "NUMBA_ENABLE_CUDASIM" not in os.environ and not (
-        os.path.exists("/dev/nvidia0") or shutil.which("nvidia-smi")):
-    os.environ["NUMBA_ENABLE_CUDASIM"] = "1"
-
-pytestmark = [
-    pytest.mark.cuda,
-    pytest.mark.skipif(importlib.util.find_spec("numba_cuda") is None,
-                       reason="numba-cuda is not installed (pip install numba-cuda)"),
-]
+pytestmark = CUDA_TESTS
 
 A, DP, WARM_STEPS = 0.05, 0.01, 15
 
@@ -47,48 +37,20 @@ def _scene(name):
 @pytest.fixture(scope="module")
 def make():
     """make(name): a fresh Simulation of scene ``name`` after WARM_STEPS CPU steps."""
-    from sph_core.cuda import unavailable_reason
-    reason = unavailable_reason()
-    if reason:
-        pytest.skip(reason)
-    from sph_core.simulation import Simulation
+    with device_session():
+        from sph_core.simulation import Simulation
 
-    old = sys.getswitchinterval()
-    sys.setswitchinterval(1e-4)   # the simulator's block threads wait on each other far less
-    checkpoints = {}
+        checkpoints = {}
 
-    def factory(name):
-        if name not in checkpoints:
-            base = Simulation(_scene(name))
-            base.advance_steps(WARM_STEPS)
-            checkpoints[name] = base.checkpoint()
-        s = Simulation(_scene(name))
-        s.restore(checkpoints[name])
-        return s
-    yield factory
-    sys.setswitchinterval(old)
-
-
-def _stepper(sim):
-    from sph_core.cuda.cuda_stepper import CudaStepper
-    return CudaStepper(sim)
-
-
-def _set_clock(st, dts=0.0, v2=0.0):
-    from sph_core.cuda import gpu_kernels as K
-    clk = np.zeros(K.N_CLK)
-    clk[K.DTS] = dts
-    clk[K.V2] = v2
-    clk[K.T_STOP] = np.inf
-    st._put(st.clk, clk)
-    st._put(st.ctl, np.zeros(K.N_CTL, dtype=np.int64))
-
-
-def _close(gpu, cpu, rel=1e-12):
-    """|gpu - cpu| <= rel * max|cpu|: the same terms, a few ulp apart (CPU fastmath reassociation,
-    GPU fused multiply-adds; test_cuda_step.py)."""
-    scale = max(float(np.abs(cpu).max()), 1e-300)
-    np.testing.assert_allclose(gpu, cpu, rtol=0.0, atol=rel * scale)
+        def factory(name):
+            if name not in checkpoints:
+                base = Simulation(_scene(name))
+                base.advance_steps(WARM_STEPS)
+                checkpoints[name] = base.checkpoint()
+            s = Simulation(_scene(name))
+            s.restore(checkpoints[name])
+            return s
+        yield factory
 
 
 def _launch(st, kernel, *args):
@@ -98,7 +60,7 @@ def _launch(st, kernel, *args):
 
 def test_step_plan(make):
     """The step plan carries each scheme's kernels in step.run's order."""
-    names = {k: [p[0] for p in _stepper(make(k))._plan[0]] for k in SCENES}
+    names = {k: [p[0] for p in stepper(make(k))._plan[0]] for k in SCENES}
     assert names["pc"][0] == "bin" and names["pc"].count("fluid") == 2
     assert names["pc"][-2:] == ["correct", "finish"]
     assert names["fickian"][-4:] == ["kick", "shift_fickian", "shift_move", "finish"]
@@ -117,11 +79,11 @@ def test_pc_sort_predict_correct_match_cpu(make):
     from sph_core.particles import N_SORTED_PC, P, RHO, RHON, VX, VZ, X, XN, Z
 
     cpu = make("pc")
-    st = _stepper(make("pc"))
+    st = stepper(make("pc"))
     ps, n, dt, prm = cpu.particles, cpu.particles.n, cpu.dt, cpu.prm
     # sort: the same order, the carried rows copied exactly
     n_sorted = sort_by_cell(ps.view, ps.view2, N_SORTED_PC, n, cpu.cells)
-    _set_clock(st, dt)
+    set_clock(st, dt)
     a, b = st.bufs[0], st.bufs[1]
     _launch(st, K.k_bin, a, n, st.cells, st.count, st.ctl)
     K.k_scan_blocks[st.nb, K.SCAN_B](st.count, st.start, st.bsum, st.m, st.ctl)
@@ -143,7 +105,7 @@ def test_pc_sort_predict_correct_match_cpu(make):
     _launch(st, S.k_predict, b, n, prm, st.clk, st.ctl)
     f2 = st._to_host(b[0])
     for r in (X, Z, VX, VZ, RHO, P) + tuple(range(XN, RHON + 1)):
-        _close(f2[r, :n], ps.f2[r, :n], rel=1e-13)
+        close(f2[r, :n], ps.f2[r, :n], rel=1e-13)
     res = wcsph.pc_correct(ps.view2, n, dt, prm)
     _launch(st, S.k_correct, b, n, prm, st.clk, st.ctl)
     n_bad, n_band, n_out, v2, a2, rmax = res
@@ -153,7 +115,7 @@ def test_pc_sort_predict_correct_match_cpu(make):
     np.testing.assert_allclose(clk[[K.V2, K.A2, K.RMAX]], [v2, a2, rmax], rtol=1e-13)
     f2 = st._to_host(b[0])
     for r in (X, Z, VX, VZ, RHO, P):
-        _close(f2[r, :n], ps.f2[r, :n], rel=1e-13)
+        close(f2[r, :n], ps.f2[r, :n], rel=1e-13)
     # the step moved the fluid (a kernel that did nothing would not match)
     assert np.abs(ps.f2[X, :n] - pre[X]).max() > 0.0
     assert np.abs(ps.f2[VZ, :n] - pre[VZ]).max() > 0.0
@@ -165,10 +127,10 @@ def test_fickian_shift_matches_cpu(make):
     from sph_core.particles import FLUID, RHO, RHON, VX, VZ, X, XN, Z
 
     cpu = make("fickian")
-    st = _stepper(make("fickian"))
+    st = stepper(make("fickian"))
     ps, n, dt = cpu.particles, cpu.particles.n, cpu.dt
     shifting.shift_particles(ps.view, n, cpu.cells, cpu.prm, dt)
-    _set_clock(st, dt)
+    set_clock(st, dt)
     a = st.bufs[0]
     _launch(st, S.k_shift_fickian, a, n, st.cells, st.prm, st.clk, st.ctl)
     _launch(st, S.k_shift_move, a, n, st.ctl)
@@ -176,9 +138,9 @@ def test_fickian_shift_matches_cpu(make):
     fluid = ps.kind[:n] == FLUID
     assert np.abs(ps.f[XN, :n][fluid]).max() > 0.0     # the particles shifted
     for r in tuple(range(XN, RHON + 1)):
-        _close(f[r, :n], ps.f[r, :n])
+        close(f[r, :n], ps.f[r, :n])
     for r in (X, Z, VX, VZ, RHO):
-        _close(f[r, :n], ps.f[r, :n], rel=1e-14)
+        close(f[r, :n], ps.f[r, :n], rel=1e-14)
 
 
 def test_dplus_shift_matches_cpu(make):
@@ -187,11 +149,11 @@ def test_dplus_shift_matches_cpu(make):
     from sph_core.particles import FLUID, GPX, GPZ, GUZ, RHO, RHON, VX, VZ, X, XN, Z
 
     cpu = make("pc_dplus")
-    st = _stepper(make("pc_dplus"))
+    st = stepper(make("pc_dplus"))
     ps, n, dt = cpu.particles, cpu.particles.n, cpu.dt
     v2 = float((ps.f[VX, :n] ** 2 + ps.f[VZ, :n] ** 2)[ps.kind[:n] == FLUID].max())
     shifting.shift_particles_dplus(ps.view, n, cpu.cells, cpu.prm, dt, math.sqrt(v2))
-    _set_clock(st, dt, v2)
+    set_clock(st, dt, v2=v2)
     a = st.bufs[0]
     _launch(st, S.k_dplus_surface, a, n, st.cells, st.prm, st.clk, st.ctl)
     _launch(st, S.k_dplus_tangential, a, n, st.cells, st.prm, st.ctl)
@@ -204,9 +166,9 @@ def test_dplus_shift_matches_cpu(make):
     assert np.abs(ps.f[XN, :n][fluid]).max() > 0.0
     np.testing.assert_array_equal(f[GUZ, :n], ps.f[GUZ, :n])   # the surface flags
     for r in tuple(range(XN, RHON + 1)) + (GPX, GPZ):
-        _close(f[r, :n], ps.f[r, :n])
+        close(f[r, :n], ps.f[r, :n])
     for r in (X, Z, VX, VZ, RHO):
-        _close(f[r, :n], ps.f[r, :n], rel=1e-14)
+        close(f[r, :n], ps.f[r, :n], rel=1e-14)
 
 
 @pytest.mark.parametrize("name", ["riemann_muscl", "riemann_first"])
@@ -219,11 +181,11 @@ def test_riemann_forces_match_cpu(make, name):
     from sph_core.riemann import NO_RECONSTRUCTION, riemann_gradients
 
     cpu = make(name)
-    st = _stepper(make(name))
+    st = stepper(make(name))
     ps, n, prm = cpu.particles, cpu.particles.n, cpu.prm
     assert prm.riemann and (prm.limiter != NO_RECONSTRUCTION) == (name == "riemann_muscl")
     wcsph.wall_pass(ps.view, n, cpu.cells, prm)
-    _set_clock(st)
+    set_clock(st)
     a = st.bufs[0]
     _launch(st, K.k_wall, a, n, st.cells, prm, st.ctl)
     fluid = ps.kind[:n] == FLUID
@@ -233,12 +195,12 @@ def test_riemann_forces_match_cpu(make, name):
         f = st._to_host(a[0])
         assert np.abs(ps.f[GPX, :n][fluid]).max() > 0.0
         for r in range(GPX, GWZ + 1):
-            _close(f[r, :n][fluid], ps.f[r, :n][fluid])
+            close(f[r, :n][fluid], ps.f[r, :n][fluid])
     wcsph.fluid_pass(ps.view, n, cpu.cells, prm, True)
     _launch(st, S.k_fluid_riemann, a, n, st.cells, prm, st.ctl)
     f = st._to_host(a[0])
     for r in (AX, AZ, DRHO, PW, DVNX, DVNZ):
-        _close(f[r, :n][fluid], ps.f[r, :n][fluid])
+        close(f[r, :n][fluid], ps.f[r, :n][fluid])
 
 
 @pytest.mark.parametrize("name", list(SCENES))
@@ -246,22 +208,10 @@ def test_short_run_matches_cpu(make, name):
     """A few steps of each scheme on the device and on the CPU agree to round-off growth
     (test_cuda_step.py's whole-run bound and why)."""
     from sph_core.cuda import simulated
-    from sph_core.wcsph import ST_STEP_LIMIT
 
     steps = 5 if simulated() else 100
     cpu = make(name)
     gpu = make(name)
-    st = _stepper(gpu)
-    assert st.advance_steps(steps) == ST_STEP_LIMIT
-    st.to_host()
-    cpu.advance_steps(steps)
-    assert gpu.steps == cpu.steps
-    assert gpu.t == pytest.approx(cpu.t, rel=1e-12)
-    assert gpu.dt == pytest.approx(cpu.dt, rel=1e-10)
-    a, b = cpu.fluid_state(), gpu.fluid_state()
-    np.testing.assert_array_equal(a["id"], b["id"])
-    print(f"{name}, {steps} steps, max |gpu - cpu| / max |cpu|:",
-          {k: float(np.abs(b[k] - a[k]).max() / np.abs(a[k]).max()) for k in a if k != "id"})
-    for key in ("x", "z", "vx", "vz", "rho", "p"):
-        _close(b[key], a[key], rel=1e-10)
+    short_run(cpu, gpu, steps)
+    a = fluid_agrees(cpu, gpu, 1e-10, f"{name}, {steps} steps, max |gpu - cpu| / max |cpu|:")
     assert np.abs(a["vz"]).max() > 0.01   # the column is falling: the comparison has content

@@ -1,29 +1,23 @@
 """``device = "cuda"`` end to end: a Simulation, the CLI and the server step on the GPU and agree
 with the CPU; a device that cannot run the scene is refused in one line.
 
-Runs on a GPU when one is present, else under numba-cuda's simulator (as test_cuda_step.py, set
-before numba.cuda is first imported); the GPU runs are skipped without numba-cuda. The simulator
+Runs on a GPU when one is present, else under numba-cuda's simulator (cuda_support,
+as test_cuda_step.py); the GPU runs are skipped without numba-cuda. The simulator
 takes ~2 s per step of the tiny dam break below (322 particles), so the runs are a few steps.
 """
 
 from __future__ import annotations
 
-import importlib.util
 import json
 import os
-import shutil
 import sys
 
 import numpy as np
 import pytest
-
-if "NUMBA_ENABLE_CUDASIM" not in os.environ and not (
-        os.path.exists("/dev/nvidia0") or shutil.which("nvidia-smi")):
-    os.environ["NUMBA_ENABLE_CUDASIM"] = "1"
+from cuda_support import device_session
+from cuda_support import needs_numba_cuda as needs_cuda
 
 pytestmark = pytest.mark.cuda
-needs_cuda = pytest.mark.skipif(importlib.util.find_spec("numba_cuda") is None,
-                                reason="numba-cuda is not installed (pip install numba-cuda)")
 
 A, DP, WARM_STEPS = 0.05, 0.01, 15
 
@@ -37,14 +31,8 @@ def _scene(**kw):
 
 @pytest.fixture(scope="module")
 def gpu_here():
-    from sph_core.cuda import unavailable_reason
-    reason = unavailable_reason()
-    if reason:
-        pytest.skip(reason)
-    old = sys.getswitchinterval()
-    sys.setswitchinterval(1e-4)   # the simulator's block threads wait on each other far less
-    yield
-    sys.setswitchinterval(old)
+    with device_session():
+        yield
 
 
 def _scaled_diff(a: np.ndarray, b: np.ndarray) -> float:

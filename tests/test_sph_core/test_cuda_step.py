@@ -1,7 +1,7 @@
 """The CUDA step (sph_core/cuda) against its CPU twins, kernel by kernel and over a short run.
 
-Runs on a GPU when one is present, else under numba-cuda's simulator (set here, before numba.cuda
-is first imported: the CPU tests in the same session never import it). Skipped without
+Runs on a GPU when one is present, else under numba-cuda's simulator (set by cuda_support,
+imported before numba.cuda: the CPU tests in the same session never import it). Skipped without
 numba-cuda. The state is a tiny dam break (a = 0.05 m, dp = 0.01 m, a 0.1 m tank: 322 particles,
 50 of them fluid) so that the simulator, which runs every CUDA thread as a Python thread (~2 s
 per step here), stays within seconds.
@@ -10,22 +10,13 @@ per step here), stays within seconds.
 from __future__ import annotations
 
 import importlib.util
-import os
-import shutil
-import sys
 
 import numpy as np
 import pytest
+from cuda_support import (CUDA_TESTS, close, device_session, fluid_agrees, set_clock, short_run,
+                          skip_without_device, stepper)
 
-if "NUMBA_ENABLE_CUDASIM" not in os.environ and not (
-        os.path.exists("/dev/nvidia0") or shutil.which("nvidia-smi")):
-    os.environ["NUMBA_ENABLE_CUDASIM"] = "1"
-
-pytestmark = [
-    pytest.mark.cuda,
-    pytest.mark.skipif(importlib.util.find_spec("numba_cuda") is None,
-                       reason="numba-cuda is not installed (pip install numba-cuda)"),
-]
+pytestmark = CUDA_TESTS
 
 A, DP, WARM_STEPS = 0.05, 0.01, 15
 
@@ -38,49 +29,22 @@ def _dambreak(**kw):
 @pytest.fixture(scope="module")
 def sim_factory():
     """Fresh Simulations of the tiny dam break after WARM_STEPS CPU steps (moving fluid)."""
-    from sph_core.cuda import unavailable_reason
-    reason = unavailable_reason()
-    if reason:
-        pytest.skip(reason)
-    from sph_core.simulation import Simulation
+    with device_session():
+        from sph_core.simulation import Simulation
 
-    old = sys.getswitchinterval()
-    sys.setswitchinterval(1e-4)   # the simulator's block threads wait on each other far less
-    base = Simulation(_dambreak())
-    base.advance_steps(WARM_STEPS)
-    ck = base.checkpoint()
+        base = Simulation(_dambreak())
+        base.advance_steps(WARM_STEPS)
+        ck = base.checkpoint()
 
-    def make():
-        s = Simulation(_dambreak())
-        s.restore(ck)
-        return s
-    yield make
-    sys.setswitchinterval(old)
-
-
-def _stepper(sim):
-    from sph_core.cuda.cuda_stepper import CudaStepper
-    return CudaStepper(sim)
-
-
-def _set_clock(st, dts=0.0):
-    from sph_core.cuda import gpu_kernels as K
-    clk = np.zeros(K.N_CLK)
-    clk[K.DTS] = dts
-    clk[K.T_STOP] = np.inf
-    st._put(st.clk, clk)
-    st._put(st.ctl, np.zeros(K.N_CTL, dtype=np.int64))
+        def make():
+            s = Simulation(_dambreak())
+            s.restore(ck)
+            return s
+        yield make
 
 
 def _host(st, a):
     return st._to_host(a)
-
-
-def _close(gpu, cpu, rel=1e-12):
-    """Equal to round-off: |gpu - cpu| <= rel * max|cpu| (the CPU passes reassociate sums under
-    fastmath, the GPU contracts to FMAs: the same terms, a few ulp apart)."""
-    scale = max(float(np.abs(cpu).max()), 1e-300)
-    np.testing.assert_allclose(gpu, cpu, rtol=0.0, atol=rel * scale)
 
 
 def test_kick_drift_and_cell_sort_match_cpu(sim_factory):
@@ -90,12 +54,12 @@ def test_kick_drift_and_cell_sort_match_cpu(sim_factory):
     from sph_core.particles import N_SORTED_KDK
 
     cpu = sim_factory()
-    st = _stepper(sim_factory())
+    st = stepper(sim_factory())
     dt = cpu.dt
     ps, n = cpu.particles, cpu.particles.n
     n_out = wcsph.kdk_kick_drift(ps.view, n, dt, cpu.prm)
     n_sorted = sort_by_cell(ps.view, ps.view2, N_SORTED_KDK, n, cpu.cells)
-    _set_clock(st, dt)
+    set_clock(st, dt)
     a, b = st.bufs[0], st.bufs[1]
     gn, tpb = st._grid_n, K.TPB
     K.k_kick_drift_bin[gn, tpb](a, n, st.prm, st.cells, st.count, st.clk, st.ctl)
@@ -118,7 +82,7 @@ def test_kick_drift_and_cell_sort_match_cpu(sim_factory):
     for r in range(N_SORTED_KDK):
         # a few ulp: the GPU fuses x + dt v into one rounding, and its pow differs from libm's
         # by an ulp, which p = B((rho/rho0)^7 - 1) amplifies near p = 0 to ~1e-14 of max |p|
-        _close(f2[r, :n], ps.f2[r, :n], rel=1e-13)
+        close(f2[r, :n], ps.f2[r, :n], rel=1e-13)
 
 
 def test_wall_and_fluid_pass_match_cpu(sim_factory):
@@ -127,12 +91,12 @@ def test_wall_and_fluid_pass_match_cpu(sim_factory):
     from sph_core.particles import AX, AZ, DRHO, DVNX, DVNZ, FLUID, P, PW, RHO, VWX, VWZ, WALL
 
     cpu = sim_factory()
-    st = _stepper(sim_factory())
+    st = stepper(sim_factory())
     ps, n = cpu.particles, cpu.particles.n
     assert cpu.prm.wall_g0 > 0.0   # the no-penetration correction is exercised
     wcsph.wall_pass(ps.view, n, cpu.cells, cpu.prm)
     wcsph.fluid_pass(ps.view, n, cpu.cells, cpu.prm, None)   # None: the delta-SPH form
-    _set_clock(st)
+    set_clock(st)
     a = st.bufs[0]
     K.k_wall[st._grid_n, K.TPB](a, n, st.cells, st.prm, st.ctl)
     K.k_fluid[st._grid_n, K.TPB](a, n, st.cells, st.prm, st.ctl)
@@ -141,9 +105,9 @@ def test_wall_and_fluid_pass_match_cpu(sim_factory):
     fluid = ps.kind[:n] == FLUID
     assert np.abs(ps.f[P, :n][wall]).max() > 0.0   # the walls carry pressure
     for row in (P, RHO, VWX, VWZ):
-        _close(f[row, :n][wall], ps.f[row, :n][wall])
+        close(f[row, :n][wall], ps.f[row, :n][wall])
     for row in (AX, AZ, DRHO, PW, DVNX, DVNZ):
-        _close(f[row, :n][fluid], ps.f[row, :n][fluid])
+        close(f[row, :n][fluid], ps.f[row, :n][fluid])
 
 
 def test_kick_and_next_dt_match_cpu(sim_factory):
@@ -152,11 +116,11 @@ def test_kick_and_next_dt_match_cpu(sim_factory):
     from sph_core.particles import RHO, VX, VZ
 
     cpu = sim_factory()
-    st = _stepper(sim_factory())
+    st = stepper(sim_factory())
     ps, n, dt = cpu.particles, cpu.particles.n, cpu.dt
     n_bad, n_band, v2, a2, rmax = wcsph.kdk_kick(ps.view, n, dt, cpu.prm)
     dt_next = wcsph.stable_dt(v2, a2, rmax, cpu.prm)
-    _set_clock(st, dt)
+    set_clock(st, dt)
     ctl = np.zeros(K.N_CTL, dtype=np.int64)
     ctl[K.MAX_STEPS] = 10
     st._put(st.ctl, ctl)
@@ -168,7 +132,7 @@ def test_kick_and_next_dt_match_cpu(sim_factory):
     np.testing.assert_allclose(clk[[K.V2, K.A2, K.RMAX]], [v2, a2, rmax], rtol=1e-14)
     f = _host(st, a[0])
     for row in (VX, VZ, RHO):
-        _close(f[row, :n], ps.f[row, :n], rel=1e-13)
+        close(f[row, :n], ps.f[row, :n], rel=1e-13)
     K.k_finish[1, 1](st.prm, st.clk, st.ctl)
     clk, ctl = _host(st, st.clk), _host(st, st.ctl)
     np.testing.assert_allclose(clk[K.DT], dt_next, rtol=1e-14)
@@ -185,7 +149,7 @@ def test_guard_stops_the_device_at_the_tripping_step(sim_factory):
     ps = sim.particles
     k = int(np.nonzero(ps.kind[: ps.n] == FLUID)[0][0])
     ps.f[VX, k] = np.nan
-    st = _stepper(sim)
+    st = stepper(sim)
     t, dt, steps, status, n_flag, vmax = st.run(np.inf, 4)
     assert (status, steps) == (ST_NONFINITE, 1)
     assert n_flag >= 1
@@ -201,25 +165,13 @@ def test_short_run_matches_cpu(sim_factory):
     The bound, 1e-10 of each field's scale, leaves room for an ulp per operation per step; a
     missing term or a wrong dt is off by many orders more."""
     from sph_core.cuda import simulated
-    from sph_core.wcsph import ST_STEP_LIMIT
 
     steps = 10 if simulated() else 100
     cpu = sim_factory()
     gpu = sim_factory()
-    st = _stepper(gpu)
-    assert st.advance_steps(steps) == ST_STEP_LIMIT
-    st.to_host()
-    cpu.advance_steps(steps)
-    assert gpu.steps == cpu.steps
-    assert gpu.t == pytest.approx(cpu.t, rel=1e-12)
-    assert gpu.dt == pytest.approx(cpu.dt, rel=1e-10)
-    a, b = cpu.fluid_state(), gpu.fluid_state()
-    np.testing.assert_array_equal(a["id"], b["id"])
+    short_run(cpu, gpu, steps)
     # the measured differences (pytest -rP shows them; docs/developer/gpu.md)
-    print(f"{steps} steps, max |gpu - cpu| / max |cpu|:",
-          {k: float(np.abs(b[k] - a[k]).max() / np.abs(a[k]).max()) for k in a if k != "id"})
-    for key in ("x", "z", "vx", "vz", "rho", "p"):
-        _close(b[key], a[key], rel=1e-10)
+    a = fluid_agrees(cpu, gpu, 1e-10, f"{steps} steps, max |gpu - cpu| / max |cpu|:")
     assert np.abs(a["vz"]).max() > 0.01   # the column is falling: the comparison has content
 
 
@@ -227,7 +179,7 @@ def test_run_lands_on_t_stop(sim_factory):
     from sph_core.wcsph import ST_REACHED_T
 
     sim = sim_factory()
-    st = _stepper(sim)
+    st = stepper(sim)
     t_stop = sim.t + 1.5 * sim.dt   # the second step is shortened to land on it
     t, dt, steps, status, _, _ = st.run(t_stop, 100)
     assert status == ST_REACHED_T and t == t_stop and steps == 2
@@ -236,9 +188,7 @@ def test_run_lands_on_t_stop(sim_factory):
 def test_unsupported_scene_is_refused():
     if importlib.util.find_spec("numba_cuda") is None:
         pytest.skip("numba-cuda is not installed")
-    from sph_core.cuda import unavailable_reason
-    if unavailable_reason():
-        pytest.skip(unavailable_reason())
+    skip_without_device()
     from sph_core.cuda.cuda_stepper import CudaStepper
     from sph_core.simulation import Simulation
 
@@ -256,8 +206,8 @@ def test_graph_replay_matches_plain_launches(sim_factory):
 
     if simulated():
         pytest.skip("CUDA graphs need a GPU")
-    plain = _stepper(sim_factory())
-    graph = _stepper(sim_factory())
+    plain = stepper(sim_factory())
+    graph = stepper(sim_factory())
     assert plain.advance_steps(1) == graph.advance_steps(1) == ST_STEP_LIMIT   # compiles
     assert graph.enable_graphs(), graph.graph_error
     print("graph launches:", graph.launches, "plain:", plain.launches)
