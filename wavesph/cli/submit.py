@@ -16,7 +16,7 @@ import os
 import sys
 from pathlib import Path
 
-SOURCES = ("linear", "stokes", "stream", "irregular")
+SOURCES = ("linear", "stokes", "stream", "irregular", "solitary")
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -52,6 +52,11 @@ def source_table(args: argparse.Namespace) -> dict | None:
         if given:
             raise ValueError(f"--{given[0].replace('_', '-')} needs --source THEORY")
         return None
+    if args.source == "solitary":  # one wave, no period: the server refuses a T
+        if args.H is None or args.T is not None:
+            raise ValueError("--source solitary needs --H and takes no --T")
+        return {"theory": "solitary", "H": args.H,
+                **{k: v for k, v in extra.items() if v is not None}}
     if args.H is None or args.T is None:
         raise ValueError(f"--source {args.source} needs --H and --T")
     return {"theory": args.source, "H": args.H, "T": args.T,
