@@ -336,11 +336,11 @@ class RunupProbe(_Model):
     drops do not count) and, with ``near_bed``, lie at most that height above the bed (the
     highest bed polyline at x, else the tank floor); its elevation is that particle's centre z,
     within about dp/2 of the water line (still water: dp/2 below it; a one-particle film: dp/2
-    above the bed). Columns: <name>_x,
-    <name>_z [m], <name>_R [m], the highest z - still_water_level of the records so far (taken
-    every output.probe_every, so a peak between two records is missed; restarted with each
-    Simulation, so a resumed run's R counts from the resume). Put the beach at the tank's +x
-    end: the probe takes the wet point of largest x anywhere in the tank."""
+    above the bed). Columns: <name>_x, <name>_z [m], <name>_R [m], the highest
+    z - still_water_level of the records so far (taken every output.probe_every, so a peak
+    between two records is missed; restarted with each Simulation, so a resumed run's R counts
+    from the resume). Put the beach at the tank's +x end: the probe takes the wet point of
+    largest x anywhere in the tank."""
 
     kind: Literal["runup"]
     name: str = Field(min_length=1)
