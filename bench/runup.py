@@ -86,7 +86,7 @@ def runup_scene(h_over_d: float, depth: float, dp: float) -> tuple[dict, Solitar
     return scene, wave, x_toe
 
 
-def run(h_over_d: float, depth: float, dp_over_d: float) -> dict:
+def run_case(h_over_d: float, depth: float, dp_over_d: float) -> dict:
     dp = dp_over_d * depth
     data, wave, x_toe = runup_scene(h_over_d, depth, dp)
     scene = make_scene(data)
@@ -125,7 +125,7 @@ def main() -> None:
                     help="particle spacing / depth (0.1: d/dp 10, minutes on 2 cores)")
     a = ap.parse_args()
     for hd in (float(v) for v in a.h_over_d.split(",")):
-        print(json.dumps(run(hd, a.depth, a.dp_over_d)), flush=True)
+        print(json.dumps(run_case(hd, a.depth, a.dp_over_d)), flush=True)
 
 
 if __name__ == "__main__":

@@ -1,4 +1,4 @@
-"""The solitary-wave theory (wave_client/theories/solitary.py) against its own formulas, and
+"""The solitary-wave theory (wave_client/theories/solitary_wave.py) against its own formulas, and
 its use as a scene [source] (server/theory_source.py) and as `wavesph couple --model solitary`."""
 
 from __future__ import annotations

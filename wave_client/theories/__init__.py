@@ -19,7 +19,7 @@ from wave_client.theories.base import G, WaveTheory, ramp_factor
 from wave_client.theories.irregular import JonswapSea, jonswap_shape
 from wave_client.theories.linear import AiryWave, StandingWave, wavenumber
 from wave_client.theories.nonlinear import StokesWave, StreamFunctionWave
-from wave_client.theories.solitary import SolitaryWave
+from wave_client.theories.solitary_wave import SolitaryWave
 
 __all__ = [
     "G",
