@@ -21,7 +21,8 @@ follow R/d = 1.109 (H/d)^0.582 (`R_over_d_breaking_fit`). `error` is (R - R_law)
 against the non-breaking law in every case.
 
 One JSON object per H/d: H_over_d, R_over_d, R_over_d_law, R_over_d_breaking_fit, error,
-R0_over_d, H_toe_over_H (the highest SPH elevation at the toe up to the run-up peak, over H), dp, d_over_dp, H_over_dp, particles, steps, t_end, wall_s.
+R0_over_d, R_loose_over_d (the same probe counting any particle with one fluid neighbour at any
+height: what the wet-film criteria leave out), H_toe_over_H (the highest SPH elevation at the toe up to the run-up peak, over H), dp, d_over_dp, H_over_dp, particles, steps, t_end, wall_s.
 """
 
 from __future__ import annotations
@@ -49,7 +50,7 @@ COT_BETA = 19.85
 
 
 def law(h_over_d: float) -> float:
-    """Synolakis (1987) eq. 4.5, non-breaking run-up R/d."""
+    """Synolakis (1987), non-breaking run-up R/d."""
     return 2.831 * math.sqrt(COT_BETA) * h_over_d**1.25
 
 
@@ -83,7 +84,9 @@ def runup_scene(h_over_d: float, depth: float, dp: float,
         "open_boundaries": [{"side": "left", "elevation": "imposed"}],
         "constants": {"wall_slip": wall_slip},
         "output": {"probe_every": 0.02},
+        # "loose": any fluid particle with one neighbour, at any height (spray included)
         "probes": [{"kind": "runup", "name": "shore", "near_bed": 2 * dp},
+                   {"kind": "runup", "name": "loose", "min_neighbours": 1},
                    {"kind": "elevation", "name": "toe", "x": x_toe}],
     }
     return scene, wave, x_toe
@@ -105,6 +108,7 @@ def run_case(h_over_d: float, depth: float, dp_over_d: float, wall_slip: str = "
     t_front = wave.t0 + (x_toe - math.acosh(10.0) / wave.k) / wave.c
     r0 = float(np.nanmax(rise[t < t_front]))
     r = float(np.nanmax(rise))
+    r_loose = max(v for v in (h[-1]["loose_R"], -math.inf) if v is not None)
     # the wave SPH delivers: the highest elevation at the toe before the shoreline peaks
     toe = np.array([np.nan if r_["toe_eta"] is None else r_["toe_eta"] for r_ in h])
     h_toe = float(np.nanmax(toe[t <= t[int(np.nanargmax(rise))]]))
@@ -112,6 +116,7 @@ def run_case(h_over_d: float, depth: float, dp_over_d: float, wall_slip: str = "
     return {"bench": "runup", "H_over_d": h_over_d, "R_over_d": round(r / depth, 4),
             "R_over_d_law": round(rl, 4), "R_over_d_breaking_fit": round(breaking_fit(h_over_d), 4),
             "error": round((r / depth - rl) / rl, 3), "R0_over_d": round(r0 / depth, 4),
+            "R_loose_over_d": round(r_loose / depth, 4),
             "H_toe_over_H": round(h_toe / (h_over_d * depth), 3),
             "t_R": round(float(t[int(np.nanargmax(rise))]), 3),
             "depth": depth, "dp": round(dp, 6), "d_over_dp": round(depth / dp, 2),

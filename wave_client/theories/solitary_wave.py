@@ -10,7 +10,7 @@ flux exactly, (d + eta) u = c eta; taking it uniform over depth is the shallow-w
 approximation, good while k d = sqrt(3 H / (4 d)) << 1 (0.12-0.19 for H/d 0.02-0.05, 0.47 at
 H/d 0.3). It is not an exact solution of the Euler equations: a wave made from it sheds a
 small dispersive tail whose size grows with H/d. Reference: C. E. Synolakis (1987), "The runup
-of solitary waves", J. Fluid Mech. 185, 523-545 (eq. 2.3 and the initial condition of sec. 3).
+of solitary waves", J. Fluid Mech. 185, 523-545.
 
 The wave has no period; ``period`` is its time scale 2 pi / (k c) (about the time for which
 eta > H/100 at a point), used where a consumer needs one: the coupling window default
