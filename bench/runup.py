@@ -2,7 +2,7 @@
 Synolakis' (1987) run-up law R/d = 2.831 sqrt(cot beta) (H/d)^(5/4)?
 
     NUMBA_NUM_THREADS=1 python bench/runup.py [--h-over-d 0.05,0.3] [--dp-over-d 0.1] [--depth 0.2]
-                                              [--wall-slip free_slip]
+                                              [--wall-slip free_slip] [--constants JSON]
 
 The canonical case (Synolakis 1987, J. Fluid Mech. 185): still water d on a flat bed, then a
 plane beach of slope 1/19.85 whose toe is L = arccosh(sqrt(20)) / k downstream of the inlet
@@ -59,8 +59,8 @@ def breaking_fit(h_over_d: float) -> float:
     return 1.109 * h_over_d**0.582
 
 
-def runup_scene(h_over_d: float, depth: float, dp: float,
-                wall_slip: str = "no_slip") -> tuple[dict, SolitaryWave, float]:
+def runup_scene(h_over_d: float, depth: float, dp: float, wall_slip: str = "no_slip",
+                constants: dict | None = None) -> tuple[dict, SolitaryWave, float]:
     """(scene dict, the inlet's theory, x of the beach's toe [m])."""
     H = h_over_d * depth
     wave = SolitaryWave(H, depth=depth)
@@ -82,7 +82,7 @@ def runup_scene(h_over_d: float, depth: float, dp: float,
         "water_blocks": [{"x0": 0.0, "x1": x_shore, "z0": 0.0, "z1": depth}],
         "beds": [{"points": [[x_toe, 0.0], [x1, (x1 - x_toe) / COT_BETA]]}],
         "open_boundaries": [{"side": "left", "elevation": "imposed"}],
-        "constants": {"wall_slip": wall_slip},
+        "constants": {"wall_slip": wall_slip, **(constants or {})},
         "output": {"probe_every": 0.02},
         # "loose": any fluid particle with one neighbour, at any height (spray included)
         "probes": [{"kind": "runup", "name": "shore", "near_bed": 2 * dp},
@@ -92,9 +92,10 @@ def runup_scene(h_over_d: float, depth: float, dp: float,
     return scene, wave, x_toe
 
 
-def run_case(h_over_d: float, depth: float, dp_over_d: float, wall_slip: str = "no_slip") -> dict:
+def run_case(h_over_d: float, depth: float, dp_over_d: float, wall_slip: str = "no_slip",
+             constants: dict | None = None) -> dict:
     dp = dp_over_d * depth
-    data, wave, x_toe = runup_scene(h_over_d, depth, dp, wall_slip)
+    data, wave, x_toe = runup_scene(h_over_d, depth, dp, wall_slip, constants)
     scene = make_scene(data)
     src = WaveModelBoundary(wave, flume_nodes(scene)["left"], depth, 0.0)
     tic = time.perf_counter()
@@ -120,7 +121,8 @@ def run_case(h_over_d: float, depth: float, dp_over_d: float, wall_slip: str = "
             "H_toe_over_H": round(h_toe / (h_over_d * depth), 3),
             "t_R": round(float(t[int(np.nanargmax(rise))]), 3),
             "depth": depth, "dp": round(dp, 6), "d_over_dp": round(depth / dp, 2),
-            "H_over_dp": round(h_over_d * depth / dp, 2), "wall_slip": wall_slip, "particles": sim.n_particles,
+            "H_over_dp": round(h_over_d * depth / dp, 2), "wall_slip": wall_slip,
+            **({"constants": constants} if constants else {}), "particles": sim.n_particles,
             "steps": sim.steps, "t_end": scene.t_end, "wall_s": round(wall, 1),
             "threads": int(os.environ.get("NUMBA_NUM_THREADS", "0") or 0)}
 
@@ -133,9 +135,11 @@ def main() -> None:
                     help="particle spacing / depth (0.1: d/dp 10, minutes on 2 cores)")
     ap.add_argument("--wall-slip", choices=("no_slip", "free_slip"), default="no_slip",
                     help="walls and beach (the scene default no_slip holds the film back)")
+    ap.add_argument("--constants", type=json.loads, default=None,
+                    help='scene constants to override, JSON, e.g. \'{"h_over_dp": 1.5}\'')
     a = ap.parse_args()
     for hd in (float(v) for v in a.h_over_d.split(",")):
-        print(json.dumps(run_case(hd, a.depth, a.dp_over_d, a.wall_slip)), flush=True)
+        print(json.dumps(run_case(hd, a.depth, a.dp_over_d, a.wall_slip, a.constants)), flush=True)
 
 
 if __name__ == "__main__":
