@@ -117,3 +117,14 @@ def test_couple_cli_builds_the_solitary_model():
     assert isinstance(wave, SolitaryWave) and wave.t0 == 1.5 and period is None
     with pytest.raises(ValueError, match="no --T"):
         model_factory(p.parse_args(["--model", "solitary", "--H", str(H), "--T", "1"]))
+
+
+def test_submit_cli_writes_a_solitary_source_table():
+    from wavesph.cli.submit import add_arguments, source_table
+
+    p = argparse.ArgumentParser()
+    add_arguments(p)
+    args = p.parse_args(["scene.toml", "--source", "solitary", "--H", str(H), "--t0", "2"])
+    assert source_table(args) == {"theory": "solitary", "H": H, "t0": 2.0}
+    with pytest.raises(ValueError, match="no --T"):
+        source_table(p.parse_args(["scene.toml", "--source", "solitary", "--H", "0.01", "--T", "1"]))
