@@ -10,6 +10,7 @@ default threshold 0.5; seed 004's free-surface criterion rho_f <= 0.9 rho0 marks
 half a particle below it. No point above the threshold: the gauge is dry (reported as None).
 Front: the largest x of the fluid particles that have at least ``min_neighbours`` fluid
 neighbours within the kernel support 2h, so isolated droplets ahead of the surge do not count.
+Run-up: the same wet-particle rule for the shoreline on a beach, its elevation read on the bed.
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ import math
 
 import numpy as np
 from numba import njit, prange
+from numpy.typing import ArrayLike
 
 from .kernels import w_of_q
 from .neighbours import cell_at
@@ -123,3 +125,34 @@ def wall_force(ps, cells, slots, xm, zm, prm):
         fz += sz
         my += (zs - zm) * sx - (xs - xm) * sz
     return fx, fz, my
+
+
+def bed_elevation(beds: list[list[tuple[float, float]]], z_floor: float, x: ArrayLike) -> np.ndarray:
+    """Top of the bed at x [m]: the highest of the bed polylines ``beds`` that span x (linear
+    between their points), else the tank floor ``z_floor``."""
+    xa = np.asarray(x, dtype=float)
+    top = np.full(xa.shape, float(z_floor))
+    for pts in beds:
+        bx, bz = np.asarray(pts, dtype=float).T
+        inside = (xa >= bx[0]) & (xa <= bx[-1])
+        top = np.where(inside, np.maximum(top, np.interp(xa, bx, bz)), top)
+    return top
+
+
+def shoreline(x: np.ndarray, z: np.ndarray, counts: np.ndarray, min_neighbours: int,
+              beds: list[list[tuple[float, float]]], z_floor: float,
+              near_bed: float | None = None) -> tuple[float, float] | None:
+    """(x, z) [m] of the shoreline particle: of the particles with ``counts`` >= ``min_neighbours``
+    fluid neighbours (counts < 0 marks non-fluid) and, with ``near_bed``, at most that height
+    above the bed, the one of largest x. None: nothing wet.
+
+    Its centre z is the estimate: the true water line lies within about dp/2 of it (still water
+    on the lattice: the top row's centre, dp/2 below the surface; a one-particle film running up:
+    dp/2 above the bed)."""
+    sel = counts >= max(min_neighbours, 0)
+    if near_bed is not None:
+        sel &= z - bed_elevation(beds, z_floor, x) <= near_bed
+    if not sel.any():
+        return None
+    k = int(np.argmax(np.where(sel, x, -np.inf)))
+    return float(x[k]), float(z[k])

@@ -330,6 +330,26 @@ class FrontProbe(_Model):
     min_neighbours: int = Field(3, ge=0)
 
 
+class RunupProbe(_Model):
+    """Shoreline and run-up on a bed: the shoreline is the most landward wet point, the largest
+    x of the fluid particles that have at least ``min_neighbours`` fluid neighbours (isolated
+    drops do not count) and, with ``near_bed``, lie at most that height above the bed (the
+    highest bed polyline at x, else the tank floor); its elevation is that particle's centre z,
+    within about dp/2 of the water line (still water: dp/2 below it; a one-particle film: dp/2
+    above the bed). Columns: <name>_x, <name>_z [m], <name>_R [m], the highest
+    z - still_water_level of the records so far (taken every output.probe_every, so a peak
+    between two records is missed; restarted with each Simulation, so a resumed run's R counts
+    from the resume). Put the beach at the tank's +x end: the probe takes the wet point of
+    largest x anywhere in the tank."""
+
+    kind: Literal["runup"]
+    name: str = Field(min_length=1)
+    min_neighbours: int = Field(3, ge=0)
+    near_bed: float | None = Field(None, gt=0, description=(
+        "only particles at most this height [m] above the bed count (e.g. 2 dp: the wet film, "
+        "not spray over it); default: all"))
+
+
 class ForceProbe(Rect):
     """Force and moment per metre of width that the fluid exerts on the wall, bed or structure
     particles whose centres lie in the rectangle [x0, x1] x [z0, z1]: the reaction of the
@@ -371,8 +391,8 @@ class OvertoppingProbe(_Model):
     x: float
 
 
-Probe = Annotated[Union[PointProbe, ElevationProbe, FrontProbe, ForceProbe, PressureLineProbe,
-                        OvertoppingProbe], Field(discriminator="kind")]
+Probe = Annotated[Union[PointProbe, ElevationProbe, FrontProbe, RunupProbe, ForceProbe,
+                        PressureLineProbe, OvertoppingProbe], Field(discriminator="kind")]
 
 
 # buffer pressure of an outlet (elevation "extrapolated") that does not name one. Extrapolated
@@ -513,6 +533,10 @@ class Scene(_Model):
             msg = datum_mismatch(swl, max(tops), t.z0, self.dp)
             if msg:
                 raise ValueError(f"still_water_level: {msg}")
+        for i, p in enumerate(self.probes):
+            if p.kind == "runup" and swl is None:
+                raise ValueError(f"probes.{i}: a runup probe measures from still_water_level; "
+                                 "give it")
         dup = {n for n, k in Counter(p.name for p in self.probes).items() if k > 1}  # O(n)
         if dup:
             raise ValueError(f"probes: duplicate names {sorted(dup)}")

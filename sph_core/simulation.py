@@ -50,9 +50,9 @@ from .open_ends import OpenBoundaries
 from .output import RunWriter
 from .particles import FLUID, INACTIVE, M, P, RHO, VX, VZ, WALL, X, Z, Checkpoint, ParticleSet
 from .probes import (fluid_neighbour_counts, interpolate_points, line_mass_density,
-                     surface_from_line)
+                     shoreline, surface_from_line)
 from .shifting import SHIFT_OPEN_END
-from .scene import DEVICES, ElevationProbe, FrontProbe, PointProbe, Scene
+from .scene import DEVICES, ElevationProbe, FrontProbe, PointProbe, RunupProbe, Scene
 from .state import Params
 from .steppers import Stepper, WcsphStepper, make_stepper
 
@@ -177,6 +177,9 @@ class Simulation:
         self._points = [p for p in scene.probes if isinstance(p, PointProbe)]
         self._elev = [p for p in scene.probes if isinstance(p, ElevationProbe)]
         self._fronts = [p for p in scene.probes if isinstance(p, FrontProbe)]
+        self._runups = [p for p in scene.probes if isinstance(p, RunupProbe)]
+        self._runup_max: dict[str, float | None] = {p.name: None for p in self._runups}
+        self._beds = [list(b.points) for b in scene.beds]
         self._px = np.array([p.x for p in self._points], dtype=float)
         self._pz = np.array([p.z for p in self._points], dtype=float)
         self._px0, self._pz0 = self._px.copy(), self._pz.copy()   # at t_start (follow)
@@ -286,6 +289,8 @@ class Simulation:
                 cols.append(f"{p.name}_eta")
         for p in self._fronts:
             cols.append(f"{p.name}_x")
+        for p in self._runups:
+            cols += [f"{p.name}_x", f"{p.name}_z", f"{p.name}_R"]
         return cols + self.loads.columns()
 
     def probe_values(self) -> dict[str, float | None]:
@@ -312,13 +317,24 @@ class Simulation:
             swl = self.scene.still_water_level
             if swl is not None:
                 out[f"{p.name}_eta"] = None if zs is None else zs - swl
-        if self._fronts:
+        if self._fronts or self._runups:
             fluid_neighbour_counts(ps.view, ps.n, self.cells, self.h, self._counts)
             counts = self._counts[: ps.n]
             x = ps.field(X)
             for p in self._fronts:
                 sel = counts >= p.min_neighbours
                 out[f"{p.name}_x"] = float(x[sel].max()) if sel.any() else None
+            for p in self._runups:
+                s = shoreline(x, ps.field(Z), counts, p.min_neighbours, self._beds,
+                              self.scene.tank.z0, p.near_bed)
+                r = self._runup_max[p.name]
+                if s is not None:
+                    rise = s[1] - float(self.scene.still_water_level)
+                    r = rise if r is None else max(r, rise)
+                    self._runup_max[p.name] = r
+                out[f"{p.name}_x"] = None if s is None else s[0]
+                out[f"{p.name}_z"] = None if s is None else s[1]
+                out[f"{p.name}_R"] = r
         if self.loads:
             out.update(self.loads.values(self.particles, self.cells, self.prm, self.t,
                                          self.bodies))

@@ -23,7 +23,8 @@ TESTS = Path(__file__).resolve().parent
 # (`pytest --durations=0`); kernel calls are checked by the hooks below (kernel_calls.py)
 UNIT: tuple[str, ...] = (
     "test_protocol/", "test_server/", "test_cli.py", "test_layers.py", "test_analysis.py",
-    "test_wave_client/test_theories.py", "test_wave_client/test_client.py", "test_wave_client/test_client_absorption.py",
+    "test_wave_client/test_theories.py", "test_wave_client/test_solitary_theory.py",
+    "test_wave_client/test_client.py", "test_wave_client/test_client_absorption.py",
     "test_cases/test_particle_noise.py", "test_cases/test_wall_impact.py",
     "test_sph_core/test_scene.py", "test_sph_core/test_geometry.py",
 )
@@ -32,6 +33,7 @@ NOT_UNIT: frozenset[str] = frozenset({  # "path" or "path::test_name" (any param
     "test_server/test_server_flume.py",
     "test_server/test_standalone_theory.py::test_standalone_theory_run_equals_the_coupled_run",
     "test_server/test_standalone_theory.py::test_cancelled_theory_run_keeps_its_data_and_resumes_to_the_end",
+    "test_server/test_standalone_theory.py::test_standalone_solitary_source_brings_its_crest_to_the_inlet",
     "test_server/test_server_bodies.py::test_standalone_run_serves_its_body_series",
     "test_server/test_server_c_client.py::test_c_client_drives_the_sph_flume",
     "test_cli.py::test_run_options_are_honoured",

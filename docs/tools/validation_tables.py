@@ -45,6 +45,9 @@ QUESTIONS: dict[str, tuple[str, ...]] = {
                  "the same length. Wall times under load.",
                  "![speed-accuracy chart, quick preset, under load](figures/accuracy_quick.png)"),
     "bodies": ("Rigid bodies", "Floating and moving bodies against theory."),
+    "runup": ("Run-up", "How far up a 1:19.85 plane beach does a solitary wave run in SPH, against "
+                        "Synolakis' (1987) law R/d = 2.831 sqrt(cot beta) (H/d)^(5/4)? "
+                        "(studies/runup.md)"),
     "boussinesq": ("Boussinesq model", "The far-field wave model against its own theory."),
     "stability": ("Stability suite",
                   "Which scenarios each integrator survives: stable (every measure within its "

@@ -117,3 +117,25 @@ def test_standalone_theory_run_waits_through_working_frames(tmp_path, factory):
         info = srv.wait_state(r.json()["id"], "finished", "failed", "unstable", timeout=60)
     assert info["state"] == "finished", info["status"]
     assert info["windows"] == 2
+
+
+def test_standalone_solitary_source_brings_its_crest_to_the_inlet(tmp_path):
+    """A scene's [source] theory = "solitary" (no T): the inlet gauge sees the crest at t0."""
+    h, t0 = 0.06, 1.2
+    scene = {**FLUME, "t_end": 1.6}
+    with live_server(tmp_path) as srv:
+        r = srv.http.post("/runs", json={"scene": scene, "mode": "standalone",
+                                         "source": {"theory": "solitary", "H": h, "t0": t0}})
+        assert r.status_code == 201, r.text
+        done = srv.wait_state(r.json()["id"], "finished", "failed", "unstable", timeout=300)
+    assert done["state"] == "finished", done["status"]
+    table = rows(tmp_path / "runs" / done["id"] / "gauges.csv")
+    col = next(i for i, name in enumerate(table[0]) if name.startswith("left_boundary")
+               and "eta" in name)
+    t = np.array([float(r[0]) for r in table[1:]])
+    eta = np.array([float(r[col]) for r in table[1:]])
+    assert abs(eta[0]) < 0.15 * h                      # the record starts near rest
+    k = int(np.argmax(eta))
+    x_gauge = 4 * FLUME["dp"]   # the boundary gauge stands 2h = 4 dp inside the inlet face
+    assert t[k] == pytest.approx(t0 + x_gauge / np.sqrt(9.81 * (DEPTH + h)), abs=0.1), t[k]
+    assert eta[k] == pytest.approx(h, rel=0.3), eta[k]

@@ -34,7 +34,11 @@ G = 9.81
 @functools.lru_cache(maxsize=None)
 def reference_wave(name: str, height: float = 0.08, period: float = 2.0, depth: float = 1.0):
     """A theory built once per session (a stream-function solve takes about a second); tests
-    only move its clock. Default: H=0.08 m, T=2 s, d=1 m (seed 002 case III)."""
+    only move its clock. Default: H=0.08 m, T=2 s, d=1 m (seed 002 case III); a solitary wave
+    has no period: its crest is at x = 2 m at t = 0.37 s."""
+    if name == "solitary":
+        c = np.sqrt(G * (depth + height))
+        return build_theory(name, height=height, period=None, depth=depth, t0=0.37 - 2.0 / c)
     return build_theory(name, height=height, period=period, depth=depth)
 
 

@@ -19,12 +19,14 @@ from wave_client.theories.base import G, WaveTheory, ramp_factor
 from wave_client.theories.irregular import JonswapSea, jonswap_shape
 from wave_client.theories.linear import AiryWave, StandingWave, wavenumber
 from wave_client.theories.nonlinear import StokesWave, StreamFunctionWave
+from wave_client.theories.solitary_wave import SolitaryWave
 
 __all__ = [
     "G",
     "THEORIES",
     "AiryWave",
     "JonswapSea",
+    "SolitaryWave",
     "StandingWave",
     "StokesWave",
     "StreamFunctionWave",
@@ -41,11 +43,14 @@ THEORIES: dict[str, type[WaveTheory]] = {
     "stream": StreamFunctionWave,
     "standing": StandingWave,
     "irregular": JonswapSea,
+    "solitary": SolitaryWave,
 }
 
 
-def build_theory(name: str, *, height: float, period: float, depth: float, **options: Any) -> WaveTheory:
-    """Build a theory by name; for ``irregular`` height is Hs and period is Tp.
+def build_theory(name: str, *, height: float, period: float | None, depth: float,
+                 **options: Any) -> WaveTheory:
+    """Build a theory by name; for ``irregular`` height is Hs and period is Tp; ``solitary``
+    takes no period (None) and ``t0``, the time its crest passes x = 0.
 
     ``options`` are the class's keyword arguments (``ramp_time``, ``order``, ``n_fourier``,
     ``gamma``, ``n_components``, ``seed``, ``g``...); an unknown one is a ValueError.
@@ -58,4 +63,6 @@ def build_theory(name: str, *, height: float, period: float, depth: float, **opt
     unknown = sorted(set(options) - allowed)
     if unknown:
         raise ValueError(f"model {name!r} takes no option(s) {unknown}; it takes {sorted(allowed)}")
+    if period is None and cls is not SolitaryWave:
+        raise ValueError(f"period: model {name!r} needs a wave period")
     return cls(height, period, depth, **options)

@@ -3,6 +3,7 @@
     wavesph couple --url ws://127.0.0.1:8000/runs/r1/couple --model stokes --H 0.08 --T 2
     wavesph couple --url tcp://127.0.0.1:8766 --run-id r1 --model irregular --H 0.15 --T 2 \
                    --out gauges.csv
+    wavesph couple --url ws://127.0.0.1:8000/runs/r1/couple --model solitary --H 0.01 --t0 3
     wavesph couple --scene examples/scenes/demo_beach_flume.toml --model stokes --H 0.04 --T 1.4
         (creates the coupled run from the scene file on the server at --url, default
         http://127.0.0.1:8765, then couples to it)
@@ -21,7 +22,7 @@ from typing import Any
 
 from protocol import Welcome
 
-THEORY_MODELS = ("linear", "stokes", "stream", "standing", "irregular")
+THEORY_MODELS = ("linear", "stokes", "stream", "standing", "irregular", "solitary")
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -43,6 +44,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                    help="still-water depth [m]; default: the scene's depth at the inlet")
     p.add_argument("--ramp-periods", type=float, default=2.0,
                    help="half-cosine start-up ramp, in wave periods (the flume starts at rest)")
+    p.add_argument("--t0", type=float, default=None,
+                   help="time [s] the crest passes the SPH inlet (--model solitary; default: "
+                        "when the elevation there starts at 1e-3 H)")
     p.add_argument("--order", type=int, default=5, help="Stokes order, 2-5 (--model stokes)")
     p.add_argument("--n-fourier", type=int, default=10, help="Fourier modes (--model stream)")
     p.add_argument("--gamma", type=float, default=3.3, help="JONSWAP peak enhancement (irregular)")
@@ -95,9 +99,16 @@ def model_factory(args: argparse.Namespace) -> tuple[Callable[[Welcome], Any], f
         return _boussinesq_factory(args)
     from wave_client.theories import build_theory
 
-    if args.H is None or args.T is None:
+    if args.model == "solitary":
+        if args.H is None or args.T is not None:
+            raise ValueError("--model solitary needs --H and takes no --T (no period)")
+        options: dict[str, Any] = {"t0": args.t0}
+    elif args.H is None or args.T is None:
         raise ValueError(f"--model {args.model} needs --H and --T")
-    options: dict[str, Any] = {"ramp_time": args.ramp_periods * args.T}
+    else:
+        if args.t0 is not None:
+            raise ValueError("--t0 is for --model solitary")
+        options = {"ramp_time": args.ramp_periods * args.T}
     if args.model == "stokes":
         options["order"] = args.order
     elif args.model == "stream":

@@ -16,7 +16,7 @@ import os
 import sys
 from pathlib import Path
 
-SOURCES = ("linear", "stokes", "stream", "irregular")
+SOURCES = ("linear", "stokes", "stream", "irregular", "solitary")
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -37,6 +37,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     p.add_argument("--ramp-periods", type=float, default=None,
                    help="--source start-up ramp in periods (default: the server's, 2)")
     p.add_argument("--order", type=int, default=None, help="--source stokes: order 2-5 (default 5)")
+    p.add_argument("--t0", type=float, default=None,
+                   help="--source solitary: time [s] the crest passes the inlet (default: the "
+                        "elevation there starts at 1e-3 H)")
     p.add_argument("--n-fourier", type=int, default=None,
                    help="--source stream: Fourier terms (default 10)")
     p.add_argument("--token", default=os.environ.get("WAVESPH_TOKEN"),
@@ -45,13 +48,19 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def source_table(args: argparse.Namespace) -> dict | None:
     """The [source] table the options give, or None; ValueError if incomplete."""
-    extra = {"ramp_periods": args.ramp_periods, "order": args.order, "n_fourier": args.n_fourier}
+    extra = {"ramp_periods": args.ramp_periods, "order": args.order, "n_fourier": args.n_fourier,
+             "t0": args.t0}
     if args.source is None:
         given = [k for k in ("H", "T") if getattr(args, k) is not None]
         given += [k for k, v in extra.items() if v is not None]
         if given:
             raise ValueError(f"--{given[0].replace('_', '-')} needs --source THEORY")
         return None
+    if args.source == "solitary":  # one wave, no period: the server refuses a T
+        if args.H is None or args.T is not None:
+            raise ValueError("--source solitary needs --H and takes no --T")
+        return {"theory": "solitary", "H": args.H,
+                **{k: v for k, v in extra.items() if v is not None}}
     if args.H is None or args.T is None:
         raise ValueError(f"--source {args.source} needs --H and --T")
     return {"theory": args.source, "H": args.H, "T": args.T,

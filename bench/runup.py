@@ -1,0 +1,146 @@
+"""Question: how far up a 1:19.85 plane beach does a solitary wave run in SPH, against
+Synolakis' (1987) run-up law R/d = 2.831 sqrt(cot beta) (H/d)^(5/4)?
+
+    NUMBA_NUM_THREADS=1 python bench/runup.py [--h-over-d 0.05,0.3] [--dp-over-d 0.1] [--depth 0.2]
+                                              [--wall-slip free_slip] [--constants JSON]
+
+The canonical case (Synolakis 1987, J. Fluid Mech. 185): still water d on a flat bed, then a
+plane beach of slope 1/19.85 whose toe is L = arccosh(sqrt(20)) / k downstream of the inlet
+(the half-width at which eta = H/20, k = sqrt(3H/(4 d^3))), the beach running on above still
+water. The whole flume is SPH: an open inlet (elevation imposed, no absorption) at x = 0 driven
+by wave_client's `solitary` theory, whose crest passes the inlet at its default t0 (eta there
+starts at 1e-3 H). The wedge of water over the beach is filled to the still shoreline. A
+`runup` probe (near_bed 2 dp) records the shoreline; R is its highest z - still water over the
+run, R0 the same before the wave's front (eta > H/100) reaches the beach's toe: what the
+layout itself gives at rest. The run ends 1.5 L/c after the linear shallow-water travel time
+to the still shoreline (by then the run-up maximum has passed).
+
+The law holds for non-breaking waves (Synolakis: H/d < 0.818 (cot beta)^(-10/9), 0.030 here;
+breaking on run-down from about 0.044); H/d = 0.3 breaks on run-up, where Synolakis' data
+follow R/d = 1.109 (H/d)^0.582 (`R_over_d_breaking_fit`). `error` is (R - R_law) / R_law
+against the non-breaking law in every case.
+
+One JSON object per H/d: H_over_d, R_over_d, R_over_d_law, R_over_d_breaking_fit, error,
+R0_over_d, R_loose_over_d (the same probe counting any particle with one fluid neighbour at any
+height: what the wet-film criteria leave out), H_toe_over_H (the highest SPH elevation at the toe up to the run-up peak, over H), dp, d_over_dp, H_over_dp, particles, steps, t_end, wall_s.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+os.environ.setdefault("OMP_WAIT_POLICY", "passive")
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from sph_core.boundary_data import WaveModelBoundary  # noqa: E402
+from sph_core.open_ends import flume_nodes  # noqa: E402
+from sph_core.scene import make_scene  # noqa: E402
+from sph_core.simulation import Simulation  # noqa: E402
+from wave_client.theories import G, SolitaryWave  # noqa: E402
+
+COT_BETA = 19.85
+
+
+def law(h_over_d: float) -> float:
+    """Synolakis (1987), non-breaking run-up R/d."""
+    return 2.831 * math.sqrt(COT_BETA) * h_over_d**1.25
+
+
+def breaking_fit(h_over_d: float) -> float:
+    """Synolakis (1987): the fit to his breaking-wave run-up data on the 1:19.85 beach, R/d."""
+    return 1.109 * h_over_d**0.582
+
+
+def runup_scene(h_over_d: float, depth: float, dp: float, wall_slip: str = "no_slip",
+                constants: dict | None = None) -> tuple[dict, SolitaryWave, float]:
+    """(scene dict, the inlet's theory, x of the beach's toe [m])."""
+    H = h_over_d * depth
+    wave = SolitaryWave(H, depth=depth)
+    half = math.acosh(math.sqrt(20.0)) / wave.k
+    x_toe = dp * round(half / dp)
+    x_shore = x_toe + COT_BETA * depth
+    # beyond the shoreline: twice the expected run-up (the law's, the breaking fit's once the
+    # law overshoots it), then 10 dp
+    r_max = (law(h_over_d) if h_over_d <= 0.1 else breaking_fit(h_over_d)) * depth
+    x1 = dp * math.ceil((x_shore + 2.0 * r_max * COT_BETA) / dp + 10)
+    # shallow-water travel to the still shoreline: x_toe / c0 + 2 cot(beta) d / sqrt(g d)
+    t_arrive = wave.t0 + x_toe / math.sqrt(G * depth) + 2.0 * COT_BETA * math.sqrt(depth / G)
+    t_end = t_arrive + 1.5 * half / wave.c
+    z_top = depth + 2.0 * r_max + 10 * dp
+    scene = {
+        "name": f"solitary-runup-H{h_over_d:g}", "dp": dp, "t_end": round(t_end, 4),
+        "still_water_level": depth,
+        "tank": {"x0": 0.0, "x1": x1, "z0": 0.0, "z1": z_top},
+        "water_blocks": [{"x0": 0.0, "x1": x_shore, "z0": 0.0, "z1": depth}],
+        "beds": [{"points": [[x_toe, 0.0], [x1, (x1 - x_toe) / COT_BETA]]}],
+        "open_boundaries": [{"side": "left", "elevation": "imposed"}],
+        "constants": {"wall_slip": wall_slip, **(constants or {})},
+        "output": {"probe_every": 0.02},
+        # "loose": any fluid particle with one neighbour, at any height (spray included)
+        "probes": [{"kind": "runup", "name": "shore", "near_bed": 2 * dp},
+                   {"kind": "runup", "name": "loose", "min_neighbours": 1},
+                   {"kind": "elevation", "name": "toe", "x": x_toe}],
+    }
+    return scene, wave, x_toe
+
+
+def run_case(h_over_d: float, depth: float, dp_over_d: float, wall_slip: str = "no_slip",
+             constants: dict | None = None) -> dict:
+    dp = dp_over_d * depth
+    data, wave, x_toe = runup_scene(h_over_d, depth, dp, wall_slip, constants)
+    scene = make_scene(data)
+    src = WaveModelBoundary(wave, flume_nodes(scene)["left"], depth, 0.0)
+    tic = time.perf_counter()
+    sim = Simulation(scene, sources={"left": src})
+    sim.advance_to(scene.t_end)
+    wall = time.perf_counter() - tic
+    h = sim.history
+    t = np.array([r["t"] for r in h])
+    rise = np.array([np.nan if r["shore_z"] is None else r["shore_z"] - depth for r in h])
+    # the front (eta > H/100) reaches the toe: (t - t0) c = x_toe - arccosh(10)/k
+    t_front = wave.t0 + (x_toe - math.acosh(10.0) / wave.k) / wave.c
+    r0 = float(np.nanmax(rise[t < t_front]))
+    r = float(np.nanmax(rise))
+    r_loose = max(v for v in (h[-1]["loose_R"], -math.inf) if v is not None)
+    # the wave SPH delivers: the highest elevation at the toe before the shoreline peaks
+    toe = np.array([np.nan if r_["toe_eta"] is None else r_["toe_eta"] for r_ in h])
+    h_toe = float(np.nanmax(toe[t <= t[int(np.nanargmax(rise))]]))
+    rl = law(h_over_d)
+    return {"bench": "runup", "H_over_d": h_over_d, "R_over_d": round(r / depth, 4),
+            "R_over_d_law": round(rl, 4), "R_over_d_breaking_fit": round(breaking_fit(h_over_d), 4),
+            "error": round((r / depth - rl) / rl, 3), "R0_over_d": round(r0 / depth, 4),
+            "R_loose_over_d": round(r_loose / depth, 4),
+            "H_toe_over_H": round(h_toe / (h_over_d * depth), 3),
+            "t_R": round(float(t[int(np.nanargmax(rise))]), 3),
+            "depth": depth, "dp": round(dp, 6), "d_over_dp": round(depth / dp, 2),
+            "H_over_dp": round(h_over_d * depth / dp, 2), "wall_slip": wall_slip,
+            **({"constants": constants} if constants else {}), "particles": sim.n_particles,
+            "steps": sim.steps, "t_end": scene.t_end, "wall_s": round(wall, 1),
+            "threads": int(os.environ.get("NUMBA_NUM_THREADS", "0") or 0)}
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--h-over-d", default="0.05", help="comma-separated H/d values")
+    ap.add_argument("--depth", type=float, default=0.2, help="still-water depth d [m]")
+    ap.add_argument("--dp-over-d", type=float, default=0.1,
+                    help="particle spacing / depth (0.1: d/dp 10, minutes on 2 cores)")
+    ap.add_argument("--wall-slip", choices=("no_slip", "free_slip"), default="no_slip",
+                    help="walls and beach (the scene default no_slip holds the film back)")
+    ap.add_argument("--constants", type=json.loads, default=None,
+                    help='scene constants to override, JSON, e.g. \'{"h_over_dp": 1.5}\'')
+    a = ap.parse_args()
+    for hd in (float(v) for v in a.h_over_d.split(",")):
+        print(json.dumps(run_case(hd, a.depth, a.dp_over_d, a.wall_slip, a.constants)), flush=True)
+
+
+if __name__ == "__main__":
+    main()
