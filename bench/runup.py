@@ -21,7 +21,8 @@ follow R/d = 1.109 (H/d)^0.582 (`R_over_d_breaking_fit`). `error` is (R - R_law)
 against the non-breaking law in every case.
 
 One JSON object per H/d: H_over_d, R_over_d, R_over_d_law, R_over_d_breaking_fit, error,
-R0_over_d, R_loose_over_d (the same probe counting any particle with one fluid neighbour at any
+R0_over_d, stopped (null, or why the run stopped early: R is then over the records before it),
+R_loose_over_d (the same probe counting any particle with one fluid neighbour at any
 height: what the wet-film criteria leave out), H_toe_over_H (the highest SPH elevation at the toe up to the run-up peak, over H), dp, d_over_dp, H_over_dp, particles, steps, t_end, wall_s.
 """
 
@@ -43,7 +44,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from sph_core.boundary_data import WaveModelBoundary  # noqa: E402
 from sph_core.open_ends import flume_nodes  # noqa: E402
 from sph_core.scene import make_scene  # noqa: E402
-from sph_core.simulation import Simulation  # noqa: E402
+from sph_core.simulation import Simulation, UnstableError  # noqa: E402
 from wave_client.theories import G, SolitaryWave  # noqa: E402
 
 COT_BETA = 19.85
@@ -100,7 +101,11 @@ def run_case(h_over_d: float, depth: float, dp_over_d: float, wall_slip: str = "
     src = WaveModelBoundary(wave, flume_nodes(scene)["left"], depth, 0.0)
     tic = time.perf_counter()
     sim = Simulation(scene, sources={"left": src})
-    sim.advance_to(scene.t_end)
+    stopped = None
+    try:
+        sim.advance_to(scene.t_end)
+    except UnstableError as exc:  # the records up to the stop still say how far it ran up
+        stopped = str(exc)
     wall = time.perf_counter() - tic
     h = sim.history
     t = np.array([r["t"] for r in h])
@@ -123,7 +128,7 @@ def run_case(h_over_d: float, depth: float, dp_over_d: float, wall_slip: str = "
             "depth": depth, "dp": round(dp, 6), "d_over_dp": round(depth / dp, 2),
             "H_over_dp": round(h_over_d * depth / dp, 2), "wall_slip": wall_slip,
             **({"constants": constants} if constants else {}), "particles": sim.n_particles,
-            "steps": sim.steps, "t_end": scene.t_end, "wall_s": round(wall, 1),
+            "steps": sim.steps, "t_end": scene.t_end, "stopped": stopped, "wall_s": round(wall, 1),
             "threads": int(os.environ.get("NUMBA_NUM_THREADS", "0") or 0)}
 
 
