@@ -17,7 +17,7 @@ to the still shoreline (by then the run-up maximum has passed).
 
 The law holds for non-breaking waves (Synolakis: H/d < 0.818 (cot beta)^(-10/9), 0.030 here;
 breaking on run-down from about 0.044); H/d = 0.3 breaks on run-up, where Synolakis' data
-follow R/d = 1.109 (H/d)^0.582 (`R_over_d_breaking_fit`). `error` is (R - R_law) / R_law
+follow R/d = 1.109 (H/d)^0.582 (`R_over_d_breaking_fit`; the fit as widely quoted, not yet checked against the paper). `error` is (R - R_law) / R_law
 against the non-breaking law in every case.
 
 One JSON object per H/d: H_over_d, R_over_d, R_over_d_law, R_over_d_breaking_fit, error,
