@@ -32,7 +32,8 @@ def _args() -> dict:
     buf = (ps.f, ps.kind, ps.ids, ps.cell)
     buf2 = (ps.f2, ps.kind2, ps.ids2, ps.cell2)
     i64 = np.zeros(8, dtype=np.int64)
-    cells = Cells(c.start, i64, c.order, c.ncx, c.ncz, c.xmin, c.zmin, c.inv_cs, c.reach)
+    cells = Cells(c.start, i64, c.order, c.ncx, c.ncz, c.xmin, c.zmin, c.inv_cs, c.reach, c.ncy,
+                  c.ymin)
     clk = np.zeros(K.N_CLK)
     ctl = np.zeros(K.N_CTL, dtype=np.int64)
     n = int(ps.n)

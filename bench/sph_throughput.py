@@ -1,4 +1,4 @@
-"""SPH throughput on the standard 2D dam break (DualSPHysics / PySPH reference case).
+"""SPH throughput on the standard 2D dam break (DualSPHysics / PySPH reference case), or in 3D.
 
 Question: how many particle-steps per second does the WCSPH core sustain on this machine, and
 where does the time go (neighbour search vs interactions vs integration)?
@@ -11,6 +11,11 @@ anchors do. Also measures the one-off numba compile time, cold (empty cache) and
 Output: one JSON object per line.
     python bench/sph_throughput.py [--steps 400] [--dps 0.01 0.005] [--integrator kdk]
         [--cells-per-support 2] [--diagnostics] [--threads 1 2 4 8 16]
+
+``--dim 3``: the 3D dam break of the MARIN tank without its box (wavesph.cases.marin_dambreak:
+a 1.228 x 1 x 0.55 m column in a 3.22 x 1 x 1 m tank, the case of PySPH's dam_break_3d), h/dp
+1.5, at dp 0.04 and 0.02 m by default; the same fields plus ``dim``.
+    python bench/sph_throughput.py --dim 3 [--dps 0.04 0.02]
 
 ``--device cuda``: the same case stepped on the GPU through ``Simulation(device="cuda")``
 (sph_core/cuda), timed with plain kernel launches and/or two-step CUDA graph replays
@@ -81,13 +86,17 @@ def time_components(sim, repeats: int) -> dict:
 
 
 def run_size(dp: float, steps: int, integrator: str, diagnostics: bool,
-             cells_per_support: int | None) -> dict:
+             cells_per_support: int | None, dim: int = 2) -> dict:
     import numba
 
     from wavesph.cases.dambreak import dambreak_scene
+    from wavesph.cases.marin_dambreak import marin_scene
     from sph_core.simulation import Simulation
 
-    scene = dambreak_scene(a=1.0, dp=dp, t_end=1.0, integrator=integrator)
+    if dim == 3:
+        scene = marin_scene(dp=dp, t_end=1.0, box=False, integrator=integrator)
+    else:
+        scene = dambreak_scene(a=1.0, dp=dp, t_end=1.0, integrator=integrator)
     sim = Simulation(scene, **({"cells_per_support": cells_per_support} if cells_per_support else {}))
     sim.advance_steps(20)                     # warm-up (compiled already, touches memory)
     sim.wall_time = 0.0
@@ -105,7 +114,9 @@ def run_size(dp: float, steps: int, integrator: str, diagnostics: bool,
     }
     total = sum(per_step.values())
     out = {
-        "bench": "sph_throughput", "case": "dambreak_2d_1x2m_tank4m", "dp": dp,
+        "bench": "sph_throughput", "dim": dim,
+        "case": "dambreak_3d_marin_tank" if dim == 3 else "dambreak_2d_1x2m_tank4m", "dp": dp,
+        "h_over_dp": round(sim.h / dp, 3),
         "integrator": integrator, "neighbours": "cell_lists",
         "cell_side_over_h": round(sim.grid.cs / sim.h, 3), "particles": n, "fluid_particles": sim.n_fluid,
         "steps": sim.steps - s0, "passes_per_step": sim.passes_per_step,
@@ -211,7 +222,10 @@ def run_threads(threads: list[int], argv: list[str]) -> None:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--steps", type=int, default=400)
-    ap.add_argument("--dps", type=float, nargs="+", default=[0.01, 0.005])
+    ap.add_argument("--dps", type=float, nargs="+", default=None,
+                    help="particle spacings [m] (default 0.01 0.005; --dim 3: 0.04 0.02)")
+    ap.add_argument("--dim", type=int, choices=[2, 3], default=2,
+                    help="3: the 3D dam break (module docstring); cpu only")
     ap.add_argument("--integrator", choices=["kdk", "symplectic_pc"], default="kdk")
     ap.add_argument("--cells-per-support", type=int, default=None,
                     help="neighbour cells of side 2h / this (default: the Simulation's)")
@@ -226,6 +240,10 @@ def main() -> None:
     ap.add_argument("--threads", type=int, nargs="+", default=None,
                     help="run at each of these numba thread counts, each in a fresh process")
     args = ap.parse_args()
+    if args.dps is None:
+        args.dps = [0.04, 0.02] if args.dim == 3 else [0.01, 0.005]
+    if args.dim == 3 and (args.device == "cuda" or args.threads):
+        ap.error("--dim 3 runs on the cpu, in this process (no --device cuda, no --threads)")
     if args.device == "cuda":
         modes = {"off": [False], "on": [True], "both": [False, True]}[args.graphs]
         for dp in args.dps:
@@ -243,7 +261,7 @@ def main() -> None:
         print(json.dumps(compile_times(args.integrator)), flush=True)
     for dp in args.dps:
         print(json.dumps(run_size(dp, args.steps, args.integrator, args.diagnostics,
-                                  args.cells_per_support)), flush=True)
+                                  args.cells_per_support, args.dim)), flush=True)
 
 
 if __name__ == "__main__":

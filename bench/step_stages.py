@@ -99,7 +99,7 @@ def profile(dp: float, steps: int, model_threads: int, precision: str = "float64
         clock("compute_cells", neighbours.compute_cells, ps, n, cells)
         clock("counting_sort", neighbours.counting_sort, ps.cell, n, cells)
         clock("permute", neighbours.permute, ps, ps2, N_SORTED_KDK, cells.order, n)
-        n = int(cells.start[cells.ncx * cells.ncz])
+        n = int(cells.start[cells.ncx * cells.ncy * cells.ncz])
         ps, ps2 = ps2, ps
         clock("wall_pass", wcsph.wall_pass, ps, n, cells, prm)
         clock("fluid_pass", wcsph.fluid_pass, ps, n, cells, prm, None)

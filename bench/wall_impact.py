@@ -113,7 +113,8 @@ class Sensors:
 
     def sample(self, sim: Simulation) -> None:
         ps = sim.particles
-        interpolate_points(ps.view, sim.cells, self.x, self.z, sim.h, sim.prm.alpha_w, self.out)
+        interpolate_points(ps.view, sim.cells, self.x, np.zeros_like(self.x), self.z, sim.h,
+                           sim.prm.alpha_w, self.out)
         self.probe.append(np.where(self.out[:, 3] > 0.05, self.out[:, 2], np.nan))
         self.u.append(self.out[0, 0] if self.out[0, 3] > 0.05 else np.nan)
         n = ps.n

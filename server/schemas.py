@@ -89,6 +89,8 @@ def estimate_particles(scene: Scene) -> float:
     """Upper estimate of fluid + wall particles, without building them (for the cap); math.inf
     when it overflows a float (a 1e308 m tank, a dp of 5e-324 m): never raises."""
     dp, t = scene.dp, scene.tank
+    if scene.dim == 3:
+        return _estimate_particles_3d(scene)
     # (a / dp) / dp, not a / dp**2: dp**2 underflows to 0 for a tiny dp; float * and / give inf
     # on overflow where ** and ceil would raise
     fluid = sum((b.x1 - b.x0) * (b.z1 - b.z0) / dp / dp for b in scene.water_blocks)
@@ -99,5 +101,24 @@ def estimate_particles(scene: Scene) -> float:
         walls += layers * length / dp
     for s in scene.structures:
         walls += layers * 2 * ((s.x1 - s.x0) + (s.z1 - s.z0)) / dp
+    n = fluid + walls
+    return float(math.ceil(n)) if math.isfinite(n) else math.inf
+
+
+def _estimate_particles_3d(scene: Scene) -> float:
+    """estimate_particles of a 3D scene: volumes over dp^3, wall shells of ``layers`` over dp^2
+    (the tank's box grown by its walls: the edges and corners counted)."""
+    dp, t = scene.dp, scene.tank
+    th = wall_layers(scene) * dp
+    fluid = sum((b.x1 - b.x0) / dp * (b.y1 - b.y0) / dp * (b.z1 - b.z0) / dp
+                for b in scene.water_blocks)
+    lx, ly, lz = (t.x1 - t.x0) + 2 * th, (t.y1 - t.y0) + 2 * th, (t.z1 - t.z0) + th
+    walls = th / dp * (lx * ly + 2 * lz * (lx + ly)) / dp / dp
+    for bed in scene.beds:
+        length = sum(math.dist(a, b) for a, b in zip(bed.points, bed.points[1:]))
+        walls += th / dp * length / dp * ly / dp
+    for s in scene.structures:
+        a, b, c = s.x1 - s.x0, s.y1 - s.y0, s.z1 - s.z0
+        walls += th / dp * 2 * (a * b + b * c + a * c) / dp / dp
     n = fluid + walls
     return float(math.ceil(n)) if math.isfinite(n) else math.inf

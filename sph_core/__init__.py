@@ -1,4 +1,4 @@
-"""wavesph sph_core: the 2D weakly-compressible SPH solver as a library.
+"""wavesph sph_core: the weakly-compressible SPH solver (2D, and 3D with ``dim = 3``) as a library.
 
     from sph_core.scene import Scene, load_scene, make_scene      # TOML / dict -> validated Scene
     from sph_core.simulation import Simulation, UnstableError
@@ -8,7 +8,7 @@
     sim.probe_values()                   # {"front_x": ..., "<point>_p": ..., "<gauge>_eta": ...}
     sim.close()
 
-Modules: scene (config), geometry (particle layout), particles (SoA storage), state (the typed
+Modules: scene (config), geometry (particle layout; geometry3d for 3D scenes), particles (SoA storage), state (the typed
 containers the kernels take), neighbours (cell lists), pairs (the one neighbour walk), terms (the
 per-pair terms), kernels (Wendland C2), eos (Tait), wcsph (the passes and integrators),
 open_boundary (the jitted open-end terms), step (the one jitted time loop), open_ends (open ends

@@ -274,8 +274,8 @@ def particle_load(j, kb, ps, cells, bd, k):
     pass's constants (terms.fluid_consts)."""
     xj = ps.x[j]
     zj = ps.z[j]
-    fx, fz = gather(j, xj, zj, ps.cell[j], ps, cells, k.s2, fluid_only, body_reaction, k,
-                    (0.0, 0.0))
+    fx, _, fz = gather(j, xj, ps.y[j], zj, ps.cell[j], ps, cells, k.s2, fluid_only,
+                       body_reaction, k, (0.0, 0.0, 0.0))   # bodies move in the x-z plane (2D)
     b = bd.owner[kb]
     rx = xj - bd.q[b, 0]
     rz = zj - bd.q[b, 1]

@@ -30,6 +30,8 @@ class Layout:
     wall_x: np.ndarray
     wall_z: np.ndarray
     n_layers: int
+    fluid_y: np.ndarray | None = None   # 3D scenes (geometry3d.py); None: the x-z plane
+    wall_y: np.ndarray | None = None
 
 
 def wall_layers(scene: Scene) -> int:
@@ -82,7 +84,10 @@ def _rect_shell(scene: Scene, r: Rect, thickness: float) -> tuple[np.ndarray, np
 
 
 def build_layout(scene: Scene) -> Layout:
-    """Place fluid and wall particles for ``scene``."""
+    """Place fluid and wall particles for ``scene`` (a 3D scene: geometry3d.build_layout_3d)."""
+    if scene.dim == 3:
+        from .geometry3d import build_layout_3d
+        return build_layout_3d(scene)
     dp, t = scene.dp, scene.tank
     nl = wall_layers(scene)
     th = nl * dp

@@ -1,4 +1,4 @@
-"""Wendland C2 smoothing kernel (2D), as jitted scalar functions.
+"""Wendland C2 smoothing kernel (2D and 3D: only a_D differs), as jitted scalar functions.
 
 W(r, h) = a_D (1 - q/2)^4 (2q + 1),  q = r/h in [0, 2],  a_D = 7 / (4 pi h^2)   (2D)
                                                           a_D = 21 / (16 pi h^3) (3D)
@@ -14,7 +14,7 @@ import math
 
 from numba import njit
 
-DIM = 2  # the solver is a 2D vertical plane (x, z); rows of the particle arrays are shaped for 3D
+DIM = 2  # the default scene: the vertical plane (x, z); a scene with dim = 3 passes 3
 
 
 def wendland_alpha(h: float, dim: int = DIM) -> float:

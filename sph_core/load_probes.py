@@ -14,7 +14,7 @@ from typing import Any
 
 import numpy as np
 
-from .particles import FLUID, M, RHO, WALL, X, Z
+from .particles import FLUID, M, RHO, WALL, X, Y, Z
 from .probes import interpolate_points, wall_force
 from .scene import ForceProbe, OvertoppingProbe, PressureLineProbe, Scene
 
@@ -23,6 +23,7 @@ class LoadProbes:
     """Force, pressure-line and overtopping probes of one scene."""
 
     def __init__(self, scene: Scene) -> None:
+        self.dim = scene.dim
         self.forces = [p for p in scene.probes if isinstance(p, ForceProbe)]
         self.lines = [p for p in scene.probes if isinstance(p, PressureLineProbe)]
         self.overtopping = [p for p in scene.probes if isinstance(p, OvertoppingProbe)]
@@ -33,7 +34,8 @@ class LoadProbes:
         bounds = np.cumsum([0] + [len(p.points) for p in self.lines])
         self._follow = [(slice(a, b), p.follow) for a, b, p in zip(bounds[:-1], bounds[1:],
                                                                       self.lines) if p.follow]
-        self._lout = np.zeros((len(pts), 4))
+        self._ly = np.array([p.y for p in self.lines for _ in p.points], dtype=float)
+        self._lout = np.zeros((len(pts), 5))
         self._side: dict[str, np.ndarray] = {}       # id -> 1 if x >= section, 0 if not, -1 unknown
         self._volume = {p.name: 0.0 for p in self.overtopping}
         self._q = {p.name: 0.0 for p in self.overtopping}
@@ -46,6 +48,8 @@ class LoadProbes:
         cols: list[str] = []
         for p in self.forces:
             cols += [f"{p.name}_fx", f"{p.name}_fz", f"{p.name}_my"]
+            if self.dim == 3:
+                cols += [f"{p.name}_fy", f"{p.name}_mx", f"{p.name}_mz"]
         for p in self.lines:
             cols += [f"{p.name}_p{k}" for k in range(len(p.points))]
         for p in self.overtopping:
@@ -62,15 +66,20 @@ class LoadProbes:
             self._lx[sl], self._lz[sl] = bodies.follow(name, self._lx0[sl], self._lz0[sl])
         f, kind = ps.f, ps.kind
         n = ps.n
-        x, z = f[X, :n], f[Z, :n]
+        x, y, z = f[X, :n], f[Y, :n], f[Z, :n]
         for p in self.forces:
-            sel = np.nonzero((kind[:n] == WALL) & (x >= p.x0) & (x <= p.x1)
-                             & (z >= p.z0) & (z <= p.z1))[0]
-            xm, zm = p.moment_about or (0.5 * (p.x0 + p.x1), p.z0)
-            fx, fz, my = wall_force(ps.view, cells, sel, xm, zm, prm)
+            inside = (kind[:n] == WALL) & (x >= p.x0) & (x <= p.x1) & (z >= p.z0) & (z <= p.z1)
+            if p.y0 is not None:
+                inside &= (y >= p.y0) & (y <= p.y1)
+            sel = np.nonzero(inside)[0]
+            xm, ym, zm = p.axis()
+            fx, fy, fz, mx, my, mz = wall_force(ps.view, cells, sel, xm, ym, zm, prm)
             out.update({f"{p.name}_fx": fx, f"{p.name}_fz": fz, f"{p.name}_my": my})
+            if self.dim == 3:
+                out.update({f"{p.name}_fy": fy, f"{p.name}_mx": mx, f"{p.name}_mz": mz})
         if self.lines:
-            interpolate_points(ps.view, cells, self._lx, self._lz, prm.h, prm.alpha_w, self._lout)
+            interpolate_points(ps.view, cells, self._lx, self._ly, self._lz, prm.h, prm.alpha_w,
+                               self._lout)
             k = 0
             for p in self.lines:
                 for j in range(len(p.points)):

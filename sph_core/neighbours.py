@@ -1,9 +1,9 @@
-"""Cell-list neighbour search: square cells of side 2h / reach, counting sort, reorder.
+"""Cell-list neighbour search: cubic cells of side 2h / reach, counting sort, reorder.
 
 After ``sort_by_cell`` the particles of cell c are the contiguous slots
-``start[c] : start[c + 1]`` (cell index c = cz * ncx + cx), so the (2 reach + 1)^2 block of cells
-that covers a particle's support 2h is 2 reach + 1 contiguous runs of slots (``block_of``).
-Inactive particles go to an extra bin at the end.
+``start[c] : start[c + 1]`` (cell index c = (cz * ncy + cy) * ncx + cx; a 2D scene has ncy = 1),
+so the block of cells that covers a particle's support 2h is (2 reach + 1)^(dim - 1) contiguous
+runs of slots (``block_of``). Inactive particles go to an extra bin at the end.
 reach = 1 (cells of 2h, 3 x 3 block) tests 36 h^2 of area for a support of 4 pi h^2 (35 % hits);
 reach = 2 (cells of h, 5 x 5) tests 25 h^2 (50 % hits): fewer distance tests per neighbour, the
 default (bench/sph_throughput.py --cells-per-support measures it).
@@ -17,83 +17,97 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit, prange
 
+from .particles import N_SORTED_PC, N_SORTED_Y_KDK, N_SORTED_Y_PC, Y
 from .state import Cells
 
 
 @dataclass(frozen=True)
 class CellGrid:
-    """A uniform grid of square cells of side ``cs`` covering [xmin, xmin + ncx cs] x [zmin, ...]."""
+    """A uniform grid of cubic cells of side ``cs`` covering [xmin, xmin + ncx cs] x
+    [ymin, ymin + ncy cs] x [zmin, ...]; ncy = 1 (and ymin 0): a 2D scene's single layer."""
 
     xmin: float
     zmin: float
     cs: float
     ncx: int
     ncz: int
-    reach: int = 1  # cells per support radius: the search block is (2 reach + 1)^2 cells
+    reach: int = 1  # cells per support radius: the search block is (2 reach + 1)^dim cells
+    ncy: int = 1
+    ymin: float = 0.0
 
     @classmethod
     def covering(cls, x0: float, x1: float, z0: float, z1: float, support: float,
-                 reach: int = 1) -> "CellGrid":
-        """A grid of cells of side support / reach over the box, one spare cell on every side."""
+                 reach: int = 1, y0: float | None = None, y1: float | None = None) -> "CellGrid":
+        """A grid of cells of side support / reach over the box, one spare cell on every side
+        (in y too when [y0, y1] is given: a 3D scene)."""
         if reach < 1:
             raise ValueError(f"reach: must be >= 1 cell per support, got {reach}")
         cs = support / reach
         ncx = int(math.ceil((x1 - x0) / cs)) + 3
         ncz = int(math.ceil((z1 - z0) / cs)) + 3
-        return cls(x0 - cs, z0 - cs, cs, ncx, ncz, reach)
+        if y0 is None or y1 is None:
+            return cls(x0 - cs, z0 - cs, cs, ncx, ncz, reach)
+        ncy = int(math.ceil((y1 - y0) / cs)) + 3
+        return cls(x0 - cs, z0 - cs, cs, ncx, ncz, reach, ncy, y0 - cs)
 
     @property
     def ncell(self) -> int:
-        return self.ncx * self.ncz
+        return self.ncx * self.ncy * self.ncz
 
     def lists(self, capacity: int) -> Cells:
         """Empty cell lists on this grid for ``capacity`` particle slots."""
         return Cells(np.zeros(self.ncell + 2, dtype=np.int64), np.zeros(self.ncell + 1, dtype=np.int64),
                      np.zeros(capacity, dtype=np.int64), self.ncx, self.ncz, float(self.xmin),
-                     float(self.zmin), 1.0 / self.cs, self.reach)
+                     float(self.zmin), 1.0 / self.cs, self.reach, self.ncy, float(self.ymin),
+                     None if self.ncy == 1 else True)
 
 
 @njit(cache=True, inline="always")
 def block_of(c, cells):
-    """(cxl, cxh, czl, czh): the block of cells within reach of cell c, clipped to the grid; its
-    particles are the slots start[zz * ncx + cxl] : start[zz * ncx + cxh + 1], zz in czl..czh."""
+    """(cxl, cxh, cyl, cyh, czl, czh): the block of cells within reach of cell c, clipped to the
+    grid; its particles are the slots start[r + cxl] : start[r + cxh + 1] of the rows
+    r = (zz * ncy + yy) * ncx, yy in cyl..cyh, zz in czl..czh."""
     ncx = cells.ncx
     r = cells.reach
-    cz = c // ncx
-    cx = c - cz * ncx
-    return max(cx - r, 0), min(cx + r, ncx - 1), max(cz - r, 0), min(cz + r, cells.ncz - 1)
+    if cells.three is None:   # 2D (when compiled): one layer, y = 0
+        cz = c // ncx
+        cx = c - cz * ncx
+        return max(cx - r, 0), min(cx + r, ncx - 1), 0, 0, max(cz - r, 0), min(cz + r, cells.ncz - 1)
+    ncy = cells.ncy
+    cx = c % ncx
+    cyz = c // ncx
+    cy = cyz % ncy
+    cz = cyz // ncy
+    return (max(cx - r, 0), min(cx + r, ncx - 1), max(cy - r, 0), min(cy + r, ncy - 1),
+            max(cz - r, 0), min(cz + r, cells.ncz - 1))
 
 
 @njit(cache=True, inline="always")
-def cell_at(x, z, cells):
-    """Cell index of the point (x, z), clamped to the grid."""
+def cell_at(x, y, z, cells):
+    """Cell index of the point (x, y, z), clamped to the grid (y is ignored in 2D)."""
     cx = min(max(int((x - cells.xmin) * cells.inv_cs), 0), cells.ncx - 1)
     cz = min(max(int((z - cells.zmin) * cells.inv_cs), 0), cells.ncz - 1)
-    return cz * cells.ncx + cx
+    if cells.three is None:   # 2D (when compiled)
+        return cz * cells.ncx + cx
+    cy = min(max(int((y - cells.ymin) * cells.inv_cs), 0), cells.ncy - 1)
+    return (cz * cells.ncy + cy) * cells.ncx + cx
 
 
 @njit(parallel=True, cache=True)
 def compute_cells(ps, n, cells):
-    """ps.cell[i] = cz*ncx + cx of particle i (clamped to the grid); inactive -> ncx*ncz."""
+    """ps.cell[i] = cell_at(x, y, z) of particle i (clamped to the grid); inactive -> the extra
+    bin ncx * ncy * ncz."""
     x = ps.x
+    y = ps.y
     z = ps.z
     kind = ps.kind
     cell = ps.cell
-    ncx = cells.ncx
-    ncz = cells.ncz
-    xmin = cells.xmin
-    zmin = cells.zmin
-    inv_cs = cells.inv_cs
-    ncell = ncx * ncz
+    ncell = cells.ncx * cells.ncy * cells.ncz
     for i in prange(n):
         if kind[i] < 0:
             cell[i] = ncell
         else:
-            cx = int((x[i] - xmin) * inv_cs)
-            cz = int((z[i] - zmin) * inv_cs)
-            cx = min(max(cx, 0), ncx - 1)
-            cz = min(max(cz, 0), ncz - 1)
-            cell[i] = cz * ncx + cx
+            cell[i] = cell_at(x[i], y[i], z[i], cells)
 
 
 # Parallel loops below split their work into a fixed number of pieces, not one per thread:
@@ -119,7 +133,7 @@ def counting_sort(cell, n, cells):
 
 @njit(cache=True)
 def _counting_sort_serial(cell, n, cells):
-    ncell = cells.ncx * cells.ncz
+    ncell = cells.ncx * cells.ncy * cells.ncz
     cell_start = cells.start
     cursor = cells.cursor
     order = cells.order
@@ -143,7 +157,7 @@ def _counting_sort_chunks(cell, n, cells, nt):
     it touches (lo[t]..hi[t]); a bin's slots go chunk by chunk, so the order is the serial one.
     Returns False, having written nothing, when the spans together exceed 2 (nbins + n) (an
     unsorted set: the first sort, appended inflow): the caller then sorts serially."""
-    ncell = cells.ncx * cells.ncz
+    ncell = cells.ncx * cells.ncy * cells.ncz
     nb = ncell + 1                      # bins: the cells and the inactive bin
     start = cells.start
     order = cells.order
@@ -257,8 +271,9 @@ def kind_ranges(kind, n, k, nr):
 
 
 @njit(parallel=True, cache=True)
-def permute(ps, ps2, nrows, order, n):
-    """Gather particle k of the sorted set from slot order[k] into the twin buffer."""
+def permute(ps, ps2, nrows, order, n, ny=0):
+    """Gather particle k of the sorted set from slot order[k] into the twin buffer: rows
+    [0, nrows) and the first ``ny`` y rows (particles.Y on; 0 in a 2D scene)."""
     f = ps.f
     f2 = ps2.f
     kind = ps.kind
@@ -271,6 +286,8 @@ def permute(ps, ps2, nrows, order, n):
         i = order[k]
         for r in range(nrows):
             f2[r, k] = f[r, i]
+        for r in range(Y, Y + ny):
+            f2[r, k] = f[r, i]
         kind2[k] = kind[i]
         ids2[k] = ids[i]
         cell2[k] = cell[i]
@@ -279,14 +296,22 @@ def permute(ps, ps2, nrows, order, n):
 @njit(cache=True)
 def sort_by_cell(ps, ps2, nrows, n, cells):
     """Bin, counting-sort and gather the first ``nrows`` rows of all particles into the twin
-    buffer ``ps2`` (the caller swaps); returns the slots in use after it (inactive ones dropped)."""
+    buffer ``ps2`` (the caller swaps), in a 3D scene their y rows too (N_SORTED_Y_KDK or
+    N_SORTED_Y_PC with N_SORTED_PC); returns the slots in use after it (inactive ones
+    dropped)."""
     compute_cells(ps, n, cells)
     counting_sort(ps.cell, n, cells)
-    permute(ps, ps2, nrows, cells.order, n)
-    return cells.start[cells.ncx * cells.ncz]
+    ny = 0
+    if cells.three is not None:
+        ny = N_SORTED_Y_PC if nrows >= N_SORTED_PC else N_SORTED_Y_KDK
+    permute(ps, ps2, nrows, cells.order, n, ny)
+    return cells.start[cells.ncx * cells.ncy * cells.ncz]
 
 
-def brute_force_neighbours(x: np.ndarray, z: np.ndarray, radius: float) -> list[set[int]]:
+def brute_force_neighbours(x: np.ndarray, z: np.ndarray, radius: float,
+                           y: np.ndarray | None = None) -> list[set[int]]:
     """Reference O(N^2) neighbour sets (for tests)."""
     d2 = (x[:, None] - x[None, :]) ** 2 + (z[:, None] - z[None, :]) ** 2
+    if y is not None:
+        d2 += (y[:, None] - y[None, :]) ** 2
     return [set(np.nonzero((row < radius * radius))[0].tolist()) - {i} for i, row in enumerate(d2)]

@@ -210,11 +210,13 @@ def buffer_update(ps, n, dt, r, zs0, du0, zs1, du1, ends, prm):
     # the rows written as locals (``ps.x[i] = ...`` inside a prange writes nothing, numba 0.68.1)
     x = ps.x
     vx = ps.vx
+    vy = ps.vy
     vz = ps.vz
     rho_ = ps.rho
     p = ps.p
     drho = ps.drho
     ax = ps.ax
+    ay = ps.ay
     az = ps.az
     kind = ps.kind
     for i in prange(n):
@@ -222,6 +224,7 @@ def buffer_update(ps, n, dt, r, zs0, du0, zs1, du1, ends, prm):
         if b < 0:
             continue
         vx[i] = u
+        vy[i] = 0.0     # long-crested: the boundary data has no y component (3D scenes)
         vz[i] = w
         x[i] = xi
         kind[i] = k
@@ -229,6 +232,7 @@ def buffer_update(ps, n, dt, r, zs0, du0, zs1, du1, ends, prm):
         p[i] = pi
         drho[i] = 0.0
         ax[i] = 0.0
+        ay[i] = 0.0
         az[i] = 0.0
 
 
@@ -325,7 +329,7 @@ def update_buffers(ps, n, t1, dt, ends, prm):
 
 
 @njit(cache=True, inline="always")
-def _ghost_pair(i, j, dx, dz, r2, ps, ctx, a):
+def _ghost_pair(i, j, dx, dy, dz, r2, ps, ctx, a):
     """The moment sums of ghost_pressure (in its order a00 a01 a02 a10 a11 a12 a20 a21 a22 b0 b1
     b2) for fluid neighbour j of the node; ctx = (h, alpha_w, alpha_f)."""
     h = ctx[0]
@@ -345,8 +349,8 @@ def _ghost_pair(i, j, dx, dz, r2, ps, ctx, a):
 
 
 @njit(cache=True, inline="always")
-def ghost_pressure(ps, cells, xg, zg, prm):
-    """First-order consistent SPH interpolation of the fluid pressure at a ghost node (xg, zg)
+def ghost_pressure(ps, cells, xg, yg, zg, prm):
+    """First-order consistent SPH interpolation of the fluid pressure at a ghost node (xg, yg, zg)
     (Liu & Liu 2006; Tafuni et al. 2018, eq. 13): with r_j = (x_j - xg, z_j - zg), V_j = m_j/rho_j,
     the Taylor series p_j = p_g + r_j . grad p_g tested with W_gj and grad W_gj = F_gj r_j gives
         sum_j V_j [W, F x_j, F z_j]^T [1, x_j, z_j] (p_g, p_x, p_z)^T
@@ -354,9 +358,10 @@ def ghost_pressure(ps, cells, xg, zg, prm):
     over fluid particles j; a linear field is reproduced exactly. Solved in h-scaled form (the
     matrix is the identity for a full, regular support). Returns (p_g, p_x, p_z, order): order 1
     if the determinant exceeds GHOST_DET_MIN, 0 for the Shepard value sum V W p / sum V W with no
-    gradient, -1 if the node has no fluid neighbour."""
+    gradient, -1 if the node has no fluid neighbour. In 3D (long-crested boundary data) the
+    same fit in x and z over the node's 3D support: the pressure does not vary across y."""
     h = prm.h
-    s = gather(-1, xg, zg, cell_at(xg, zg, cells), ps, cells, 4.0 * h * h, fluid_only,
+    s = gather(-1, xg, yg, zg, cell_at(xg, yg, zg, cells), ps, cells, 4.0 * h * h, fluid_only,
                _ghost_pair, (h, prm.alpha_w, prm.alpha_f),
                (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0))
     a00, a01, a02, a10, a11, a12, a20, a21, a22, b0, b1, b2 = s
@@ -409,7 +414,7 @@ def extrapolated_state(i, ps, cells, ends, prm):
         return False, 0.0, 0.0
     xi = ps.x[i]
     xg = 2.0 * ends.x_face[b] - xi
-    pg, px, pz, order = ghost_pressure(ps, cells, xg, zi, prm)
+    pg, px, pz, order = ghost_pressure(ps, cells, xg, ps.y[i], zi, prm)
     if order < 0:
         return False, 0.0, 0.0
     p = max(pg + (xi - xg) * px, 0.0)
@@ -425,10 +430,11 @@ def extrapolate_buffers(ps, n, cells, ends, prm):
 
 
 @njit(cache=True, inline="always")
-def line_density(ps, cells, xp, zk, prm):
-    """sum_j m_j W(x - x_j) at (xp, zk) over fluid and active buffer particles (a gauge point)."""
+def line_density(ps, cells, xp, yp, zk, prm):
+    """sum_j m_j W(x - x_j) at (xp, yp, zk) over fluid and active buffer particles (a gauge
+    point)."""
     h = prm.h
-    return gather(-1, xp, zk, cell_at(xp, zk, cells), ps, cells, 4.0 * h * h, fluidlike,
+    return gather(-1, xp, yp, zk, cell_at(xp, yp, zk, cells), ps, cells, 4.0 * h * h, fluidlike,
                   mass_pair, (h, prm.alpha_w), 0.0)
 
 
@@ -448,8 +454,8 @@ def crossing(k, nz, zk, s, prev, dz, level):
 
 
 @njit(cache=True)
-def surface_z(ps, cells, xp, z_lo, z_hi, dz, prm):
-    """Free-surface height at x = xp by the vertical-line method (seed 004, eq. 23):
+def surface_z(ps, cells, xp, yp, z_lo, z_hi, dz, prm):
+    """Free-surface height at (xp, yp) by the vertical-line method (seed 004, eq. 23):
     rho_f(z) = sum_j m_j W(x - x_j) over fluid and active buffer particles on points z_lo + k dz;
     the surface is the highest z where rho_f falls through rho0/2 (linear between points).
     Returns NaN when no point reaches rho0/2 (dry)."""
@@ -458,7 +464,7 @@ def surface_z(ps, cells, xp, z_lo, z_hi, dz, prm):
     prev = 0.0
     for k in range(nz - 1, -1, -1):
         zk = z_lo + k * dz
-        s = line_density(ps, cells, xp, zk, prm)
+        s = line_density(ps, cells, xp, yp, zk, prm)
         if s >= level:
             return crossing(k, nz, zk, s, prev, dz, level)
         prev = s
@@ -473,6 +479,6 @@ def measure_boundaries(ps, cells, ends, prm):
         return
     for b in range(2):
         if ends.on[b]:
-            zsurf = surface_z(ps, cells, ends.x_gauge[b], ends.z_bed[b], ends.z_top[b],
-                              ends.dz_gauge, prm)
+            zsurf = surface_z(ps, cells, ends.x_gauge[b], ends.y_gauge, ends.z_bed[b],
+                              ends.z_top[b], ends.dz_gauge, prm)
             ends.eta_meas[b] = zsurf - ends.swl[b]

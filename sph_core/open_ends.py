@@ -29,7 +29,7 @@ from .boundary_data import (BoundaryData, BoundaryDataError, BoundaryNodes, Boun
                             still_sample, validate_sample)
 from .eos import GAMMA, hydrostatic_density
 from .open_boundary import INLET_IDLE
-from .particles import INLET, M, P, RHO, WALL, X, Z, ParticleSet
+from .particles import INLET, M, P, RHO, WALL, X, Y, Z, ParticleSet
 from .scene import (INLET_PRESSURE, ISPH_INLET_PRESSURE, OUTLET_PRESSURE, OpenBoundary,
                     Scene)
 from .state import OpenEnds, closed_ends
@@ -142,7 +142,9 @@ class OpenBoundaries:
         for b in range(2):  # an end without boundary keeps valid (unused) node levels
             if not e.on[b]:
                 e.zn[b] = e.zn[1 - b]
-        e = e._replace(active=True, dz_gauge=0.25 * dp, dp=dp)
+        # 3D: long-crested boundary data, the gauges' lines at mid-width
+        y_gauge = 0.5 * (scene.tank.y0 + scene.tank.y1) if scene.dim == 3 else 0.0
+        e = e._replace(active=True, dz_gauge=0.25 * dp, dp=dp, y_gauge=y_gauge)
         return cls(sides, nodes, sources, window, e, swl)
 
     # ---------------------------------------------------------------- setup
@@ -159,19 +161,22 @@ class OpenBoundaries:
         tank, dp, c = scene.tank, scene.dp, scene.constants
         self.ends.length[:] = buffer_length
         n = ps.n
-        x, z, kind = ps.f[X, :n], ps.f[Z, :n], ps.kind[:n]
+        x, y, z, kind = ps.f[X, :n], ps.f[Y, :n], ps.f[Z, :n], ps.kind[:n]
+        # 3D: only the columns across the tank's width; those beyond it (the edges of the x
+        # walls) stay walls, the side walls of the buffer
+        across = (y > tank.y0) & (y < tank.y1) if scene.dim == 3 else np.ones(n, dtype=bool)
         for side in self.sides:
             b = SIDES.index(side)
             xf, nx = self.ends.x_face[b], self.ends.nx[b]
             # the wall columns outside this face (above the floor) become the buffer lattice
-            sel = np.nonzero((kind == WALL) & ((x - xf) * nx > 0) & (z > tank.z0))[0]
+            sel = np.nonzero((kind == WALL) & ((x - xf) * nx > 0) & (z > tank.z0) & across)[0]
             wet = z[sel] < self.swl
             kind[sel] = np.where(wet, INLET + b, INLET_IDLE + b)
             rho = np.where(wet, hydrostatic_density(z[sel], self.swl, c.rho0, c.g, b_tait),
                            c.rho0)
             ps.f[RHO, sel] = rho
             ps.f[P, sel] = b_tait * ((rho / c.rho0) ** GAMMA - 1.0)
-            ps.f[M, sel] = rho * dp * dp
+            ps.f[M, sel] = rho * dp ** scene.dim
 
     def fluid_box(self, x0: float, x1: float, dp: float) -> tuple[float, float]:
         """x range a fluid particle may reach: fluid may enter a buffer before it is converted."""

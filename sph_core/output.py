@@ -93,15 +93,17 @@ class RunWriter:
         self._csv.writerow(row)
         self._csv_file.flush()
 
-    def snapshot(self, t: float, x: np.ndarray, z: np.ndarray, data: dict[str, Any]) -> Path:
+    def snapshot(self, t: float, x: np.ndarray, z: np.ndarray, data: dict[str, Any],
+                 y: np.ndarray | None = None) -> Path:
         """Particles as VTK unstructured points (.vtu) plus a ParaView collection (run.pvd);
-        a tuple value of ``data`` is a vector field (x, y, z components)."""
+        a tuple value of ``data`` is a vector field (x, y, z components); y None: the x-z plane."""
         from pyevtk.hl import pointsToVTK
 
         k = len(self.snapshots)
         stem = self.dir / "snapshots" / f"particles_{k:05d}"
-        y = np.zeros_like(x)
-        path = pointsToVTK(str(stem), np.ascontiguousarray(x), y, np.ascontiguousarray(z),
+        y = np.zeros_like(x) if y is None else y
+        path = pointsToVTK(str(stem), np.ascontiguousarray(x), np.ascontiguousarray(y),
+                           np.ascontiguousarray(z),
                            data={key: (tuple(np.ascontiguousarray(c) for c in v)
                                        if isinstance(v, tuple) else np.ascontiguousarray(v))
                                  for key, v in data.items()})
@@ -113,16 +115,20 @@ class RunWriter:
         tmp = self.dir / "run.pvd.tmp"
         tmp.write_text(pvd)
         os.replace(tmp, self.dir / "run.pvd")
-        self._last_snapshot(t, x, z, data)
+        self._last_snapshot(t, x, z, data, y)
         return Path(path)
 
-    def _last_snapshot(self, t: float, x: np.ndarray, z: np.ndarray, data: dict[str, Any]) -> None:
+    def _last_snapshot(self, t: float, x: np.ndarray, z: np.ndarray, data: dict[str, Any],
+                       y: np.ndarray) -> None:
         """snapshots/last.npz: the newest snapshot's positions, pressure, speed and kind in
         float32, for the run monitor's particle scatter (GET /runs/{id}/particles); replaced
-        atomically, so a reader never sees half a file."""
+        atomically, so a reader never sees half a file. (A 3D run's monitor shows the x-z slice
+        of width 2h about a y: its y and h are stored too.)"""
         tmp = self.dir / "snapshots" / "last.npz.tmp"
+        h = np.asarray(data.get("h", [0.0]))
         with open(tmp, "wb") as fh:
             np.savez(fh, t=np.float64(t), x=x.astype(np.float32), z=z.astype(np.float32),
+                     y=y.astype(np.float32), h=np.float64(h[0] if h.size else 0.0),
                      pressure=np.asarray(data["pressure"], np.float32),
                      speed=np.asarray(data["speed"], np.float32),
                      kind=np.asarray(data["kind"], np.int8))
@@ -136,26 +142,47 @@ class RunWriter:
 def write_geometry_vtk(scene: Any, path: Path) -> Path:
     """The scene's outlines as VTK line cells (``path`` without suffix; returns the .vtu): the
     tank's inner faces, each bed's polyline, each structure's rectangle, each open end's face,
-    one two-point cell per segment. Cell data ``part``: 0 tank, 1 bed, 2 structure, 3 open end.
-    (Poly-line cells, VTK type 4, opened in ParaView but not in meshio 5.)"""
+    one two-point cell per segment (a 3D scene: the edges of the tank's and structures' boxes,
+    the beds' polylines on both side walls and across). Cell data ``part``: 0 tank, 1 bed,
+    2 structure, 3 open end. (Poly-line cells, VTK type 4, opened in ParaView but not in
+    meshio 5.)"""
     from pyevtk.hl import unstructuredGridToVTK
     from pyevtk.vtk import VtkLine
 
     t = scene.tank
-    lines: list[tuple[list[tuple[float, float]], int]] = [
-        ([(t.x0, t.z1), (t.x0, t.z0), (t.x1, t.z0), (t.x1, t.z1)], 0)]
-    lines += [([tuple(p) for p in bed.points], 1) for bed in scene.beds]
-    lines += [([(s.x0, s.z0), (s.x1, s.z0), (s.x1, s.z1), (s.x0, s.z1), (s.x0, s.z0)], 2)
-              for s in scene.structures]
+    P = tuple[float, float, float]
+    segments: list[tuple[P, P, int]] = []
+
+    def poly(pts: list[tuple[float, float]], part: int, y: float = 0.0) -> None:
+        segments.extend(((a[0], y, a[1]), (b[0], y, b[1]), part) for a, b in zip(pts[:-1], pts[1:]))
+
+    def box(r: Any, part: int) -> None:
+        for y in (r.y0, r.y1):
+            poly([(r.x0, r.z0), (r.x1, r.z0), (r.x1, r.z1), (r.x0, r.z1), (r.x0, r.z0)], part, y)
+        segments.extend(((x, r.y0, z), (x, r.y1, z), part) for x in (r.x0, r.x1) for z in (r.z0, r.z1))
+
+    if scene.dim == 3:
+        box(t, 0)
+        for bed in scene.beds:
+            for y in (t.y0, t.y1):
+                poly([tuple(p) for p in bed.points], 1, y)
+            segments.extend(((p[0], t.y0, p[1]), (p[0], t.y1, p[1]), 1) for p in bed.points)
+        for s in scene.structures:
+            box(s, 2)
+    else:
+        poly([(t.x0, t.z1), (t.x0, t.z0), (t.x1, t.z0), (t.x1, t.z1)], 0)
+        for bed in scene.beds:
+            poly([tuple(p) for p in bed.points], 1)
+        for s in scene.structures:
+            poly([(s.x0, s.z0), (s.x1, s.z0), (s.x1, s.z1), (s.x0, s.z1), (s.x0, s.z0)], 2)
     top = scene.still_water_level if scene.still_water_level is not None else t.z1
-    lines += [([(x, t.z0), (x, top)], 3)
-              for x in (t.x0 if o.side == "left" else t.x1 for o in scene.open_boundaries)]
-    segments = [(a, b, part) for pts, part in lines for a, b in zip(pts[:-1], pts[1:])]
-    x = np.array([p[0] for a, b, _ in segments for p in (a, b)], dtype=float)
-    z = np.array([p[1] for a, b, _ in segments for p in (a, b)], dtype=float)
+    for x in (t.x0 if o.side == "left" else t.x1 for o in scene.open_boundaries):
+        poly([(x, t.z0), (x, top)], 3)
+    pts = np.array([p for a, b, _ in segments for p in (a, b)], dtype=float)
     n = len(segments)   # pyevtk's linesToVTK writes NumberOfCells="5.0", which meshio refuses
     out = unstructuredGridToVTK(
-        str(path), x, np.zeros_like(x), z, connectivity=np.arange(2 * n, dtype=np.int64),
+        str(path), np.ascontiguousarray(pts[:, 0]), np.ascontiguousarray(pts[:, 1]),
+        np.ascontiguousarray(pts[:, 2]), connectivity=np.arange(2 * n, dtype=np.int64),
         offsets=2 * np.arange(1, n + 1, dtype=np.int64),
         cell_types=np.full(n, VtkLine.tid, dtype=np.uint8),
         cellData={"part": np.array([k for _, _, k in segments], dtype=np.int32)})

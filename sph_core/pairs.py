@@ -1,13 +1,18 @@
 """The one neighbour walk of the solver, and the particle-kind selectors it filters with.
 
-    acc = gather(i, xi, zi, c, ps, cells, s2, select, term, ctx, acc)
+    acc = gather(i, xi, yi, zi, c, ps, cells, s2, select, term, ctx, acc)
 
 visits every slot j != i in the cell block around cell ``c`` whose kind passes
-``select(kind_j)`` and that lies within sqrt(s2) of (xi, zi), and folds it into the
-accumulator with ``acc = term(i, j, dx, dz, r2, ps, ctx, acc)``, where dx = xi - x_j,
-dz = zi - z_j, r2 = dx^2 + dz^2. ``i`` is the walking particle's slot, or -1 around a point
-(probes, boundary gauges); ``ctx`` is whatever the term reads besides the particles (Params,
-a tuple of per-particle values, ...); ``acc`` a number or a NamedTuple of numbers.
+``select(kind_j)`` and that lies within sqrt(s2) of (xi, yi, zi), and folds it into the
+accumulator with ``acc = term(i, j, dx, dy, dz, r2, ps, ctx, acc)``, where dx = xi - x_j,
+dy = yi - y_j, dz = zi - z_j, r2 = dx^2 + dy^2 + dz^2. ``i`` is the walking particle's slot,
+or -1 around a point (probes, boundary gauges); ``ctx`` is whatever the term reads besides the
+particles (Params, a tuple of per-particle values, ...); ``acc`` a number or a NamedTuple of
+numbers.
+
+Dimensions: every term is written once for three components. A 2D scene (one layer of cells
+in y, ``cells.three`` None: a type, so decided when compiled) walks one layer and gets dy = the
+constant 0 without reading y, so its sums are the 2D sums (to the sign of a zero).
 
 Every pass that needs neighbours (wcsph, riemann, renormalisation, shifting, isph, bodies,
 probes, open ends) walks through ``gather``; the per-pair physics lives in ``terms.py``.
@@ -17,8 +22,8 @@ loop is the hand-written one (same code, same speed; bench/refactor_check.py che
 results are bit-identical), and every pass stays a module-level ``cache=True`` function whose
 cache a second process loads.
 
-Cells (neighbours.py): cell c = cz * ncx + cx holds slots start[c]:start[c + 1]; the block
-within reach of a cell is (2 reach + 1) rows of contiguous slot runs (``block_of``).
+Cells (neighbours.py): cell c = (cz * ncy + cy) * ncx + cx holds slots start[c]:start[c + 1];
+the block within reach of a cell is rows of contiguous slot runs (``block_of``).
 """
 
 from __future__ import annotations
@@ -30,24 +35,30 @@ from .particles import FLUID, INLET, OUTLET, WALL
 
 
 @njit(cache=True, inline="always")
-def gather(i, xi, zi, c, ps, cells, s2, select, term, ctx, acc):
-    """Fold ``term`` over the neighbours of (xi, zi) in cell ``c``'s block (module docstring)."""
+def gather(i, xi, yi, zi, c, ps, cells, s2, select, term, ctx, acc):
+    """Fold ``term`` over the neighbours of (xi, yi, zi) in cell ``c``'s block (module
+    docstring)."""
     x = ps.x
+    y = ps.y
     z = ps.z
     kind = ps.kind
     start = cells.start
     ncx = cells.ncx
-    cxl, cxh, czl, czh = block_of(c, cells)
+    ncy = cells.ncy
+    cxl, cxh, cyl, cyh, czl, czh = block_of(c, cells)
     for zz in range(czl, czh + 1):
-        row = zz * ncx
-        for j in range(start[row + cxl], start[row + cxh + 1]):
-            if j == i or not select(kind[j]):
-                continue
-            dx = xi - x[j]
-            dz = zi - z[j]
-            r2 = dx * dx + dz * dz
-            if r2 < s2:
-                acc = term(i, j, dx, dz, r2, ps, ctx, acc)
+        for yy in range(cyl, cyh + 1):
+            row = (zz * ncy + yy) * ncx   # (2D: ncy = 1, yy = 0)
+            for j in range(start[row + cxl], start[row + cxh + 1]):
+                if j == i or not select(kind[j]):
+                    continue
+                dx = xi - x[j]
+                dz = zi - z[j]
+                # a 2D grid (cells.three None, decided when compiled): dy is the constant 0
+                dy = 0.0 if cells.three is None else yi - y[j]
+                r2 = dx * dx + dy * dy + dz * dz
+                if r2 < s2:
+                    acc = term(i, j, dx, dy, dz, r2, ps, ctx, acc)
     return acc
 
 

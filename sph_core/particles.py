@@ -7,8 +7,12 @@ or, with the scene's ``constants.precision = "float32"``, float32;
 buffer: reordering by cell gathers into the twin and the two are swapped, so nothing is
 allocated per step. ``view`` / ``view2`` are the kernels' typed views (``state.Particles``).
 
-Row layout (2D). The first ``N_SORTED_*`` rows are carried through a reorder; the others are
-recomputed after it. A 3D build adds Y, VY, AY, VWY rows; kernels name rows, never positions.
+Row layout. The first ``N_SORTED_*`` rows are carried through a reorder, and in a 3D scene the
+first ``N_SORTED_Y_*`` of the y rows from ``Y`` on too; the others are recomputed after it. Every
+particle has three components (x, y, z): a 2D scene (the vertical plane x-z) keeps its y rows
+zero, never sorts or reads them, and every term it adds is exactly zero. The y rows come last,
+so a 2D particle's rows 0..25 are those of the 2D-only layout (and its checkpoints). Kernels
+name rows, never positions.
 """
 
 from __future__ import annotations
@@ -31,7 +35,7 @@ X, Z, VX, VZ, AX, AZ, RHO, P, M = range(9)
 XN, ZN, VXN, VZN, RHON = range(9, 14)
 # recomputed after every reorder: density rate, wall velocity for viscous terms (Adami no-slip)
 DRHO, VWX, VWZ = range(14, 17)
-# Riemann SPH with MUSCL (riemann.py): gradients of p, vx, vz of fluid and buffer particles,
+# Riemann SPH with MUSCL (riemann.py, 2D): gradients of p, vx, vz of fluid and buffer particles,
 # recomputed before every force pass
 GPX, GPZ, GUX, GUZ, GWX, GWZ = range(17, 23)
 # no-penetration velocity correction of fluid particles at a wall face (wall_contact.py),
@@ -40,13 +44,19 @@ DVNX, DVNZ = range(23, 25)
 # fluid: the pressure its wall neighbours feel from it, p or max(p, 0) (wcsph.fluid_pass), read
 # by the body loads so they are the reaction of what the fluid felt (not carried by a sort)
 PW = 25
-N_FIELDS = 26
+# the y components (3D scenes; zero in 2D): carried y, vy, ay (and yn, vyn of the
+# predictor-corrector), recomputed vwy, dvny
+Y, VY, AY, YN, VYN, VWY, DVNY = range(26, 33)
+N_FIELDS = 33
 N_SORTED_KDK = 9
 N_SORTED_PC = 14
+N_SORTED_Y_KDK = 3     # y, vy, ay
+N_SORTED_Y_PC = 5      # ... yn, vyn
 
 FIELD_NAMES = ("x", "z", "vx", "vz", "ax", "az", "rho", "p", "m",
                "xn", "zn", "vxn", "vzn", "rhon", "drho", "vwx", "vwz",
-               "gpx", "gpz", "gux", "guz", "gwx", "gwz", "dvnx", "dvnz", "pw")
+               "gpx", "gpz", "gux", "guz", "gwx", "gwz", "dvnx", "dvnz", "pw",
+               "y", "vy", "ay", "yn", "vyn", "vwy", "dvny")
 
 
 @dataclass
@@ -94,8 +104,9 @@ class ParticleSet:
         self.view = particles_view(self.f, self.kind, self.ids, self.cell)
         self.view2 = particles_view(self.f2, self.kind2, self.ids2, self.cell2)
 
-    def add(self, x: np.ndarray, z: np.ndarray, kind: int, rho: np.ndarray, mass: np.ndarray) -> np.ndarray:
-        """Append particles at rest; return their ids."""
+    def add(self, x: np.ndarray, z: np.ndarray, kind: int, rho: np.ndarray, mass: np.ndarray,
+            y: np.ndarray | float = 0.0) -> np.ndarray:
+        """Append particles at rest at (x, y, z) (y 0: a 2D scene); return their ids."""
         x = np.asarray(x, dtype=float)
         k = x.size
         if self.n + k > self.capacity:
@@ -103,6 +114,7 @@ class ParticleSet:
         s = slice(self.n, self.n + k)
         self.f[:, s] = 0.0
         self.f[X, s] = x
+        self.f[Y, s] = y
         self.f[Z, s] = z
         self.f[RHO, s] = rho
         self.f[M, s] = mass
@@ -141,7 +153,7 @@ class ParticleSet:
             raise ValueError("checkpoint: more particles than this set's capacity")
         rows = c.f.shape[0]
         # a checkpoint of an older version has fewer rows: the ones it lacks are per-step
-        # scratch (gradients, correction matrices), recomputed before they are read
+        # scratch (gradients, correction matrices) or the y rows of a 2D run, zero
         if not N_SORTED_PC <= rows <= N_FIELDS:
             raise ValueError(f"checkpoint: {rows} particle fields, this version reads "
                              f"{N_SORTED_PC}..{N_FIELDS}")

@@ -92,7 +92,7 @@ MOMENTS_ZERO = Moments(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.
 
 
 @njit(cache=True, inline="always")
-def moments_pair(i, j, dx, dz, r2, ps, ctx, a):
+def moments_pair(i, j, dx, dy, dz, r2, ps, ctx, a):
     """One neighbour's share of the sums of ``moments``; ctx as built there."""
     c = ctx
     wall = ps.kind[j] == WALL
@@ -139,7 +139,7 @@ def moments(i, ps, cells, prm, phi, u, w, suction_walls):
     the air side of a wetted wall). ``phi``, ``u``, ``w`` are particle rows (any, when unused)."""
     ctx = MomentsCtx(1.0 / prm.h, prm.alpha_f, prm.alpha_w, prm.shift_inv_wdp, phi, u, w, phi[i],
                      u[i], w[i], suction_walls)
-    return gather(i, ps.x[i], ps.z[i], ps.cell[i], ps, cells, 4.0 * prm.h * prm.h, interacting,
+    return gather(i, ps.x[i], ps.y[i], ps.z[i], ps.cell[i], ps, cells, 4.0 * prm.h * prm.h, interacting,
                   moments_pair, ctx, MOMENTS_ZERO)
 
 

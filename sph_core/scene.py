@@ -1,7 +1,10 @@
 """Scene description: a validated tank configuration, from TOML or Python objects.
 
 Coordinates are absolute (SPH datum): x to the right, z up, the tank floor usually at z = 0.
-Rectangles are given by their corners (x0, x1, z0, z1) in metres. Unknown keys are errors
+Rectangles are given by their corners (x0, x1, z0, z1) in metres. A 2D scene (``dim = 2``, the
+default) is the vertical plane x-z; a 3D scene (``dim = 3``) adds y across the tank, and its
+tank, water blocks, structures and force probes are boxes (x0, x1, y0, y1, z0, z1; a block,
+structure or probe without y0, y1 spans the tank's width). Unknown keys are errors
 (``extra="forbid"``), and every error names its field path, e.g.
 ``water_blocks.0.z1: must be greater than z0``.
 """
@@ -68,12 +71,15 @@ class _Model(BaseModel):
 
 
 class Rect(_Model):
-    """Axis-aligned rectangle [x0, x1] x [z0, z1] [m]."""
+    """Axis-aligned rectangle [x0, x1] x [z0, z1] [m]; in a 3D scene the box [x0, x1] x
+    [y0, y1] x [z0, z1] (y0, y1 None: across the whole tank)."""
 
     x0: float
     x1: float
     z0: float
     z1: float
+    y0: float | None = Field(None, description="3D scenes: the box's y range [m] (None: the tank's)")
+    y1: float | None = None
 
     @model_validator(mode="after")
     def _ordered(self) -> "Rect":
@@ -81,6 +87,10 @@ class Rect(_Model):
             raise ValueError("x1: must be greater than x0")
         if not self.z1 > self.z0:
             raise ValueError("z1: must be greater than z0")
+        if (self.y0 is None) != (self.y1 is None):
+            raise ValueError("y1: give both y0 and y1, or neither")
+        if self.y0 is not None and not self.y1 > self.y0:
+            raise ValueError("y1: must be greater than y0")
         return self
 
 
@@ -308,6 +318,7 @@ class PointProbe(_Model):
     name: str = Field(min_length=1)
     x: float
     z: float
+    y: float = Field(0.0, description="3D scenes: y of the point [m]")
     follow: str | None = Field(None, description=(
         "name of a body: the point(s) move rigidly with it (given at t_start, in scene "
         "coordinates; e.g. a pressure line on a moving hull)"))
@@ -319,6 +330,7 @@ class ElevationProbe(_Model):
     kind: Literal["elevation"]
     name: str = Field(min_length=1)
     x: float
+    y: float = Field(0.0, description="3D scenes: y of the vertical line [m]")
     threshold: float = Field(0.5, gt=0, lt=1, description="surface where sum(m W) < threshold*rho0")
 
 
@@ -351,8 +363,10 @@ class RunupProbe(_Model):
 
 
 class ForceProbe(Rect):
-    """Force and moment per metre of width that the fluid exerts on the wall, bed or structure
-    particles whose centres lie in the rectangle [x0, x1] x [z0, z1]: the reaction of the
+    """Force and moment per metre of width (3D: force [N] and moment [N m], with the extra
+    columns <name>_fy, <name>_mx, <name>_mz, in a box [x0, x1] x [y0, y1] x [z0, z1]) that the
+    fluid exerts on the wall, bed or structure particles whose centres lie in the rectangle
+    [x0, x1] x [z0, z1]: the reaction of the
     pressure pair forces those particles exert on the fluid (wcsph.fluid_pass),
     F = -sum_s sum_f m_f m_s (p_f + p_s)/(rho_f rho_s) F_fs (r_f - r_s), and the moment
     M = sum_s (z_s - z_m) F_x,s - (x_s - x_m) F_z,s about ``moment_about`` (x_m, z_m) [N m/m],
@@ -362,8 +376,19 @@ class ForceProbe(Rect):
 
     kind: Literal["force"]
     name: str = Field(min_length=1)
-    moment_about: tuple[float, float] | None = Field(
-        None, description="(x, z) of the moment's axis [m]; default (x-centre of the box, z0)")
+    moment_about: tuple[float, float] | tuple[float, float, float] | None = Field(
+        None, description="(x, z) of the moment's axis [m] (3D: (x, y, z), the point the "
+                          "moments are taken about); default the box's bottom centre")
+
+    def axis(self) -> tuple[float, float, float]:
+        """(x, y, z) the moments are taken about [m]."""
+        m = self.moment_about
+        if m is None:
+            yc = 0.0 if self.y0 is None else 0.5 * (self.y0 + self.y1)
+            return 0.5 * (self.x0 + self.x1), yc, self.z0
+        if len(m) == 2:
+            return m[0], 0.0, m[1]
+        return m[0], m[1], m[2]
 
 
 class PressureLineProbe(_Model):
@@ -375,6 +400,7 @@ class PressureLineProbe(_Model):
     kind: Literal["pressure_line"]
     name: str = Field(min_length=1)
     points: list[tuple[float, float]] = Field(min_length=1, description="(x, z) of each point [m]")
+    y: float = Field(0.0, description="3D scenes: y of the line's points [m]")
     follow: str | None = Field(None, description=(
         "name of a body: the point(s) move rigidly with it (given at t_start, in scene "
         "coordinates; e.g. a pressure line on a moving hull)"))
@@ -474,6 +500,8 @@ class Scene(_Model):
     """A complete SPH tank scene."""
 
     name: str = "scene"
+    dim: Literal[2, 3] = Field(2, description=(
+        "2: the vertical plane x-z (per metre of width); 3: x, y, z (the tank a box, y across it)"))
     dp: float = Field(gt=0, description="initial particle spacing [m]")
     t_end: float = Field(gt=0, description="end time [s]")
     # A coupled zone that stays at rest until the far-field waves arrive need not be solved
@@ -508,6 +536,10 @@ class Scene(_Model):
     @model_validator(mode="after")
     def _consistent(self) -> "Scene":
         t = self.tank
+        if self.dim == 3:
+            self._consistent_3d()
+        else:
+            self._flat()
         if not self.t_end > self.t_start:
             raise ValueError(f"t_end: must be after t_start = {self.t_start} s")
         sides = [o.side for o in self.open_boundaries]
@@ -570,6 +602,53 @@ class Scene(_Model):
                 raise ValueError(f"output.{name}: {every:g} s makes more than {MAX_OUTPUTS:,} "
                                  f"outputs of the run's {self.t_end - self.t_start:g} s")
         return self
+
+    def _flat(self) -> None:
+        """A 2D scene names no y."""
+        boxes = ([("tank", self.tank)] + [(f"water_blocks.{i}", b) for i, b in enumerate(self.water_blocks)]
+                 + [(f"structures.{i}", b) for i, b in enumerate(self.structures)]
+                 + [(f"probes.{i}", p) for i, p in enumerate(self.probes) if isinstance(p, Rect)])
+        for where, r in boxes:
+            if r.y0 is not None:
+                raise ValueError(f"{where}.y0: a y range needs a 3D scene (dim = 3)")
+        for i, p in enumerate(self.probes):
+            if getattr(p, "y", 0.0) != 0.0 or len(getattr(p, "moment_about", None) or ()) == 3:
+                raise ValueError(f"probes.{i}: y needs a 3D scene (dim = 3)")
+
+    def _consistent_3d(self) -> None:
+        """A 3D scene: the tank has a y range, every box lies across it, and only the features
+        the 3D step has are asked for (each refusal one line)."""
+        t = self.tank
+        if t.y0 is None:
+            raise ValueError("tank.y0: a 3D scene's tank needs y0 and y1 (its width) [m]")
+        if (t.y1 - t.y0) < 2.0 * self.dp:
+            raise ValueError("tank.y1: the tank must be at least 2 dp wide")
+        named = ([(f"water_blocks.{i}", b) for i, b in enumerate(self.water_blocks)]
+                 + [(f"structures.{i}", b) for i, b in enumerate(self.structures)]
+                 + [(f"probes.{i}", p) for i, p in enumerate(self.probes) if isinstance(p, Rect)])
+        for where, r in named:
+            if r.y0 is None:   # across the tank
+                object.__setattr__(r, "y0", t.y0)
+                object.__setattr__(r, "y1", t.y1)
+                r.model_fields_set.update({"y0", "y1"})
+            elif where.startswith("water_blocks") and (r.y0 < t.y0 - 1e-12 or r.y1 > t.y1 + 1e-12):
+                raise ValueError(f"{where}: must lie inside the tank (y {t.y0}..{t.y1})")
+        for i, p in enumerate(self.probes):
+            y = getattr(p, "y", None)
+            if y is not None and not (t.y0 <= y <= t.y1):
+                raise ValueError(f"probes.{i}.y: must lie inside the tank [{t.y0}, {t.y1}]")
+        refused = {
+            "bodies": bool(self.bodies),
+            "scheme.kind": self.scheme.kind != "wcsph",
+            "constants.shifting": self.constants.shifting != "none",
+            "run.device": self.run.device != "cpu",
+        }
+        for key, asked in refused.items():
+            if asked:
+                raise ValueError(f"{key}: not available in 3D yet (dim = 3 runs WCSPH with "
+                                 "delta-SPH on the CPU: walls, beds, box structures and "
+                                 "open ends with long-crested waves; "
+                                 "docs/developer/three_dimensions.md)")
 
     # derived quantities -------------------------------------------------------------------
     @property

@@ -43,7 +43,7 @@ import math
 from numba import njit, prange
 
 from .pairs import fluid_only, gather, interacting
-from .particles import FLUID, GPX, GWZ, INLET, OUTLET, RHO, RHON, X, XN
+from .particles import FLUID, GPX, GWZ, INLET, OUTLET, RHO, RHON, VZ, X, XN
 from .renormalisation import moments, smallest_eigenvalue, solve
 
 
@@ -94,7 +94,7 @@ def _active_buffer(k):
 
 
 @njit(cache=True, inline="always")
-def _any_pair(i, j, dx, dz, r2, ps, ctx, a):
+def _any_pair(i, j, dx, dy, dz, r2, ps, ctx, a):
     """True once any neighbour has been seen."""
     return True
 
@@ -102,7 +102,7 @@ def _any_pair(i, j, dx, dz, r2, ps, ctx, a):
 @njit(cache=True, inline="always")
 def _near_buffer(i, ps, cells, h):
     """Is an active open-end buffer particle within 2h of particle i?"""
-    return gather(i, ps.x[i], ps.z[i], ps.cell[i], ps, cells, 4.0 * h * h, _active_buffer,
+    return gather(i, ps.x[i], ps.y[i], ps.z[i], ps.cell[i], ps, cells, 4.0 * h * h, _active_buffer,
                   _any_pair, 0, False)
 
 
@@ -118,8 +118,9 @@ def _open_end_limited(i, ps, cells, prm, sx, sz, tangential, nx, nz, max_shift):
 @njit(cache=True, inline="always")
 def move_particle(f, i):
     """x, z, vx, vz += xn, zn, vxn, vzn (rows X..VZ and XN..VZN), rho += rhon of slot i of the
-    storage ``f``: ``_move``'s body, which the CUDA step's kernel calls too."""
-    for r in range(4):
+    storage ``f``: ``_move``'s body, which the CUDA step's kernel calls too. (2D: shifting is
+    refused in 3D scenes.)"""
+    for r in range(VZ - X + 1):
         f[X + r, i] += f[XN + r, i]
     f[RHO, i] += f[RHON, i]
 
@@ -129,7 +130,7 @@ def _move(ps, n):
     """Apply the gathered shifts and carries (rows xn, zn and rhon, vxn, vzn) to every fluid
     particle: a separate loop, so that no particle's sums saw a neighbour already moved."""
     # through the storage f (a local: ``ps.x[i] = ...`` inside a prange writes nothing, numba
-    # 0.68.1): x, z, vx, vz += xn, zn, vxn, vzn (rows X..VZ and XN..VZN), rho += rhon
+    # 0.68.1): rows X..VZ += XN..VZN, rho += rhon
     f = ps.f
     for i in prange(n):
         if ps.kind[i] == FLUID:
@@ -190,7 +191,7 @@ FS_ISOLATED = 2.0
 
 
 @njit(cache=True, inline="always")
-def _scan_pair(i, j, dx, dz, r2, ps, ctx, occupied):
+def _scan_pair(i, j, dx, dy, dz, r2, ps, ctx, occupied):
     """Marrone et al. 2010's scan: is neighbour j in the region around T = r_i + h n, the
     umbrella |e . n| + |e x n| < h (e = r_j - T) within sqrt(2) h of i, else the circle |e| < h?
     ctx = (T_x, T_z, n_x, n_z, h, 2 h^2)."""
@@ -205,7 +206,7 @@ def _scan_pair(i, j, dx, dz, r2, ps, ctx, occupied):
 
 
 @njit(cache=True, inline="always")
-def _surface_pair(i, j, dx, dz, r2, ps, ctx, near):
+def _surface_pair(i, j, dx, dy, dz, r2, ps, ctx, near):
     """Is neighbour j a surface particle (pass 1's flag, in row guz)?"""
     return near or ps.guz[j] == FS_SURFACE
 
@@ -238,7 +239,7 @@ def dplus_surface(i, ps, cells, prm, coef):
         # scan: is any neighbour in the region around T = r_i + h n?
         xi = ps.x[i]
         zi = ps.z[i]
-        occupied = gather(i, xi, zi, ps.cell[i], ps, cells, s2, interacting, _scan_pair,
+        occupied = gather(i, xi, ps.y[i], zi, ps.cell[i], ps, cells, s2, interacting, _scan_pair,
                           (xi + h * nx, zi + h * nz, nx, nz, h, scan2), False)
         if not occupied:
             flag = FS_SURFACE
@@ -253,7 +254,7 @@ def dplus_tangential(i, ps, cells, prm):
     h = prm.h
     near = ps.guz[i] == FS_SURFACE
     if not near:
-        near = gather(i, ps.x[i], ps.z[i], ps.cell[i], ps, cells, 4.0 * h * h, fluid_only,
+        near = gather(i, ps.x[i], ps.y[i], ps.z[i], ps.cell[i], ps, cells, 4.0 * h * h, fluid_only,
                       _surface_pair, 0, False)
     sx, sz = _open_end_limited(i, ps, cells, prm, ps.xn[i], ps.zn[i], near, ps.gpx[i], ps.gpz[i],
                                0.05 * h)

@@ -48,7 +48,8 @@ from .load_probes import LoadProbes
 from .open_boundary import INLET_IDLE
 from .open_ends import OpenBoundaries
 from .output import RunWriter
-from .particles import FLUID, INACTIVE, M, P, RHO, VX, VZ, WALL, X, Z, Checkpoint, ParticleSet
+from .particles import (FLUID, INACTIVE, M, P, RHO, VX, VY, VZ, WALL, X, Y, Z, Checkpoint,
+                        ParticleSet)
 from .probes import (fluid_neighbour_counts, interpolate_points, line_mass_density,
                      shoreline, surface_from_line)
 from .shifting import SHIFT_OPEN_END
@@ -125,12 +126,15 @@ class Simulation:
                                           np.float32 if c.precision == "float32" else np.float64)
         # the scheme: its Params, initial state and time loop (steppers.py)
         self.stepper: Stepper = make_stepper(scene, ps.capacity)
-        vol = dp * dp
+        self.dim = scene.dim
+        vol = dp ** scene.dim
+        flat = scene.dim == 2
         ps.add(layout.wall_x, layout.wall_z, WALL, np.full(layout.wall_x.size, c.rho0),
-               np.full(layout.wall_x.size, c.rho0 * vol))
-        # mass = rho * dp^2: the particle volume is exactly dp^2
+               np.full(layout.wall_x.size, c.rho0 * vol), y=0.0 if flat else layout.wall_y)
+        # mass = rho * dp^dim: the particle volume is exactly dp^2 (3D: dp^3)
         rho_f, p_f = self.stepper.initial_fluid(layout.fluid_z, layout.fluid_surface)
-        ps.add(layout.fluid_x, layout.fluid_z, FLUID, rho_f, rho_f * vol)
+        ps.add(layout.fluid_x, layout.fluid_z, FLUID, rho_f, rho_f * vol,
+               y=0.0 if flat else layout.fluid_y)
         if p_f is not None:
             ps.f[P, ps.n - rho_f.size: ps.n] = p_f
         self.bodies.attach(ps, c.rho0, dp)
@@ -138,10 +142,11 @@ class Simulation:
         self.open.attach(ps, scene, self.b, layout.n_layers * dp)
         t = scene.tank
         wall = layout.n_layers * dp
+        yr = {} if flat else dict(y0=t.y0 - wall, y1=t.y1 + wall)
         self.grid = CellGrid.covering(t.x0 - wall, t.x1 + wall, t.z0 - wall, t.z1, 2.0 * h,
-                                      reach=cells_per_support)
+                                      reach=cells_per_support, **yr)
         self.cells = self.grid.lists(ps.capacity)
-        aw = wendland_alpha(h)
+        aw = wendland_alpha(h, scene.dim)
         # a fluid particle whose centre passes the first dummy layer (dp/2 behind the wall face)
         # has gone through the wall; the top z1 is open
         fx0, fx1 = self.open.fluid_box(t.x0 - 0.5 * dp, t.x1 + 0.5 * dp, dp)
@@ -154,6 +159,8 @@ class Simulation:
                     fz0=t.z0 - 0.5 * dp, fz1=t.z1, alpha_wall=c.alpha_wall_factor,
                     shift_fs_div=c.shift_fs_div, shift_inv_wdp=1.0 / w_of_q(dp / h, aw),
                     shift_open=SHIFT_OPEN_END[c.shift_open_end])
+        if not flat:   # the y walls' first layers, as fx0, fx1 for the x walls
+            base.update(fy0=t.y0 - 0.5 * dp, fy1=t.y1 + 0.5 * dp, three=True)
         self.stepper.params(scene, base, layout.n_layers)
         self.passes_per_step = self.stepper.passes_per_step
         self._counts = np.zeros(ps.capacity, dtype=np.int64)
@@ -183,7 +190,8 @@ class Simulation:
         self._px = np.array([p.x for p in self._points], dtype=float)
         self._pz = np.array([p.z for p in self._points], dtype=float)
         self._px0, self._pz0 = self._px.copy(), self._pz.copy()   # at t_start (follow)
-        self._pout = np.zeros((len(self._points), 4))
+        self._py = np.array([p.y for p in self._points], dtype=float)
+        self._pout = np.zeros((len(self._points), 5))
         self.loads = LoadProbes(scene)  # force, pressure_line, overtopping
         nz = int(math.floor((t.z1 - t.z0) / (0.5 * dp)))
         self._line_z = t.z0 + (np.arange(nz) + 0.5) * 0.5 * dp
@@ -303,14 +311,15 @@ class Simulation:
                 if p.follow:
                     x, z = self.bodies.follow(p.follow, self._px0[k:k + 1], self._pz0[k:k + 1])
                     self._px[k], self._pz[k] = x[0], z[0]
-            interpolate_points(ps.view, self.cells, self._px, self._pz, self.h, aw, self._pout)
+            interpolate_points(ps.view, self.cells, self._px, self._py, self._pz, self.h, aw,
+                               self._pout)
             for k, p in enumerate(self._points):
                 wet = self._pout[k, 3] > 0.05
                 for j, suffix in enumerate(("u", "w", "p")):
                     out[f"{p.name}_{suffix}"] = float(self._pout[k, j]) if wet else None
         rho0 = self.scene.constants.rho0
         for p in self._elev:
-            line_mass_density(ps.view, self.cells, float(p.x), self._line_z, self.h, aw,
+            line_mass_density(ps.view, self.cells, float(p.x), float(p.y), self._line_z, self.h, aw,
                               self._line_rho)
             zs = surface_from_line(self._line_z, self._line_rho, p.threshold * rho0)
             out[f"{p.name}_z_surface"] = zs
@@ -384,15 +393,18 @@ class Simulation:
         # held in place, in no pass) are left out: in ParaView and the page they hung in the air
         sel = (ps.kind[: ps.n] >= 0) & (ps.kind[: ps.n] < INLET_IDLE)
         fld = {name: ps.field(row)[sel] for name, row in
-               (("rho", RHO), ("pressure", P), ("vx", VX), ("vz", VZ))}
+               (("rho", RHO), ("pressure", P), ("vx", VX), ("vy", VY), ("vz", VZ))}
+        if self.dim == 2:
+            del fld["vy"]
         fld["kind"] = ps.kind[: ps.n][sel].astype(np.int32)
         fld["id"] = ps.ids[: ps.n][sel].astype(np.int64)
-        fld["speed"] = np.hypot(fld["vx"], fld["vz"])
-        fld["velocity"] = (fld["vx"], np.zeros_like(fld["vx"]), fld["vz"])  # a vector for glyphs
+        vy = ps.field(VY)[sel]
+        fld["speed"] = np.sqrt(fld["vx"] ** 2 + vy ** 2 + fld["vz"] ** 2)
+        fld["velocity"] = (fld["vx"], vy, fld["vz"])  # a vector for glyphs
         fld["mass"] = ps.field(M)[sel]
         fld["h"] = np.full(fld["mass"].size, self.h)
         fld["body"] = self.bodies.particle_body(fld["id"])  # -1: not a body particle
-        self.writer.snapshot(self.t, ps.field(X)[sel], ps.field(Z)[sel], fld)
+        self.writer.snapshot(self.t, ps.field(X)[sel], ps.field(Z)[sel], fld, y=ps.field(Y)[sel])
 
     def _next_output_time(self, t_target: float) -> float:
         o = self.scene.output
@@ -569,7 +581,9 @@ class Simulation:
             # a particle thrown over the top or through a wall is removed like one whose density
             # left the band (same log, same exclude_limit): one splash must not end the run
             q = self.prm
-            bad = np.nonzero(~((x >= q.fx0) & (x <= q.fx1) & (z >= q.fz0) & (z <= q.fz1)))[0]
+            y = ps.field(Y)[sel]
+            bad = np.nonzero(~((x >= q.fx0) & (x <= q.fx1) & (z >= q.fz0) & (z <= q.fz1)
+                               & (y >= q.fy0) & (y <= q.fy1)))[0]
             if self._exclude(bad, ids, x, z, rho, "left the tank"):
                 return
             cause += f" (after {len(self.excluded)} excluded)"

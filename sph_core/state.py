@@ -19,8 +19,9 @@ from typing import NamedTuple
 import numpy as np
 
 from .absorption import N_FILTER
-from .particles import (AX, AZ, DRHO, DVNX, DVNZ, GPX, GPZ, GUX, GUZ, GWX, GWZ,
-                        M, P, PW, RHO, RHON, VWX, VWZ, VX, VXN, VZ, VZN, XN, ZN, X, Z)
+from .particles import (AX, AY, AZ, DRHO, DVNX, DVNY, DVNZ, GPX, GPZ, GUX, GUZ, GWX, GWZ, M, P,
+                        PW, RHO, RHON, VWX, VWY, VWZ, VX, VXN, VY, VYN, VZ, VZN, XN, YN, ZN, X, Y,
+                        Z)
 
 
 class Particles(NamedTuple):
@@ -32,29 +33,36 @@ class Particles(NamedTuple):
 
     f: np.ndarray
     x: np.ndarray
+    y: np.ndarray        # zero in a 2D scene (the x-z plane)
     z: np.ndarray
     vx: np.ndarray
+    vy: np.ndarray
     vz: np.ndarray
     ax: np.ndarray
+    ay: np.ndarray
     az: np.ndarray
     rho: np.ndarray
     p: np.ndarray
     m: np.ndarray
     xn: np.ndarray
+    yn: np.ndarray
     zn: np.ndarray
     vxn: np.ndarray
+    vyn: np.ndarray
     vzn: np.ndarray
     rhon: np.ndarray
     drho: np.ndarray
     vwx: np.ndarray      # wall particles: velocity for the viscous term (Adami no-slip)
+    vwy: np.ndarray
     vwz: np.ndarray
-    gpx: np.ndarray      # Riemann SPH + MUSCL: grad p, grad vx = (gux, guz), grad vz = (gwx, gwz)
+    gpx: np.ndarray      # Riemann SPH + MUSCL (2D): grad p, grad vx = (gux, guz), grad vz = (gwx, gwz)
     gpz: np.ndarray
     gux: np.ndarray
     guz: np.ndarray
     gwx: np.ndarray
     gwz: np.ndarray
     dvnx: np.ndarray     # fluid: no-penetration velocity correction at a wall face (wall_contact.py)
+    dvny: np.ndarray
     dvnz: np.ndarray
     pw: np.ndarray       # fluid: the pressure its walls feel from it, p or max(p, 0) (wcsph.fluid_pass)
     kind: np.ndarray     # int8: particles.FLUID, WALL, INLET, ...
@@ -64,16 +72,17 @@ class Particles(NamedTuple):
 
 def particles_view(f: np.ndarray, kind: np.ndarray, ids: np.ndarray, cell: np.ndarray) -> Particles:
     """Named views of the storage ``f`` (no copy)."""
-    return Particles(f, f[X], f[Z], f[VX], f[VZ], f[AX], f[AZ], f[RHO], f[P], f[M], f[XN], f[ZN],
-                     f[VXN], f[VZN], f[RHON], f[DRHO], f[VWX], f[VWZ], f[GPX], f[GPZ], f[GUX], f[GUZ],
-                     f[GWX], f[GWZ], f[DVNX], f[DVNZ], f[PW],
-                     kind, ids, cell)
+    return Particles(f, f[X], f[Y], f[Z], f[VX], f[VY], f[VZ], f[AX], f[AY], f[AZ], f[RHO], f[P],
+                     f[M], f[XN], f[YN], f[ZN], f[VXN], f[VYN], f[VZN], f[RHON], f[DRHO], f[VWX],
+                     f[VWY], f[VWZ], f[GPX], f[GPZ], f[GUX], f[GUZ], f[GWX], f[GWZ], f[DVNX],
+                     f[DVNY], f[DVNZ], f[PW], kind, ids, cell)
 
 
 class Cells(NamedTuple):
-    """Cell lists: the particles of cell c = cz * ncx + cx are slots start[c]:start[c + 1] (the
-    bin ncx * ncz holds inactive slots); cursor and order are the sort's scratch. A particle's
-    neighbours are in the block neighbours.block_of(cell)."""
+    """Cell lists: the particles of cell c = (cz * ncy + cy) * ncx + cx are slots
+    start[c]:start[c + 1] (the bin ncx * ncy * ncz holds inactive slots); cursor and order are
+    the sort's scratch. A particle's neighbours are in the block neighbours.block_of(cell). A 2D
+    scene has one layer of cells in y (ncy = 1: c = cz * ncx + cx)."""
 
     start: np.ndarray
     cursor: np.ndarray
@@ -83,7 +92,10 @@ class Cells(NamedTuple):
     xmin: float
     zmin: float
     inv_cs: float
-    reach: int           # cells per support radius 2h: the search block is (2 reach + 1)^2
+    reach: int           # cells per support radius 2h: the search block is (2 reach + 1)^dim
+    ncy: int = 1         # cells across y (1: a 2D scene)
+    ymin: float = 0.0
+    three: bool | None = None   # True: a 3D grid; None: 2D, decided when compiled (Params.three)
 
 
 class Params(NamedTuple):
@@ -97,7 +109,7 @@ class Params(NamedTuple):
     b: float             # Tait B
     gamma: float
     gx: float
-    gz: float
+    gz: float            # (gy: at the end, 0 unless a 3D scene tilts gravity)
     alpha: float         # artificial viscosity
     nu: float            # laminar viscosity
     delta: float         # delta-SPH
@@ -129,6 +141,14 @@ class Params(NamedTuple):
     wall_gb: float = 0.0
     # shifting next to an open end's buffer (shifting.SHIFT_OPEN_END): 0 full, 1 none
     shift_open: int = 0
+    # three dimensions: gravity's y component and the y range of the box of fx0..fz1
+    gy: float = 0.0
+    fy0: float = -1e300
+    fy1: float = 1e300
+    # True: a 3D scene; None: 2D. Its *type* differs (bool / none), so every kernel compiles
+    # once per dimension, and in 2D the y components a term would add (exact zeros) are left
+    # out at compile time: ``if prm.three is None`` (terms.py), as the step's None-able parts
+    three: bool | None = None
 
 
 class OpenEnds(NamedTuple):
@@ -170,6 +190,8 @@ class OpenEnds(NamedTuple):
     # [2, nodes]: the absorption correction's vertical profile on zn (depth mean 1 below the
     # still-water level; all ones: a depth-uniform piston; sph_core.absorption.correction_profile)
     corr_prof: np.ndarray
+    # y of the boundary gauges' lines [m]: mid-width in a 3D scene (long-crested waves), 0 in 2D
+    y_gauge: float = 0.0
 
 
 def closed_ends(capacity: int, n_nodes: int = 2) -> OpenEnds:

@@ -102,7 +102,8 @@ class WcsphStepper:
                           shift_carry=c.shift_carry,
                           # no penetration at wall faces (wall_contact.py)
                           **dict(zip(("wall_ga", "wall_g0", "wall_gb"),
-                                     face_shares(scene.h, scene.dp, n_layers, base["alpha_w"]))),
+                                     face_shares(scene.h, scene.dp, n_layers, base["alpha_w"],
+                                                 scene.dim))),
                           **scheme_params(scene.scheme))
         return self.prm
 

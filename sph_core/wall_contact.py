@@ -31,43 +31,47 @@ import numpy as np
 from numba import njit
 
 
-def face_shares(h: float, dp: float, n_layers: int, alpha_w: float) -> tuple[float, float, float]:
+def face_shares(h: float, dp: float, n_layers: int, alpha_w: float,
+                dim: int = 2) -> tuple[float, float, float]:
     """The wall share sum_s V_s W_is of a point dp/4 in front of a flat wall face, at it and
-    dp/4 behind it (wall particles on the dp lattice, n_layers deep, first row dp/2 behind)."""
+    dp/4 behind it (wall particles on the dp lattice, n_layers deep, first row dp/2 behind; in
+    3D a plane of such rows)."""
     k = math.ceil(2.0 * h / dp) + 2
     xs = (np.arange(-k, k + 1)) * dp
     zs = -(np.arange(n_layers) + 0.5) * dp
-    gx, gz = np.meshgrid(xs, zs)
+    ys = xs if dim == 3 else np.zeros(1)
+    gx, gy, gz = np.meshgrid(xs, ys, zs)
+    vol = dp ** dim
     out = []
     for d in (0.25 * dp, 0.0, -0.25 * dp):
-        q = np.hypot(gx, gz - d) / h
+        q = np.sqrt(gx * gx + gy * gy + (gz - d) ** 2) / h
         t = np.clip(1.0 - 0.5 * q, 0.0, None)
-        out.append(float(np.sum(alpha_w * t ** 4 * (2.0 * q + 1.0)) * dp * dp))
+        out.append(float(np.sum(alpha_w * t ** 4 * (2.0 * q + 1.0)) * vol))
     return out[0], out[1], out[2]
 
 
 @njit(cache=True, inline="always")
-def approach_speed(g, nx, nz, gvx, gvz, vx, vz):
-    """u_n of a fluid particle with velocity (vx, vz) against its walls (< 0: towards them);
-    0 without wall neighbours. g, (nx, nz), (gvx, gvz) as in ``no_penetration``."""
-    nn = math.sqrt(nx * nx + nz * nz)
+def approach_speed(g, nx, ny, nz, gvx, gvy, gvz, vx, vy, vz):
+    """u_n of a fluid particle with velocity (vx, vy, vz) against its walls (< 0: towards
+    them); 0 without wall neighbours. g, n, gv as in ``no_penetration``."""
+    nn = math.sqrt(nx * nx + ny * ny + nz * nz)
     if g <= 0.0 or nn <= 0.0:
         return 0.0
-    return ((vx - gvx / g) * nx + (vz - gvz / g) * nz) / nn
+    return ((vx - gvx / g) * nx + (vy - gvy / g) * ny + (vz - gvz / g) * nz) / nn
 
 
 @njit(cache=True, inline="always")
-def no_penetration(g, nx, nz, gvx, gvz, vx, vz, ga, g0, gb):
-    """Velocity change (dvx, dvz) of a fluid particle with velocity (vx, vz), wall share g,
-    unnormalised normal (nx, nz) and sum_s V_s W_is v_s = (gvx, gvz); (0, 0) if g <= ga."""
+def no_penetration(g, nx, ny, nz, gvx, gvy, gvz, vx, vy, vz, ga, g0, gb):
+    """Velocity change (dvx, dvy, dvz) of a fluid particle with velocity v, wall share g,
+    unnormalised normal n and sum_s V_s W_is v_s = gv; zero if g <= ga."""
     if g <= ga:
-        return 0.0, 0.0
-    un = approach_speed(g, nx, nz, gvx, gvz, vx, vz)
+        return 0.0, 0.0, 0.0
+    un = approach_speed(g, nx, ny, nz, gvx, gvy, gvz, vx, vy, vz)
     if un >= 0.0:
-        return 0.0, 0.0
-    nn = math.sqrt(nx * nx + nz * nz)
+        return 0.0, 0.0, 0.0
+    nn = math.sqrt(nx * nx + ny * ny + nz * nz)
     if g <= g0:
         f = (g - ga) / (g0 - ga)
     else:
         f = min(1.0 + (g - g0) / (gb - g0), 2.0)
-    return -f * un * nx / nn, -f * un * nz / nn
+    return -f * un * nx / nn, -f * un * ny / nn, -f * un * nz / nn

@@ -1,5 +1,8 @@
 """Weakly-compressible SPH: the passes of a step over the particles, and the integrators.
 
+Every vector has three components (x, y, z); a 2D scene (the x-z plane) keeps y, vy, ay zero and
+its sums are the 2D ones (pairs.py). The equations below hold in either dimension.
+
 The per-pair terms the passes fold over their neighbours (pairs.gather) are in terms.py; the
 step that calls the passes is ``step.run`` (one skeleton for every integrator and scene).
 
@@ -39,8 +42,8 @@ from numba import njit, prange
 from .eos import density, pressure
 from .neighbours import PASS_RANGES, kind_ranges
 from .pairs import fluidlike, gather, interacting
-from .particles import (AX, AZ, DRHO, DVNX, DVNZ, FLUID, P, PW, RHO, RHON, VWX, VWZ, VX, VXN, VZ,
-                        VZN, WALL, XN, ZN, X, Z)
+from .particles import (AX, AY, AZ, DRHO, DVNX, DVNY, DVNZ, FLUID, P, PW, RHO, RHON, VWX, VWY,
+                        VWZ, VX, VXN, VY, VYN, VZ, VZN, WALL, XN, YN, ZN, X, Y, Z)
 from .terms import (FLUID_SUMS_ZERO, WALL_SUMS_ZERO, adami_pair, fluid_consts, fluid_i,
                     riemann_pair, wcsph_pair)
 from .wall_contact import approach_speed, no_penetration
@@ -69,20 +72,23 @@ PASSES_PER_STEP = {"kdk": 1, "symplectic_pc": 2}
 
 @njit(cache=True, inline="always")
 def adami_state(i, ps, cells, prm):
-    """(p, rho, vwx, vwz) of wall particle i: Adami et al. (2012) pressure, density and no-slip
-    velocity from its fluid neighbours (terms.adami_pair). One particle's share of
+    """(p, rho, vwx, vwy, vwz) of wall particle i: Adami et al. (2012) pressure, density and
+    no-slip velocity from its fluid neighbours (terms.adami_pair). One particle's share of
     ``wall_pass``: the CUDA step's kernel calls the same function."""
     h = prm.h
-    ctx = (1.0 / h, prm.alpha_w, prm.gx - ps.ax[i], prm.gz - ps.az[i])
-    s = gather(i, ps.x[i], ps.z[i], ps.cell[i], ps, cells, 4.0 * h * h, fluidlike, adami_pair, ctx,
-               WALL_SUMS_ZERO)
+    by = 0.0 if prm.three is None else prm.gy - ps.ay[i]   # 2D: a constant (no y lever)
+    ctx = (1.0 / h, prm.alpha_w, prm.gx - ps.ax[i], by, prm.gz - ps.az[i])
+    s = gather(i, ps.x[i], ps.y[i], ps.z[i], ps.cell[i], ps, cells, 4.0 * h * h, fluidlike,
+               adami_pair, ctx, WALL_SUMS_ZERO)
     if s.sw > 0.0:
         # no suction: a negative extrapolated pressure (free surface near the wall) would pull
         # fluid into the wall
         pi = max(s.sp / s.sw, 0.0)
+        # 2D (prm.three None, when compiled): no y sum, so none is gathered
+        vwy = 0.0 if prm.three is None else 2.0 * ps.vy[i] - s.svy / s.sw
         return (pi, density(pi, prm.rho0, prm.b, prm.gamma), 2.0 * ps.vx[i] - s.svx / s.sw,
-                2.0 * ps.vz[i] - s.svz / s.sw)
-    return 0.0, prm.rho0, ps.vx[i], ps.vz[i]
+                vwy, 2.0 * ps.vz[i] - s.svz / s.sw)
+    return 0.0, prm.rho0, ps.vx[i], ps.vy[i], ps.vz[i]
 
 
 @njit(parallel=True, cache=True, fastmath=FASTMATH)
@@ -94,12 +100,18 @@ def wall_pass(ps, n, cells, prm):
     for r in prange(b.size - 1):
         for i in range(b[r], b[r + 1]):
             if kind[i] == WALL:
-                f[P, i], f[RHO, i], f[VWX, i], f[VWZ, i] = adami_state(i, ps, cells, prm)
+                p, rho, vwx, vwy, vwz = adami_state(i, ps, cells, prm)
+                f[P, i] = p
+                f[RHO, i] = rho
+                f[VWX, i] = vwx
+                f[VWZ, i] = vwz
+                if prm.three is not None:   # 2D: the y rows stay zero, untouched
+                    f[VWY, i] = vwy
 
 
 @njit(cache=True, inline="always")
 def fluid_rates(i, ps, cells, prm, riemann, k, fi):
-    """(ax, az, drho, pw, dvnx, dvnz) of fluid particle i: continuity, delta-SPH, pressure,
+    """(ax, ay, az, drho, pw, dvnx, dvny, dvnz) of fluid particle i: continuity, delta-SPH, pressure,
     viscosity, gravity (terms.wcsph_pair), or with ``riemann`` True (not None) the Riemann SPH
     flux (terms.riemann_pair; MUSCL gradients from riemann_gradients); pw is the pressure its
     walls feel, dvn the no-penetration velocity change (wall_contact.py; zero when off). One
@@ -108,13 +120,23 @@ def fluid_rates(i, ps, cells, prm, riemann, k, fi):
     into a prange loop, the NamedTuple they build fails numba's parfor array analysis; a CUDA
     kernel needs them inlined)."""
     if riemann is None:
-        a = gather(i, fi.x, fi.z, ps.cell[i], ps, cells, k.s2, interacting, wcsph_pair, (k, fi),
-                   FLUID_SUMS_ZERO)
+        a = gather(i, fi.x, fi.y, fi.z, ps.cell[i], ps, cells, k.s2, interacting, wcsph_pair,
+                   (k, fi), FLUID_SUMS_ZERO)
     else:
-        a = gather(i, fi.x, fi.z, ps.cell[i], ps, cells, k.s2, interacting, riemann_pair, (k, fi),
-                   FLUID_SUMS_ZERO)
+        a = gather(i, fi.x, fi.y, fi.z, ps.cell[i], ps, cells, k.s2, interacting, riemann_pair,
+                   (k, fi), FLUID_SUMS_ZERO)
     fx = a.fx
     fz = a.fz
+    # 2D (prm.three None, decided when compiled): the y sums are left out, so the compiler
+    # drops their accumulation from the walk
+    if prm.three is None:
+        fy = gny = gvy = ty = vyi = 0.0
+    else:
+        fy = a.fy
+        gny = a.gny
+        gvy = a.gvy
+        ty = a.ty
+        vyi = fi.vy
     # no tension across a wall while the particle approaches it (p_i -> max(p_i, 0)): a
     # particle in tension is otherwise pulled into the wall (a dry-bed front sinks through the
     # bed); one that moves away keeps the pull, so a thin swash film stays on its beach
@@ -122,21 +144,27 @@ def fluid_rates(i, ps, cells, prm, riemann, k, fi):
     # walls always feel max(p_i, 0)
     pwi = fi.p
     if fi.p < 0.0 and (riemann is not None
-                       or approach_speed(a.gw, a.gnx, a.gnz, a.gvx, a.gvz, fi.vx, fi.vz) < 0.0):
+                       or approach_speed(a.gw, a.gnx, gny, a.gnz, a.gvx, gvy, a.gvz, fi.vx,
+                                         vyi, fi.vz) < 0.0):
         fx += a.tx
+        fy += ty
         fz += a.tz
         pwi = 0.0
     dvx = 0.0
+    dvy = 0.0
     dvz = 0.0
     if prm.wall_g0 > 0.0:   # no penetration at wall faces (wall_contact.py): g0 = 0 turns it off
-        dvx, dvz = no_penetration(a.gw, a.gnx, a.gnz, a.gvx, a.gvz, fi.vx, fi.vz, prm.wall_ga,
-                                  prm.wall_g0, prm.wall_gb)
-    return fx + prm.gx, fz + prm.gz, fi.rho * a.cont + k.ddiff * a.diff, pwi, dvx, dvz
+        dvx, dvy, dvz = no_penetration(a.gw, a.gnx, gny, a.gnz, a.gvx, gvy, a.gvz, fi.vx,
+                                       vyi, fi.vz, prm.wall_ga, prm.wall_g0, prm.wall_gb)
+    if prm.three is None:
+        dvy = 0.0
+    return (fx + prm.gx, fy + prm.gy, fz + prm.gz, fi.rho * a.cont + k.ddiff * a.diff, pwi, dvx,
+            dvy, dvz)
 
 
 @njit(parallel=True, cache=True, fastmath=FASTMATH)
 def fluid_pass(ps, n, cells, prm, riemann):
-    """Rates of every fluid particle (``fluid_rates``): writes ax, az, drho, pw, dvnx, dvnz;
+    """Rates of every fluid particle (``fluid_rates``): writes a, drho, pw, dvn;
     returns nothing (reductions are in the kicks). A None ``riemann`` compiles the WCSPH pair
     alone (step.py)."""
     f = ps.f
@@ -147,24 +175,34 @@ def fluid_pass(ps, n, cells, prm, riemann):
             if kind[i] == FLUID:
                 k = fluid_consts(prm)
                 fi = fluid_i(i, ps, k)
-                f[AX, i], f[AZ, i], f[DRHO, i], f[PW, i], f[DVNX, i], f[DVNZ, i] = fluid_rates(
-                    i, ps, cells, prm, riemann, k, fi)
+                ax, ay, az, drho, pw, dvx, dvy, dvz = fluid_rates(i, ps, cells, prm, riemann, k,
+                                                                  fi)
+                f[AX, i] = ax
+                f[AZ, i] = az
+                f[DRHO, i] = drho
+                f[PW, i] = pw
+                f[DVNX, i] = dvx
+                f[DVNZ, i] = dvz
+                if prm.three is not None:   # 2D: the y rows stay zero, untouched
+                    f[AY, i] = ay
+                    f[DVNY, i] = dvy
 
 
 # Numba drops stores made inside a prange loop through ``ps.row[i] = ...``: the passes write
 # through the storage array ``f = ps.f`` (rows named by particles.py), and read through either.
 
 @njit(cache=True, inline="always")
-def _outside(xi, zi, prm):
-    """1 if (xi, zi) is outside the box a fluid particle must stay in, else 0."""
-    return 0 if (xi >= prm.fx0 and xi <= prm.fx1 and zi >= prm.fz0 and zi <= prm.fz1) else 1
+def _outside(xi, yi, zi, prm):
+    """1 if (xi, yi, zi) is outside the box a fluid particle must stay in, else 0."""
+    return 0 if (xi >= prm.fx0 and xi <= prm.fx1 and zi >= prm.fz0 and zi <= prm.fz1
+                 and yi >= prm.fy0 and yi <= prm.fy1) else 1
 
 
 @njit(cache=True, inline="always")
-def _guard(u, w, r, axi, azi, lo, hi):
+def _guard(u, v, w, r, axi, ayi, azi, lo, hi):
     """(non-finite, outside the density band, |v|^2, |a|^2) of a particle after its update."""
-    v2 = u * u + w * w
-    a2 = axi * axi + azi * azi
+    v2 = u * u + v * v + w * w
+    a2 = axi * axi + ayi * ayi + azi * azi
     if not (math.isfinite(v2) and math.isfinite(r) and math.isfinite(a2)):   # (CUDA has math's)
         return 1, 0, v2, a2
     return 0, 1 if (r < lo or r > hi) else 0, v2, a2
@@ -188,7 +226,12 @@ def kdk_kick_drift(ps, n, dt, prm):
             zi = f[Z, i] + dt * f[VZ, i]
             f[X, i] = xi
             f[Z, i] = zi
-            n_out += _outside(xi, zi, prm)
+            yi = 0.0
+            if prm.three is not None:   # 2D (when compiled): the y rows stay zero
+                f[VY, i] += hdt * f[AY, i]
+                yi = f[Y, i] + dt * f[VY, i]
+                f[Y, i] = yi
+            n_out += _outside(xi, yi, zi, prm)
     return n_out
 
 
@@ -214,7 +257,12 @@ def kdk_kick(ps, n, dt, prm):
             f[VX, i] = u
             f[VZ, i] = w
             f[RHO, i] = r
-            bad, band, v2, a2 = _guard(u, w, r, f[AX, i], f[AZ, i], lo, hi)
+            v = ay = 0.0
+            if prm.three is not None:   # 2D (when compiled): the y rows stay zero
+                ay = f[AY, i]
+                v = f[VY, i] + hdt * ay + f[DVNY, i]
+                f[VY, i] = v
+            bad, band, v2, a2 = _guard(u, v, w, r, f[AX, i], ay, f[AZ, i], lo, hi)
             n_bad += bad
             n_band += band
             v2max = max(v2max, v2)
@@ -238,6 +286,11 @@ def pc_predict_particle(f, i, dt, prm):
     f[Z, i] += hdt * f[VZ, i]
     f[VX, i] += hdt * f[AX, i]
     f[VZ, i] += hdt * f[AZ, i]
+    if prm.three is not None:   # 2D (when compiled): the y rows stay zero
+        f[YN, i] = f[Y, i]
+        f[VYN, i] = f[VY, i]
+        f[Y, i] += hdt * f[VY, i]
+        f[VY, i] += hdt * f[AY, i]
     r = f[RHO, i] + hdt * f[DRHO, i]
     f[RHO, i] = r
     f[P, i] = pressure(r, prm.rho0, prm.b, prm.gamma)
@@ -273,9 +326,17 @@ def pc_correct_particle(f, i, dt, prm):
     f[P, i] = pressure(r, prm.rho0, prm.b, prm.gamma)
     f[X, i] = xi
     f[Z, i] = zi
-    bad, band, v2, a2 = _guard(u, w, r, f[AX, i], f[AZ, i], prm.rho_lo * prm.rho0,
+    v = ay = yi = 0.0
+    if prm.three is not None:   # 2D (when compiled): the y rows stay zero
+        v0 = f[VYN, i]
+        ay = f[AY, i]
+        v = v0 + dt * ay + f[DVNY, i]
+        yi = f[YN, i] + 0.5 * dt * (v + v0)
+        f[VY, i] = v
+        f[Y, i] = yi
+    bad, band, v2, a2 = _guard(u, v, w, r, f[AX, i], ay, f[AZ, i], prm.rho_lo * prm.rho0,
                                prm.rho_hi * prm.rho0)
-    return bad, band, _outside(xi, zi, prm), v2, a2, r
+    return bad, band, _outside(xi, yi, zi, prm), v2, a2, r
 
 
 @njit(parallel=True, cache=True)

@@ -31,6 +31,7 @@ UNIT: tuple[str, ...] = (
 NOT_UNIT: frozenset[str] = frozenset({  # "path" or "path::test_name" (any parametrisation)
     # numba kernels: a real SPH engine, a Simulation, the Boussinesq model
     "test_server/test_server_flume.py",
+    "test_server/test_server_basin_3d.py",
     "test_server/test_standalone_theory.py::test_standalone_theory_run_equals_the_coupled_run",
     "test_server/test_standalone_theory.py::test_cancelled_theory_run_keeps_its_data_and_resumes_to_the_end",
     "test_server/test_standalone_theory.py::test_standalone_solitary_source_brings_its_crest_to_the_inlet",

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import asyncio
 import json
+import math
 from pathlib import Path
 from typing import Literal
 
@@ -187,7 +188,7 @@ async def get_bodies(run: RunDep, format: Literal["csv", "json"] = Query("csv"))
 MAX_SCATTER = 40_000   # particles sent to the page's scatter (every k-th beyond it)
 
 
-def _last_particles(run_dir, field: str) -> dict | None:
+def _last_particles(run_dir, field: str, y_at: float | None = None) -> dict | None:
     import numpy as np
 
     paths = sorted(run_dir.glob("sph*/snapshots/last.npz"), key=lambda p: p.stat().st_mtime)
@@ -196,19 +197,34 @@ def _last_particles(run_dir, field: str) -> dict | None:
     with np.load(paths[-1], allow_pickle=False) as z:
         x, zz, value, kind = z["x"], z["z"], z[field], z["kind"]
         t = float(z["t"])
+        y = z["y"] if "y" in z.files else None
+        h = float(z["h"]) if "h" in z.files else 0.0
+    cut = None
+    if y is not None and np.ptp(y) > 0:   # a 3D run: the slice |y - y_at| <= h
+        fluid = y[kind == 0] if np.any(kind == 0) else y
+        y_at = float(0.5 * (fluid.min() + fluid.max())) if y_at is None else y_at
+        sel = np.abs(y - y_at) <= h
+        x, zz, value, kind = x[sel], zz[sel], value[sel], kind[sel]
+        cut = {"y": round(y_at, 6), "half_width": round(h, 6)}
     stride = max(1, -(-x.size // MAX_SCATTER))
     r = lambda a: [round(float(v), 6) for v in a[::stride]]  # noqa: E731
     return {"t": t, "field": field, "stride": stride, "x": r(x), "z": r(zz), "value": r(value),
-            "kind": [int(k) for k in kind[::stride]]}
+            "kind": [int(k) for k in kind[::stride]], "slice": cut}
 
 
 @router.get("/{run_id}/particles", responses={**NOT_FOUND, 404: _detail(
     "no run, or no snapshot yet (the scene's output.snapshot_every)")})
-async def get_particles(run: RunDep, field: Literal["pressure", "speed"] = Query("pressure")) -> Response:
+async def get_particles(run: RunDep, field: Literal["pressure", "speed"] = Query("pressure"),
+                        y: float | None = Query(None, description=(
+                            "3D runs: the y [m] of the x-z slice (default: the fluid's mid-width)"))
+                        ) -> Response:
     """The newest snapshot's particles for a scatter plot: t [s], x, z [m], `value` (pressure
     [Pa] or speed [m/s]) and `kind` (0 fluid, 1 wall/bed/structure, 2/3 open-end buffers), at
-    most 40 000 (every `stride`-th beyond that)."""
-    data = await asyncio.to_thread(_last_particles, run.dir, field)
+    most 40 000 (every `stride`-th beyond that). A 3D run's are the slice within h of `y`
+    (`slice`: its y and half-width; null for a 2D run)."""
+    if y is not None and not math.isfinite(y):
+        raise HTTPException(422, "y: must be a finite number [m]")
+    data = await asyncio.to_thread(_last_particles, run.dir, field, y)
     if data is None:
         raise HTTPException(404, f"run {run.info.id} has no snapshot yet (set the scene's "
                                  "output.snapshot_every)")

@@ -87,7 +87,7 @@ class CudaStepper:
         # with open ends the kernels run over every slot (gpu_open_ends.py): the count changes
         self.n = int(ps.capacity) if sim.open.active else int(ps.n)
         grid = sim.grid
-        self.ncell = grid.ncx * grid.ncz
+        self.ncell = grid.ncell
         self.m = self.ncell + 2            # cells, the inactive bin, and the total
         dev = self._to_device
         # the simulator's kernels take numpy arrays (numba-compiled bodies cannot index its
@@ -104,7 +104,7 @@ class CudaStepper:
         self.nb = (self.m + K.SCAN_B - 1) // K.SCAN_B
         self.bsum = dev(np.zeros(self.nb, dtype=np.int64))
         self.cells = Cells(self.start, self.cursor, self.order, c.ncx, c.ncz, c.xmin, c.zmin,
-                           c.inv_cs, c.reach)
+                           c.inv_cs, c.reach, c.ncy, c.ymin)
         self.clk = dev(np.zeros(K.N_CLK))
         self.ctl = dev(np.zeros(K.N_CTL, dtype=np.int64))
         self.prm = sim.prm

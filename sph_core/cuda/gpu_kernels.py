@@ -296,7 +296,7 @@ def k_wall(buf, n, cells, prm, ctl):
     i = cuda.grid(1)
     if i < n and buf[1][i] == WALL:
         ps = _view(buf)
-        ps.p[i], ps.rho[i], ps.vwx[i], ps.vwz[i] = adami_state(i, ps, cells, prm)
+        ps.p[i], ps.rho[i], ps.vwx[i], ps.vwy[i], ps.vwz[i] = adami_state(i, ps, cells, prm)
 
 
 def fluid_kernel(name, riemann, doc):
@@ -309,8 +309,8 @@ def fluid_kernel(name, riemann, doc):
         if i < n and buf[1][i] == FLUID:
             ps = _view(buf)
             k = _fluid_consts(prm)
-            ps.ax[i], ps.az[i], ps.drho[i], ps.pw[i], ps.dvnx[i], ps.dvnz[i] = fluid_rates(
-                i, ps, cells, prm, riemann, k, _fluid_i(i, ps, k))
+            (ps.ax[i], ps.ay[i], ps.az[i], ps.drho[i], ps.pw[i], ps.dvnx[i], ps.dvny[i],
+             ps.dvnz[i]) = fluid_rates(i, ps, cells, prm, riemann, k, _fluid_i(i, ps, k))
     return _named_kernel(k_fluid, name, doc)
 
 

@@ -183,7 +183,7 @@ def k_extrapolate(buf, n, cells, ends, prm, ctl, oe):
         return
     i = cuda.grid(1)
     if i == 0:
-        oe[I][N_LIVE] = cells.start[cells.ncx * cells.ncz]
+        oe[I][N_LIVE] = cells.start[cells.ncx * cells.ncy * cells.ncz]
     if i < n:
         ps = _view(buf)
         ok, p, rho = extrapolated_state(i, ps, cells, ends, prm)
@@ -204,7 +204,7 @@ def k_gauge_line(buf, cells, ends, prm, ctl, oe):
         b = g // npt
         k = g - b * npt
         if ends.on[b] and k < gauge_points(ends, b):
-            dens[b, k] = line_density(_view(buf), cells, ends.x_gauge[b],
+            dens[b, k] = line_density(_view(buf), cells, ends.x_gauge[b], ends.y_gauge,
                                       ends.z_bed[b] + k * ends.dz_gauge, prm)
 
 

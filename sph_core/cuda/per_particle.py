@@ -11,21 +11,20 @@ of ``gpu_kernels.py`` and as ordinary CPU code under the CUDA simulator (compile
 
 from __future__ import annotations
 
-import math
-
 from numba import njit
 
 from ..eos import pressure
 from ..neighbours import cell_at
+from ..wcsph import _guard, _outside
 
 
 @njit(cache=True, inline="always")
 def cell_of(i, ps, cells):
     """ps.cell of slot i as ``neighbours.compute_cells`` sets it: clamped to the grid, inactive
-    slots in the extra bin ncx * ncz."""
+    slots in the extra bin ncx * ncy * ncz."""
     if ps.kind[i] < 0:
-        return cells.ncx * cells.ncz
-    return cell_at(ps.x[i], ps.z[i], cells)
+        return cells.ncx * cells.ncy * cells.ncz
+    return cell_at(ps.x[i], ps.y[i], ps.z[i], cells)
 
 
 @njit(cache=True, inline="always")
@@ -33,15 +32,18 @@ def kick_drift_particle(i, ps, dt, prm):
     """``wcsph.kdk_kick_drift`` for fluid slot i; True if it ends outside the fluid box."""
     hdt = 0.5 * dt
     ps.vx[i] += hdt * ps.ax[i]
+    ps.vy[i] += hdt * ps.ay[i]
     ps.vz[i] += hdt * ps.az[i]
     r = ps.rho[i] + hdt * ps.drho[i]
     ps.rho[i] = r
     ps.p[i] = pressure(r + hdt * ps.drho[i], prm.rho0, prm.b, prm.gamma)
     xi = ps.x[i] + dt * ps.vx[i]
+    yi = ps.y[i] + dt * ps.vy[i]
     zi = ps.z[i] + dt * ps.vz[i]
     ps.x[i] = xi
+    ps.y[i] = yi
     ps.z[i] = zi
-    return not (xi >= prm.fx0 and xi <= prm.fx1 and zi >= prm.fz0 and zi <= prm.fz1)
+    return _outside(xi, yi, zi, prm) == 1
 
 
 @njit(cache=True, inline="always")
@@ -50,21 +52,19 @@ def kick_particle(i, ps, dt, prm):
     1 non-finite, 2 outside the density band."""
     hdt = 0.5 * dt
     ax = ps.ax[i]
+    ay = ps.ay[i]
     az = ps.az[i]
     u = ps.vx[i] + hdt * ax + ps.dvnx[i]
+    v = ps.vy[i] + hdt * ay + ps.dvny[i]
     w = ps.vz[i] + hdt * az + ps.dvnz[i]
     r = ps.rho[i] + hdt * ps.drho[i]
     ps.vx[i] = u
+    ps.vy[i] = v
     ps.vz[i] = w
     ps.rho[i] = r
-    v2 = u * u + w * w
-    a2 = ax * ax + az * az
-    guard = 0
-    if not (math.isfinite(v2) and math.isfinite(r) and math.isfinite(a2)):
-        guard = 1
-    elif r < prm.rho_lo * prm.rho0 or r > prm.rho_hi * prm.rho0:
-        guard = 2
-    return v2, a2, r, guard
+    bad, band, v2, a2 = _guard(u, v, w, r, ax, ay, az, prm.rho_lo * prm.rho0,
+                               prm.rho_hi * prm.rho0)
+    return v2, a2, r, 1 if bad else (2 if band else 0)
 
 
 @njit(cache=True, inline="always")

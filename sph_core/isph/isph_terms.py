@@ -2,7 +2,7 @@
 ppe.py), with the physical pieces they share with WCSPH (sph_core.terms: the Adami wall sums,
 the laminar viscosity).
 
-Same signature as every term, ``acc = term(i, j, dx, dz, r2, ps, ctx, acc)`` (dx = x_i - x_j);
+Same signature as every term, ``acc = term(i, j, dx, dy, dz, r2, ps, ctx, acc)`` (dx = x_i - x_j; 2D: dy = 0);
 ``ctx`` is a tuple read by index (numba's parfor analysis rejects unpacking it inside a term).
 Equations: the package docstring (r_ij = r_i - r_j, grad_i W_ij = -F_ij r_ij, V_j = m_j / rho0).
 """
@@ -22,7 +22,7 @@ MAX_ROW = 64   # non-zeros per PPE row, generous: a full 2D support at h/dp 2 ha
 
 
 @njit(cache=True, inline="always")
-def surface_pair(i, j, dx, dz, r2, ps, ctx, a):
+def surface_pair(i, j, dx, dy, dz, r2, ps, ctx, a):
     """(kernel density sum_j m_j W_ij, position divergence sum_j V_j F_ij r_ij^2) of a fluid
     particle. ctx = (inv_h, alpha_w, alpha_f, rho0)."""
     q = math.sqrt(r2) * ctx[0]
@@ -46,19 +46,19 @@ WALL_ROW_SUMS_ZERO = WallRowSums(0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
 
 
 @njit(cache=True, inline="always")
-def wall_pair(i, j, dx, dz, r2, ps, ctx, a):
+def wall_pair(i, j, dx, dy, dz, r2, ps, ctx, a):
     """Wall particle i and a fluid or buffer neighbour j: the Adami sums (terms.adami_sum) with
     the fluid's pressure left out (it is an unknown of the wall's PPE row; a buffer's is known),
     and the wall normal. ctx = (inv_h, alpha_w, bx, bz), b = g - a_i."""
     w = w_of_q(math.sqrt(r2) * ctx[0], ctx[1])
     pj = 0.0 if ps.kind[j] == FLUID else ps.p[j]
-    s = adami_sum(WallSums(a.sw, a.sp, a.svx, a.svz), w, pj, ps.rho[j],
-                  ctx[2] * dx + ctx[3] * dz, ps.vx[j], ps.vz[j])
+    s = adami_sum(WallSums(a.sw, a.sp, a.svx, 0.0, a.svz), w, pj, ps.rho[j],
+                  ctx[2] * dx + ctx[3] * dz, ps.vx[j], 0.0, ps.vz[j])   # ISPH is 2D (x-z)
     return WallRowSums(s.sw, s.sp, s.svx, s.svz, a.nx - dx * w, a.nz - dz * w)
 
 
 @njit(cache=True, inline="always")
-def wall_stop_pair(i, j, dx, dz, r2, ps, ctx, a):
+def wall_stop_pair(i, j, dx, dy, dz, r2, ps, ctx, a):
     """Wall particle i and fluid neighbour j approaching it (u_n = (u_j - v_i) . n < 0, n the
     wall's unit normal into the fluid): the ghost-pressure rise rho_j |u_n| d / tau W_ij that
     stops it within tau, d = n . r_ji. ctx = (inv_h, alpha_w, nx, nz, vx_i, vz_i, tau)."""
@@ -71,7 +71,7 @@ def wall_stop_pair(i, j, dx, dz, r2, ps, ctx, a):
 
 
 @njit(cache=True, inline="always")
-def viscous_pair(i, j, dx, dz, r2, ps, ctx, a):
+def viscous_pair(i, j, dx, dy, dz, r2, ps, ctx, a):
     """Fluid particle i and a fluid, buffer or (no-slip) wall neighbour j: Lo & Shao's laminar
     viscosity, terms.viscous_momentum without pressure or artificial viscosity; against a wall
     its Adami no-slip velocity. ctx = (terms.FluidConsts, terms.FluidI); a = (fx, fz)."""
@@ -85,12 +85,13 @@ def viscous_pair(i, j, dx, dz, r2, ps, ctx, a):
     else:
         dvx = fi.vx - ps.vx[j]
         dvz = fi.vz - ps.vz[j]
-    return viscous_momentum(a[0], a[1], 0.0, dvx, dvz, dx, dz, r2, kernel_f(r2, k), fi.rho,
-                            ps.rho[j], ps.m[j], 0.0, k)
+    fx, _, fz = viscous_momentum(a[0], 0.0, a[1], 0.0, dvx, 0.0, dvz, dx, dy, dz, r2,
+                                 kernel_f(r2, k), fi.rho, ps.rho[j], ps.m[j], 0.0, k)
+    return fx, fz
 
 
 @njit(cache=True, inline="always")
-def fluid_row_pair(i, j, dx, dz, r2, ps, ctx, a):
+def fluid_row_pair(i, j, dx, dy, dz, r2, ps, ctx, a):
     """Fluid particle i's PPE row and neighbour j (fluid, wall, buffer): the Shao & Lo (2003)
     Laplacian coefficient B_ij into the diagonal and, for an unknown j, the row's column
     (written into ``indices``, ``data`` at base + count); a buffer's known pressure goes to
@@ -123,7 +124,7 @@ def fluid_row_pair(i, j, dx, dz, r2, ps, ctx, a):
 
 
 @njit(cache=True, inline="always")
-def wall_row_pair(i, j, dx, dz, r2, ps, ctx, a):
+def wall_row_pair(i, j, dx, dy, dz, r2, ps, ctx, a):
     """Wall particle i's PPE row and fluid neighbour j: the Adami weight -W_ij / sum W (scaled)
     of j's unknown. ctx = (inv_h, alpha_w, wscale / sum W, idx, indices, data, base);
     a = the row's count."""
@@ -136,7 +137,7 @@ def wall_row_pair(i, j, dx, dz, r2, ps, ctx, a):
 
 
 @njit(cache=True, inline="always")
-def symmetric_pressure_pair(i, j, dx, dz, r2, ps, ctx, a):
+def symmetric_pressure_pair(i, j, dx, dy, dz, r2, ps, ctx, a):
     """-(1/rho) grad p of seed 004 eq. 5, sum_j m_j (p_i/rho_i^2 + p_j/rho_j^2) F_ij r_ij, over
     fluid, buffer and wet wall neighbours (a wall with p < 0, the air side of a wetted wall,
     is left out like air). ctx = (inv_h, alpha_f, p_i / rho_i^2); a = (fx, fz)."""

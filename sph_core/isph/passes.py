@@ -31,7 +31,7 @@ def free_surface_flags(ps, n, cells, prm, threshold, flag, rho_k):
         flag[i] = -1
         if kind[i] == FLUID:
             # walked around the point (slot -1): the self term m_i W(0) counts in rho_k
-            sr, sdiv = gather(-1, ps.x[i], ps.z[i], ps.cell[i], ps, cells, s2, interacting,
+            sr, sdiv = gather(-1, ps.x[i], ps.y[i], ps.z[i], ps.cell[i], ps, cells, s2, interacting,
                               surface_pair, ctx, (0.0, 0.0))
             rho_k[i] = sr
             flag[i] = 1 if sdiv <= threshold else 0
@@ -64,7 +64,7 @@ def wall_state(ps, n, cells, prm, dt, stop, wsum, dwall):
             xi = ps.x[i]
             zi = ps.z[i]
             ctx = (inv_h, aw, prm.gx - ps.ax[i], prm.gz - ps.az[i])
-            s = gather(i, xi, zi, ps.cell[i], ps, cells, s2, fluidlike, wall_pair, ctx,
+            s = gather(i, xi, ps.y[i], zi, ps.cell[i], ps, cells, s2, fluidlike, wall_pair, ctx,
                        WALL_ROW_SUMS_ZERO)
             sd = s.sp
             # the no-penetration part: fluid approaching the wall (relative normal velocity
@@ -73,7 +73,7 @@ def wall_state(ps, n, cells, prm, dt, stop, wsum, dwall):
             # tau = stop dt (stop = isph_wall_stop steps, 1: within the step)
             nn = math.sqrt(s.nx * s.nx + s.nz * s.nz)
             if nn > 0.0:
-                sd = gather(i, xi, zi, ps.cell[i], ps, cells, s2, fluid_only, wall_stop_pair,
+                sd = gather(i, xi, ps.y[i], zi, ps.cell[i], ps, cells, s2, fluid_only, wall_stop_pair,
                             (inv_h, aw, s.nx / nn, s.nz / nn, vx[i], vz[i], tau), sd)
             wsum[i] = s.sw
             if s.sw > 0.0:
@@ -98,7 +98,7 @@ def predict(ps, n, cells, prm, dt):
             # built per particle: a NamedTuple live into a prange loop fails parfor lowering
             k = fluid_consts(prm)
             fi = fluid_i(i, ps, k)
-            fx, fz = gather(i, fi.x, fi.z, ps.cell[i], ps, cells, k.s2, interacting,
+            fx, fz = gather(i, fi.x, ps.y[i], fi.z, ps.cell[i], ps, cells, k.s2, interacting,
                             viscous_pair, (k, fi), (0.0, 0.0))
             ax[i] = fx + prm.gx
             az[i] = fz + prm.gz
@@ -173,7 +173,7 @@ def correct(ps, n, cells, prm, dt):
                 fx = -gpx / rho[i]
                 fz = -gpz / rho[i]
             else:
-                fx, fz = gather(i, x[i], z[i], ps.cell[i], ps, cells, s2, interacting,
+                fx, fz = gather(i, x[i], ps.y[i], z[i], ps.cell[i], ps, cells, s2, interacting,
                                 symmetric_pressure_pair, (inv_h, af, p[i] / (rho[i] * rho[i])),
                                 (0.0, 0.0))
             # the pressure acceleration; with the predictor's, (u^{n+1} - u^n) / dt

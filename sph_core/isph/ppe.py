@@ -63,7 +63,7 @@ def _assemble_row(ps, i, k, cells, prm, inv_dt, idx, wsum, dwall, wscale, indptr
     if ps.kind[i] == FLUID:
         ctx = (1.0 / h, prm.alpha_f, 0.01 * h * h, ps.vx[i], ps.vz[i], ps.rho[i], idx, indices,
                data, base)
-        diag, div, known, cnt = gather(i, ps.x[i], ps.z[i], ps.cell[i], ps, cells, s2,
+        diag, div, known, cnt = gather(i, ps.x[i], ps.y[i], ps.z[i], ps.cell[i], ps, cells, s2,
                                        interacting, fluid_row_pair, ctx, (0.0, 0.0, 0.0, 1))
         data[base] = diag
         # density-invariance relaxation (Asai et al. 2012): a kernel density above the lattice's
@@ -73,7 +73,7 @@ def _assemble_row(ps, i, k, cells, prm, inv_dt, idx, wsum, dwall, wscale, indptr
         data[base] = wscale
         b[k] = wscale * dwall[i]
         ctx = (1.0 / h, prm.alpha_w, wscale / wsum[i], idx, indices, data, base)
-        cnt = gather(i, ps.x[i], ps.z[i], ps.cell[i], ps, cells, s2, fluid_only, wall_row_pair,
+        cnt = gather(i, ps.x[i], ps.y[i], ps.z[i], ps.cell[i], ps, cells, s2, fluid_only, wall_row_pair,
                      ctx, 1)
     for c in range(cnt, MAX_ROW):
         indices[base + c] = -1

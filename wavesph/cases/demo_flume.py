@@ -110,8 +110,10 @@ def run_demo(dp: float, t_end: float, transport: str, out: Path,
         return _couple(srv, demo_scene(dp, t_end, body), transport, out)
 
 
-def _couple(srv: InProcessServer, scene: dict, transport: str, out: Path) -> tuple[dict, Any]:
-    """Create the run, couple the wave to it; (final run record, client report or None)."""
+def _couple(srv: InProcessServer, scene: dict, transport: str, out: Path,
+            where: str | None = None) -> tuple[dict, Any]:
+    """Create the run, couple the wave to it; (final run record, client report or None).
+    ``where``: what the waves run into, for the start line (default: the flume's beach)."""
     import httpx
 
     from server.schemas import TERMINAL
@@ -130,7 +132,8 @@ def _couple(srv: InProcessServer, scene: dict, transport: str, out: Path) -> tup
         count = f"{info['particles']} particles, " if info.get("particles") else ""
         print(f"wavesph demo: {count}dp = {scene['dp']} m, "
               f"{scene['t_end']} s of Stokes-2 waves (H = {HEIGHT} m, T = {PERIOD} s, depth "
-              f"{scene['still_water_level']:.4g} m) onto a 1:{1 / SLOPE:g} beach; server on {base}, coupling over "
+              f"{scene['still_water_level']:.4g} m) {where or f'onto a 1:{1 / SLOPE:g} beach'}; "
+              f"server on {base}, coupling over "
               f"{'WebSocket' if transport == 'ws' else 'TCP'}", file=sys.stderr)
         url = (f"ws://127.0.0.1:{srv.port}/runs/{run['id']}/couple" if transport == "ws"
                else f"tcp://127.0.0.1:{srv.tcp_port}")
