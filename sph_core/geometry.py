@@ -84,10 +84,9 @@ def _rect_shell(scene: Scene, r: Rect, thickness: float) -> tuple[np.ndarray, np
 
 
 def build_layout(scene: Scene) -> Layout:
-    """Place fluid and wall particles for ``scene`` (a 3D scene: geometry3d.build_layout_3d)."""
-    if scene.dim == 3:
-        from .geometry3d import build_layout_3d
-        return build_layout_3d(scene)
+    """Place fluid and wall particles for a 2D ``scene`` (3D: geometry3d.build_layout_3d)."""
+    if scene.dim != 2:
+        raise ValueError("build_layout: a 2D scene's; geometry3d.build_layout_3d places a 3D one")
     dp, t = scene.dp, scene.tank
     nl = wall_layers(scene)
     th = nl * dp

@@ -312,7 +312,8 @@ class Scheme(_Model):
 
 
 class PointProbe(_Model):
-    """Kernel-interpolated velocity (u, w) and pressure p at a point."""
+    """Kernel-interpolated velocity (u, w; in 3D also v, column <name>_v) and pressure p at a
+    point."""
 
     kind: Literal["point"]
     name: str = Field(min_length=1)

@@ -42,6 +42,7 @@ from .bodies import BodyLog, BodySet
 from .boundary_data import BoundaryData, BoundaryDataError, BoundarySample
 from .eos import tait_b
 from .geometry import build_layout
+from .geometry3d import build_layout_3d
 from .kernels import w_of_q, wendland_alpha
 from .neighbours import CellGrid, compute_cells, counting_sort
 from .load_probes import LoadProbes
@@ -107,7 +108,7 @@ class Simulation:
                 raise DeviceError(f"device cuda: {reason}")
         self.scene = scene
         c = scene.constants
-        layout = build_layout(scene)
+        layout = build_layout(scene) if scene.dim == 2 else build_layout_3d(scene)
         dp, h = scene.dp, scene.h
         self.h = h
         self.c0 = scene.c0
@@ -277,12 +278,13 @@ class Simulation:
         return float(ps.field(M)[ps.mask(FLUID)].sum())
 
     def fluid_state(self) -> dict[str, np.ndarray]:
-        """Copies of the fluid particles' fields, ordered by particle id."""
+        """Copies of the fluid particles' fields, ordered by particle id (y, vy: zero in 2D)."""
         ps = self.particles
         sel = ps.mask(FLUID)
         order = np.argsort(ps.ids[: ps.n][sel])
         out = {name: ps.field(row)[sel][order].copy() for name, row in
-               (("x", X), ("z", Z), ("vx", VX), ("vz", VZ), ("rho", RHO), ("p", P), ("m", M))}
+               (("x", X), ("y", Y), ("z", Z), ("vx", VX), ("vy", VY), ("vz", VZ), ("rho", RHO),
+                ("p", P), ("m", M))}
         out["id"] = ps.ids[: ps.n][sel][order].copy()
         return out
 
@@ -291,6 +293,8 @@ class Simulation:
         cols: list[str] = []
         for p in self._points:
             cols += [f"{p.name}_u", f"{p.name}_w", f"{p.name}_p"]
+            if self.dim == 3:
+                cols.append(f"{p.name}_v")
         for p in self._elev:
             cols.append(f"{p.name}_z_surface")
             if self.scene.still_water_level is not None:
@@ -315,8 +319,9 @@ class Simulation:
                                self._pout)
             for k, p in enumerate(self._points):
                 wet = self._pout[k, 3] > 0.05
-                for j, suffix in enumerate(("u", "w", "p")):
-                    out[f"{p.name}_{suffix}"] = float(self._pout[k, j]) if wet else None
+                for j, suffix in enumerate(("u", "w", "p", None, "v")[: 5 if self.dim == 3 else 3]):
+                    if suffix:
+                        out[f"{p.name}_{suffix}"] = float(self._pout[k, j]) if wet else None
         rho0 = self.scene.constants.rho0
         for p in self._elev:
             line_mass_density(ps.view, self.cells, float(p.x), float(p.y), self._line_z, self.h, aw,

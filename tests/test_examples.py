@@ -24,7 +24,8 @@ SCENES = ROOT / "examples" / "scenes"
 
 # example -> coarse dp [m] (the documented mode of the closed tanks is `wavesph run`)
 RUN_DP = {"still_water_tank.toml": 0.05, "dambreak_martin_moyce.toml": 0.05,
-          "floating_box_and_flap.toml": 0.0375}   # 8 rows of its 0.3 m (0.04 is refused: 7.5)
+          "floating_box_and_flap.toml": 0.0375,   # 8 rows of its 0.3 m (0.04 is refused: 7.5)
+          "tall_structure_3d.toml": 0.05}
 
 
 def test_every_example_is_covered():

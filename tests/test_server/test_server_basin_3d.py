@@ -4,7 +4,6 @@ and the page's particle view as an x-z slice."""
 
 from __future__ import annotations
 
-import numpy as np
 import pytest
 
 from protocol import Result, Set, Solve

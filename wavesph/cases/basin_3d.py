@@ -70,23 +70,15 @@ def basin_figures(info: dict, report: Any, wall: float, depth: float) -> dict[st
     """The figures of a finished basin run (summary.json): speed, coupling overhead, RMSE/H at
     the centre-line gauge before the column against the Stokes-2 theory (from when the ramped
     wave has reached it at the linear group velocity)."""
-    import numpy as np
-
     from wave_client.theories import wavenumber
 
-    from ..analysis import group_velocity, rmse_over_height
-    from .demo_flume import RAMP_PERIODS
+    from ..analysis import group_velocity
+    from .demo_flume import RAMP_PERIODS, gauge_rmse
 
     wavelength = 2 * math.pi / float(wavenumber(2 * math.pi / PERIOD, depth))
     t0 = RAMP_PERIODS * PERIOD + BASIN_GAUGES["front"] / group_velocity(wavelength, PERIOD, depth)
-    j = 2 + list(BASIN_GAUGES).index("front")   # after the two open ends' own gauges
-    t = report.t
-    sel = t >= t0
-    rmse = None
-    if sel.sum() >= 10:
-        meas = np.array([r.eta[j] if r.wet[j] else np.nan for r in report.records])[sel]
-        theory = np.array([r.eta_model[j] for r in report.records])[sel]
-        rmse = rmse_over_height(meas, theory, HEIGHT)
+    # after the two open ends' own gauges
+    rmse = gauge_rmse(report, 2 + list(BASIN_GAUGES).index("front"), t0)
     particles, steps = info["particles"], info["steps"]
     pss = info["particle_steps_per_s"] or 0.0
     return {"particles": particles, "windows": info["windows"], "steps": steps,

@@ -159,18 +159,22 @@ def compare_from(depth: float) -> float:
     return RAMP_PERIODS * PERIOD + GAUGES["flat"] / group_velocity(wavelength, PERIOD, depth)
 
 
+def gauge_rmse(report: Any, j: int, t0: float) -> float | None:
+    """RMSE/H of RESULT gauge j (measured, dry as NaN) against the wave model's elevation there
+    from t0 on; None with fewer than 10 windows after t0."""
+    sel = report.t >= t0
+    if sel.sum() < 10:
+        return None
+    meas = np.array([r.eta[j] if r.wet[j] else np.nan for r in report.records])[sel]
+    theory = np.array([r.eta_model[j] for r in report.records])[sel]
+    return rmse_over_height(meas, theory, HEIGHT)
+
+
 def demo_figures(info: dict, report: Any, wall: float, depth: float) -> dict[str, Any]:
     """The figures of a finished demo run (summary.json): speed, coupling overhead, RMSE/H at
     the flat-bed gauge against the Stokes-2 theory."""
-    t = report.t
-    j = _gauge_index(report, "flat")
     t0 = compare_from(depth)
-    sel = t >= t0
-    rmse = None
-    if sel.sum() >= 10:
-        meas = np.array([r.eta[j] if r.wet[j] else np.nan for r in report.records])[sel]
-        theory = np.array([r.eta_model[j] for r in report.records])[sel]
-        rmse = rmse_over_height(meas, theory, HEIGHT)
+    rmse = gauge_rmse(report, _gauge_index(report, "flat"), t0)
     particles, steps = info["particles"], info["steps"]
     pss = info["particle_steps_per_s"] or 0.0
     return {"particles": particles, "windows": info["windows"], "steps": steps,

@@ -104,10 +104,7 @@ def main(args: argparse.Namespace) -> int:
         return 130
     depth = depth_for(dp)
     wall = time.perf_counter() - tic
-    run_dir = out / info["id"]
-    if info["state"] != "finished" or report is None:
-        print(f"wavesph demo: the run ended {info['status']}; data so far in {run_dir}",
-              file=sys.stderr)
+    if not _finished(info, report, out):
         return 1
     figures = demo_figures(info, report, wall, depth)
     (out / "summary.json").write_text(json.dumps(figures, indent=2))
@@ -151,10 +148,7 @@ def _basin(args: argparse.Namespace, dp: float, t_end: float, out: Path) -> int:
         print(f"\nwavesph demo: interrupted; partial results in {out}", file=sys.stderr)
         return 130
     wall = time.perf_counter() - tic
-    run_dir = out / info["id"]
-    if info["state"] != "finished" or report is None:
-        print(f"wavesph demo: the run ended {info['status']}; data so far in {run_dir}",
-              file=sys.stderr)
+    if not _finished(info, report, out):
         return 1
     figures = basin_figures(info, report, wall, depth_for_case(BASIN_DEPTH, dp))
     (out / "summary.json").write_text(json.dumps(figures, indent=2))
@@ -168,6 +162,15 @@ def _basin(args: argparse.Namespace, dp: float, t_end: float, out: Path) -> int:
           f"(the column's load), {info['id']}/sph/run.pvd (ParaView), client_gauges.csv, "
           f"summary.json", file=sys.stderr)
     return 0
+
+
+def _finished(info: dict, report: object, out: Path) -> bool:
+    """Did the coupled run finish with a client report? Else say how it ended, where its data is."""
+    if info["state"] == "finished" and report is not None:
+        return True
+    print(f"wavesph demo: the run ended {info['status']}; data so far in {out / info['id']}",
+          file=sys.stderr)
+    return False
 
 
 def _rmse_text(v: float | None) -> str:
