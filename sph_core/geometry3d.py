@@ -10,7 +10,7 @@ spans the tank's inside. Inside spacings along the floor and the y walls are the
 one spacing from the walls across it whatever the tank's size. Beds are the 2D polylines
 extruded across the width; structures are boxes, a shell of the walls' thickness on a lattice
 of the box's own (spacings closest to dp that fit it whole, so its faces are where the scene
-puts them).
+puts them), or vertical cylinders of concentric rings (``_cylinder_shell``).
 """
 
 from __future__ import annotations
@@ -55,6 +55,26 @@ def _lattice3(scene: Scene, b: Rect) -> tuple[np.ndarray, np.ndarray, np.ndarray
     return _grid(axis(b.x0, b.x1, t.x0), axis(b.y0, b.y1, t.y0), axis(b.z0, b.z1, t.z0))
 
 
+def _cylinder_shell(s: Rect, dp: float, nl: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A vertical cylinder's wall particles: ``nl`` rings at radii R - (k + 1/2) dp (the ring's
+    circumference over a whole number of spacings closest to dp), stacked every ~dp from z0 to
+    z1, and discs of the same rings inside them as the top and bottom caps."""
+    xc, yc, r = 0.5 * (s.x0 + s.x1), 0.5 * (s.y0 + s.y1), 0.5 * (s.x1 - s.x0)
+    zs = _even(s.z0, s.z1, dp)
+    rings = [(r - (k + 0.5) * dp) for k in range(int(r / dp + 0.5))]
+    out = []
+    for k, rk in enumerate(rings):
+        m = max(1, round(2 * np.pi * rk / dp))
+        a = (np.arange(m) + 0.5 * (k % 2)) * 2 * np.pi / m
+        # the outer nl rings over the whole height; the inner ones only within nl layers of the
+        # top and the bottom (the caps)
+        z = zs if k < nl else zs[(zs - s.z0 < nl * dp) | (s.z1 - zs < nl * dp)]
+        gx, gz = np.meshgrid(xc + rk * np.cos(a), z, indexing="ij")
+        gy, _ = np.meshgrid(yc + rk * np.sin(a), z, indexing="ij")
+        out.append((gx.ravel(), gy.ravel(), gz.ravel()))
+    return tuple(np.concatenate([o[i] for o in out]) for i in range(3))
+
+
 def _unique(x: np.ndarray, y: np.ndarray, z: np.ndarray, dp: float) -> np.ndarray:
     """Indices of the first of each group of points closer than ~dp/4 (kept in order)."""
     key = np.round(np.stack([x, y, z]) / (0.25 * dp)).astype(np.int64)
@@ -90,11 +110,16 @@ def build_layout_3d(scene: Scene) -> Layout:
         x2, z2 = gx[keep], gz[keep]
         parts.append((np.repeat(x2, yin.size), np.tile(yin, x2.size), np.repeat(z2, yin.size)))
     for s in scene.structures:
-        # on the box's own lattice (its faces dp/2 outside the outer layer, whatever the box's
-        # size): on the fluid's lattice a face that falls on a lattice point loses that layer
-        sx, sy, sz = _grid(_even(s.x0, s.x1, dp), _even(s.y0, s.y1, dp), _even(s.z0, s.z1, dp))
-        d = np.minimum.reduce([sx - s.x0, s.x1 - sx, sy - s.y0, s.y1 - sy, sz - s.z0, s.z1 - sz])
-        keep = (d < th) & (sx > t.x0) & (sx < t.x1) & (sy > t.y0) & (sy < t.y1) & (sz > t.z0)
+        if s.shape == "cylinder":
+            sx, sy, sz = _cylinder_shell(s, dp, nl)
+        else:
+            # on the box's own lattice (its faces dp/2 outside the outer layer, whatever the
+            # box's size): on the fluid's lattice a face that falls on a lattice point loses it
+            sx, sy, sz = _grid(_even(s.x0, s.x1, dp), _even(s.y0, s.y1, dp), _even(s.z0, s.z1, dp))
+            d = np.minimum.reduce([sx - s.x0, s.x1 - sx, sy - s.y0, s.y1 - sy, sz - s.z0,
+                                   s.z1 - sz])
+            sx, sy, sz = sx[d < th], sy[d < th], sz[d < th]
+        keep = (sx > t.x0) & (sx < t.x1) & (sy > t.y0) & (sy < t.y1) & (sz > t.z0)
         parts.append((sx[keep], sy[keep], sz[keep]))
     wx, wy, wz = (np.concatenate([p[k] for p in parts]) for k in range(3))
     first = _unique(wx, wy, wz, dp)
@@ -120,8 +145,13 @@ def build_layout_3d(scene: Scene) -> Layout:
         _, below = _polyline_distance(bed, x, z)
         keep &= ~below
     for s in scene.structures:
-        keep &= ~((x > s.x0 - half) & (x < s.x1 + half) & (y > s.y0 - half) & (y < s.y1 + half)
-                  & (z > s.z0 - half) & (z < s.z1 + half))
+        vertical = (z > s.z0 - half) & (z < s.z1 + half)
+        if s.shape == "cylinder":
+            r = 0.5 * (s.x1 - s.x0)
+            across = np.hypot(x - 0.5 * (s.x0 + s.x1), y - 0.5 * (s.y0 + s.y1)) < r + half
+        else:
+            across = (x > s.x0 - half) & (x < s.x1 + half) & (y > s.y0 - half) & (y < s.y1 + half)
+        keep &= ~(vertical & across)
     if not keep.any():
         raise ValueError("water_blocks: no fluid particle left after removing beds and structures")
     return Layout(x[keep], z[keep], surf[keep], wx, wz, nl, fluid_y=y[keep], wall_y=wy)

@@ -120,7 +120,21 @@ class Bed(_Model):
 
 
 class Structure(Rect):
-    """A fixed rectangular structure: a shell of dummy particles one kernel support thick."""
+    """A fixed structure: a shell of dummy particles one kernel support thick. ``box`` (default):
+    the rectangle (3D: the box) of its corners; ``cylinder`` (3D scenes): a vertical circular
+    cylinder inscribed in its corners, its axis at the centre of [x0, x1] x [y0, y1] (which
+    must be a square: the diameter), from z0 to z1."""
+
+    shape: Literal["box", "cylinder"] = "box"
+
+    @model_validator(mode="after")
+    def _round(self) -> "Structure":
+        if self.shape == "cylinder" and self.y0 is not None:
+            d, e = self.x1 - self.x0, self.y1 - self.y0
+            if abs(d - e) > 1e-9 * max(d, e):
+                raise ValueError(f"y1: a cylinder's x and y extents are its diameter; got "
+                                 f"{d:g} m and {e:g} m")
+        return self
 
 
 class Body(_Model):
@@ -615,6 +629,9 @@ class Scene(_Model):
         for i, p in enumerate(self.probes):
             if getattr(p, "y", 0.0) != 0.0 or len(getattr(p, "moment_about", None) or ()) == 3:
                 raise ValueError(f"probes.{i}: y needs a 3D scene (dim = 3)")
+        for i, s in enumerate(self.structures):
+            if s.shape != "box":
+                raise ValueError(f"structures.{i}.shape: a {s.shape} needs a 3D scene (dim = 3)")
 
     def _consistent_3d(self) -> None:
         """A 3D scene: the tank has a y range, every box lies across it, and only the features
@@ -629,6 +646,8 @@ class Scene(_Model):
                  + [(f"probes.{i}", p) for i, p in enumerate(self.probes) if isinstance(p, Rect)])
         for where, r in named:
             if r.y0 is None:   # across the tank
+                if getattr(r, "shape", "box") == "cylinder":
+                    raise ValueError(f"{where}.y0: a cylinder needs its y0, y1 (its diameter)")
                 object.__setattr__(r, "y0", t.y0)
                 object.__setattr__(r, "y1", t.y1)
                 r.model_fields_set.update({"y0", "y1"})
@@ -647,8 +666,8 @@ class Scene(_Model):
         for key, asked in refused.items():
             if asked:
                 raise ValueError(f"{key}: not available in 3D yet (dim = 3 runs WCSPH with "
-                                 "delta-SPH on the CPU: walls, beds, box structures and "
-                                 "open ends with long-crested waves; "
+                                 "delta-SPH on the CPU: walls, beds, box and cylinder "
+                                 "structures, open ends with long-crested waves; "
                                  "docs/developer/three_dimensions.md)")
 
     # derived quantities -------------------------------------------------------------------

@@ -130,3 +130,25 @@ def test_y_needs_a_3d_scene_and_a_3d_tank_needs_y():
     sc = make_scene(_box(3))
     assert (sc.water_blocks[0].y0, sc.water_blocks[0].y1) == (0.0, 0.3)   # across the tank
     assert math.isclose(sc.h, 0.04)
+
+
+def test_a_vertical_cylinder_is_rings_of_wall_particles_with_the_fluid_outside():
+    from sph_core.geometry3d import build_layout_3d
+
+    d = _box(3, structures=[dict(shape="cylinder", x0=0.1, x1=0.3, y0=0.05, y1=0.25, z0=0.0,
+                                 z1=0.4)])
+    lay = build_layout_3d(make_scene(d))
+    r_w = np.hypot(lay.wall_x - 0.2, lay.wall_y - 0.15)
+    on = (r_w < 0.1) & (lay.wall_z > 0.0)
+    radii = np.unique(np.round(r_w[on], 9))
+    np.testing.assert_allclose(radii, [0.01, 0.03, 0.05, 0.07, 0.09])   # R - (k + 1/2) dp
+    outer = on & (np.abs(r_w - 0.09) < 1e-9) & (np.abs(lay.wall_z - 0.21) < 0.011)
+    gaps = np.diff(np.sort(np.arctan2(lay.wall_y[outer] - 0.15, lay.wall_x[outer] - 0.2)))
+    assert gaps.max() * 0.09 == pytest.approx(0.02, rel=0.05)          # ~dp along the ring
+    r_f = np.hypot(lay.fluid_x - 0.2, lay.fluid_y - 0.15)
+    assert r_f.min() >= 0.1 + 0.01 - 1e-9                              # R + dp/2
+    with pytest.raises(SceneError, match="diameter"):
+        make_scene(_box(3, structures=[dict(shape="cylinder", x0=0.1, x1=0.3, y0=0.05, y1=0.2,
+                                            z0=0.0, z1=0.4)]))
+    with pytest.raises(SceneError, match="3D scene"):
+        make_scene(_box(2, structures=[dict(shape="cylinder", x0=0.1, x1=0.3, z0=0.0, z1=0.4)]))
