@@ -125,6 +125,8 @@ def test_every_example_previews_without_solving(tmp_path, name):
     assert last["kind"].size == points and last["kind"].max() <= 3
     # idle open-end buffer particles (above the surface, in no pass) are not written
     assert points == meta["n_particles"] if not scene.open_boundaries else points < meta["n_particles"]
-    assert piece(out / "geometry.vtu", "NumberOfCells") == (   # one line cell per segment
-        3 + sum(len(b.points) - 1 for b in scene.beds) + 4 * len(scene.structures)
-        + len(scene.open_boundaries))
+    # one line cell per segment (3D: a box's 12 edges, the tank's included; beds on both walls)
+    cells = (12 * (1 + len(scene.structures))
+             + sum(3 * len(b.points) - 2 for b in scene.beds) if scene.dim == 3
+             else 3 + sum(len(b.points) - 1 for b in scene.beds) + 4 * len(scene.structures))
+    assert piece(out / "geometry.vtu", "NumberOfCells") == cells + len(scene.open_boundaries)

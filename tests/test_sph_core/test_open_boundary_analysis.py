@@ -81,11 +81,11 @@ def test_ghost_node_interpolation_reproduces_a_linear_field_exactly():
     a, b, c = 50.0, 300.0, -9810.0
     f[P, : ps.n][fl] = a + b * f[X, : ps.n][fl] + c * f[Z, : ps.n][fl]
     for xg, zg in [(0.3, 0.15), (0.6, 0.15), (0.59, 0.01), (0.3, 0.29)]:
-        pg, px, pz, order = ob.ghost_pressure(ps.view, sim.cells, xg, zg, sim.prm)
+        pg, px, pz, order = ob.ghost_pressure(ps.view, sim.cells, xg, 0.0, zg, sim.prm)
         assert order == 1, (xg, zg)
         assert pg == pytest.approx(a + b * xg + c * zg, rel=1e-9, abs=1e-6), (xg, zg)
         assert (px, pz) == pytest.approx((b, c), rel=1e-7), (xg, zg)
-    assert ob.ghost_pressure(ps.view, sim.cells, 0.3, 0.39, sim.prm)[3] == -1
+    assert ob.ghost_pressure(ps.view, sim.cells, 0.3, 0.0, 0.39, sim.prm)[3] == -1
 
 
 def test_decay_aware_reflection_fit_separates_damping_from_reflection():
