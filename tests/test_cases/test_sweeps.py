@@ -382,3 +382,14 @@ def test_plan_table_says_what_to_do_and_what_it_rests_on(tmp_path, capsys):
     assert "H/dp 2-8" in out and "c0 = 15.3 m/s" in out     # the scene's own c0
     assert "To apply it, in the scene file:" in out and "    dp = 0.006667" in out
     assert "flat + 3.4 structures" in out
+
+
+def test_plan_refuses_a_3d_scene_in_one_line(tmp_path):
+    scene = tmp_path / "basin.toml"
+    scene.write_text((ROOT / "examples/scenes/tall_structure_3d.toml").read_text()
+                     .replace("t_end = 1.5", "t_end = 1.5\nstill_water_level = 0.3"))
+    res = subprocess.run([sys.executable, "-m", "wavesph", "plan", str(scene), "--H", "0.05",
+                          "--T", "1.0"], cwd=ROOT, capture_output=True, text=True, timeout=300,
+                         env={"PYTHONPATH": str(ROOT), "PATH": "/usr/bin:/bin"})
+    assert res.returncode == 2
+    assert res.stderr.count("\n") == 1 and "3D scene" in res.stderr

@@ -34,6 +34,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def main(args: argparse.Namespace) -> int:
     try:
         scene = load_scene(args.scene)
+        if scene.dim == 3:
+            raise ValueError("a 3D scene (dim = 3): the sweep the plan rests on is 2D flumes; "
+                             "no 3D plan yet (docs/developer/three_dimensions.md has 3D costs)")
         req = request_from_scene(scene, args.height, args.period, args.target_error)
         data = sweep_data(args.data)
         plan = make_plan(req, data, throughput=args.throughput)
