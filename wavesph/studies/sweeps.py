@@ -457,7 +457,7 @@ def plot_accuracy(records: list[dict[str, Any]], path: Path, title: str = "") ->
             ax.plot([r["wall_s"] for r in pts], [r["error"] for r in pts], "o-", label=label,
                     color=colour[method])
             for r in pts:
-                ax.annotate(f"{r['dp']:g}", (r["wall_s"], r["error"]), fontsize=7,
+                ax.annotate(f"{r['dp']:.3g}", (r["wall_s"], r["error"]), fontsize=7,
                             xytext=(3, 3), textcoords="offset points")
         ax.set_xscale("log")
         ax.set_yscale("log")
