@@ -224,7 +224,6 @@ def buffer_update(ps, n, dt, r, zs0, du0, zs1, du1, ends, prm):
         if b < 0:
             continue
         vx[i] = u
-        vy[i] = 0.0     # long-crested: the boundary data has no y component (3D scenes)
         vz[i] = w
         x[i] = xi
         kind[i] = k
@@ -232,8 +231,10 @@ def buffer_update(ps, n, dt, r, zs0, du0, zs1, du1, ends, prm):
         p[i] = pi
         drho[i] = 0.0
         ax[i] = 0.0
-        ay[i] = 0.0
         az[i] = 0.0
+        if prm.three is not None:   # long-crested: the boundary data has no y component
+            vy[i] = 0.0
+            ay[i] = 0.0
 
 
 # what a slot does at the face crossings (transition_of)

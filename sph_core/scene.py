@@ -537,6 +537,32 @@ class Scene(_Model):
 
     @model_validator(mode="before")
     @classmethod
+    def _across_tank(cls, data: Any) -> Any:
+        # a 3D scene's water block, box structure or force probe without y0, y1 spans the tank's
+        # width: given so here, as a new value (the models are frozen, and a caller's object
+        # may serve other scenes)
+        if not (isinstance(data, dict) and data.get("dim") == 3):
+            return data
+        tank = data.get("tank")
+        get = tank.get if isinstance(tank, dict) else (lambda k: getattr(tank, k, None))
+        y0, y1 = get("y0"), get("y1")
+        if y0 is None or y1 is None:
+            return data
+
+        def across(v: Any) -> Any:
+            if isinstance(v, dict):
+                box = v.get("kind", "force") == "force" and v.get("shape") != "cylinder"
+                return {**v, "y0": y0, "y1": y1} if box and v.get("y0") is None and v.get("y1") is None else v
+            if isinstance(v, Rect) and v.y0 is None and getattr(v, "shape", "box") != "cylinder":
+                return v.model_copy(update={"y0": y0, "y1": y1})
+            return v
+
+        return {**data, **{key: [across(v) for v in data[key]]
+                           for key in ("water_blocks", "structures", "probes")
+                           if isinstance(data.get(key), list)}}
+
+    @model_validator(mode="before")
+    @classmethod
     def _scheme_h(cls, data: Any) -> Any:
         # ISPH was built and measured at h/dp sqrt 2; at the WCSPH default h/dp 2 its still tank
         # (d/dp 10) reaches 0.045 m/s in 0.2 s against 0.009 (corner particles creep inward), so an
@@ -645,13 +671,9 @@ class Scene(_Model):
                  + [(f"structures.{i}", b) for i, b in enumerate(self.structures)]
                  + [(f"probes.{i}", p) for i, p in enumerate(self.probes) if isinstance(p, Rect)])
         for where, r in named:
-            if r.y0 is None:   # across the tank
-                if getattr(r, "shape", "box") == "cylinder":
-                    raise ValueError(f"{where}.y0: a cylinder needs its y0, y1 (its diameter)")
-                object.__setattr__(r, "y0", t.y0)
-                object.__setattr__(r, "y1", t.y1)
-                r.model_fields_set.update({"y0", "y1"})
-            elif where.startswith("water_blocks") and (r.y0 < t.y0 - 1e-12 or r.y1 > t.y1 + 1e-12):
+            if r.y0 is None:   # the others were given the tank's width (_across_tank)
+                raise ValueError(f"{where}.y0: a cylinder needs its y0, y1 (its diameter)")
+            if where.startswith("water_blocks") and (r.y0 < t.y0 - 1e-12 or r.y1 > t.y1 + 1e-12):
                 raise ValueError(f"{where}: must lie inside the tank (y {t.y0}..{t.y1})")
         for i, p in enumerate(self.probes):
             y = getattr(p, "y", None)

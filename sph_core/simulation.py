@@ -319,9 +319,9 @@ class Simulation:
                                self._pout)
             for k, p in enumerate(self._points):
                 wet = self._pout[k, 3] > 0.05
-                for j, suffix in enumerate(("u", "w", "p", None, "v")[: 5 if self.dim == 3 else 3]):
-                    if suffix:
-                        out[f"{p.name}_{suffix}"] = float(self._pout[k, j]) if wet else None
+                # interpolate_points' columns: u, w, p, (sum V W), v
+                for suffix, j in (("u", 0), ("w", 1), ("p", 2), ("v", 4))[: 4 if self.dim == 3 else 3]:
+                    out[f"{p.name}_{suffix}"] = float(self._pout[k, j]) if wet else None
         rho0 = self.scene.constants.rho0
         for p in self._elev:
             line_mass_density(ps.view, self.cells, float(p.x), float(p.y), self._line_z, self.h, aw,

@@ -32,17 +32,19 @@ def kick_drift_particle(i, ps, dt, prm):
     """``wcsph.kdk_kick_drift`` for fluid slot i; True if it ends outside the fluid box."""
     hdt = 0.5 * dt
     ps.vx[i] += hdt * ps.ax[i]
-    ps.vy[i] += hdt * ps.ay[i]
     ps.vz[i] += hdt * ps.az[i]
     r = ps.rho[i] + hdt * ps.drho[i]
     ps.rho[i] = r
     ps.p[i] = pressure(r + hdt * ps.drho[i], prm.rho0, prm.b, prm.gamma)
     xi = ps.x[i] + dt * ps.vx[i]
-    yi = ps.y[i] + dt * ps.vy[i]
     zi = ps.z[i] + dt * ps.vz[i]
     ps.x[i] = xi
-    ps.y[i] = yi
     ps.z[i] = zi
+    yi = 0.0
+    if prm.three is not None:   # 2D (when compiled): the y rows stay zero
+        ps.vy[i] += hdt * ps.ay[i]
+        yi = ps.y[i] + dt * ps.vy[i]
+        ps.y[i] = yi
     return _outside(xi, yi, zi, prm) == 1
 
 
@@ -52,16 +54,18 @@ def kick_particle(i, ps, dt, prm):
     1 non-finite, 2 outside the density band."""
     hdt = 0.5 * dt
     ax = ps.ax[i]
-    ay = ps.ay[i]
     az = ps.az[i]
     u = ps.vx[i] + hdt * ax + ps.dvnx[i]
-    v = ps.vy[i] + hdt * ay + ps.dvny[i]
     w = ps.vz[i] + hdt * az + ps.dvnz[i]
     r = ps.rho[i] + hdt * ps.drho[i]
     ps.vx[i] = u
-    ps.vy[i] = v
     ps.vz[i] = w
     ps.rho[i] = r
+    v = ay = 0.0
+    if prm.three is not None:   # 2D (when compiled): the y rows stay zero
+        ay = ps.ay[i]
+        v = ps.vy[i] + hdt * ay + ps.dvny[i]
+        ps.vy[i] = v
     bad, band, v2, a2 = _guard(u, v, w, r, ax, ay, az, prm.rho_lo * prm.rho0,
                                prm.rho_hi * prm.rho0)
     return v2, a2, r, 1 if bad else (2 if band else 0)

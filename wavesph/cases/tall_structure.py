@@ -46,11 +46,12 @@ def measured_force() -> tuple[np.ndarray, np.ndarray]:
 
 def tall_structure_scene(dp: float = 0.02, t_end: float = 1.0, probe_every: float = 0.005,
                          snapshot_every: float = 0.0, wet_bed: bool | None = None,
-                         **constants) -> Scene:
+                         scheme: dict | None = None, **constants) -> Scene:
     """The 3D case at spacing ``dp`` with a force probe ``column`` on the structure's particles.
 
     ``wet_bed``: the 1 cm layer downstream of the gate; default on when it holds a particle row
-    (dp <= 1 cm), off at a coarser dp (a dry bed, as Proteus' model of the case).
+    (dp <= 1 cm), off at a coarser dp (a dry bed, as Proteus' model of the case). ``scheme``:
+    the scene's [scheme] table (default wcsph).
     ``constants`` override the scene constants: alpha defaults to the dam break's 0.1
     (wavesph.cases.dambreak), h/dp to TALL_H_OVER_DP, the wall viscosity factor to
     TALL_ALPHA_WALL_FACTOR."""
@@ -72,7 +73,7 @@ def tall_structure_scene(dp: float = 0.02, t_end: float = 1.0, probe_every: floa
         "tank": {"x0": 0.0, "x1": length, "y0": 0.0, "y1": width, "z0": 0.0, "z1": height},
         "water_blocks": blocks,
         "structures": [{"x0": x0, "x1": x1, "y0": y0, "y1": y1, "z0": 0.0, "z1": height}],
-        "constants": constants,
+        "constants": constants, "scheme": scheme or {},
         "output": {"probe_every": probe_every, "snapshot_every": snapshot_every},
         "probes": [{"kind": "force", "name": "column", "x0": x0 - 0.5 * dp, "x1": x1 + 0.5 * dp,
                     "y0": y0 - 0.5 * dp, "y1": y1 + 0.5 * dp, "z0": 0.0, "z1": height}],

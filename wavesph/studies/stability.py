@@ -270,11 +270,13 @@ def _still_water_3d(consts: dict, quick: bool) -> dict[str, Any]:
 
     d, dp = 0.3, 0.05 if quick else 0.03
     t_end = (20.0 if quick else 60.0) * math.sqrt(d / G)
+    scheme = consts.pop("scheme", {})
     sim = Simulation(make_scene({
         "name": "still_water_3d", "dim": 3, "dp": dp, "t_end": t_end, "still_water_level": d,
         "tank": {"x0": 0.0, "x1": 0.6, "y0": 0.0, "y1": 0.3, "z0": 0.0, "z1": d + 0.1},
         "water_blocks": [{"x0": 0.0, "x1": 0.6, "z0": 0.0, "z1": d}],
-        "constants": {**consts, "h_over_dp": 1.5}, "output": {"probe_every": 0.05},
+        "constants": {**consts, "h_over_dp": 1.5}, "scheme": scheme,
+        "output": {"probe_every": 0.05},
         "probes": [{"kind": "elevation", "name": "mid", "x": 0.3, "y": 0.15}]}))
     status, t_fail, reason = _advance(sim, t_end)
     eta = np.array([r["mid_eta"] for r in sim.history if r["mid_eta"] is not None])
