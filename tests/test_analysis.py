@@ -12,7 +12,7 @@ import pytest
 
 import wavesph
 import wavesph.cli
-from wavesph.analysis import analyse_run, mean_overtopping, peaks, wave_statistics
+from wavesph.analysis import analyse_run, mean_overtopping, peaks, runup_statistics, wave_statistics
 
 T, DT = 1.5, 0.01
 
@@ -66,6 +66,24 @@ def test_load_peaks_per_period():
     assert p.highest_tenth_mean == pytest.approx(119.0, rel=1e-4)
 
 
+def test_runup_ru2_is_the_two_percent_event_of_the_incident_waves():
+    # 100 swash cycles, the k-th reaching 0.01 k m above still water (order shuffled)
+    rng = np.random.default_rng(3)
+    heights = rng.permutation(0.01 * np.arange(1, 101))
+    t = np.arange(0.0, 100 * T, DT)
+    k = np.minimum((t // T).astype(int), 99)
+    rise = heights[k] * np.sin(2 * np.pi * t / T)
+    r = runup_statistics(t, rise)
+    whole = np.sort(heights[1:-1])[::-1]    # events between up-crossings: the ends are cut
+    assert r.n_events == 98 and r.n_waves == 98
+    assert r.Rmax == pytest.approx(whole[0], abs=2e-3)
+    # 2 % of 98 events -> rank 2 from the top; of 200 incident waves -> rank 4
+    assert r.Ru2 == pytest.approx(whole[1], abs=2e-3)
+    assert runup_statistics(t, rise, n_waves=200).Ru2 == pytest.approx(whole[3], abs=2e-3)
+    with pytest.raises(ValueError, match="up-crossings"):
+        runup_statistics(t[:10], rise[:10])
+
+
 def _run_dir(tmp_path):
     t = np.arange(0.0, 12 * T, DT)
     cols = {"t": t, "step": np.arange(t.size),
@@ -73,11 +91,13 @@ def _run_dir(tmp_path):
             "flat_eta": 0.03 * np.sin(2 * math.pi * t / T),
             "wall_fx": 50 + 5 * np.sin(2 * math.pi * t / T), "wall_fz": 0 * t, "wall_my": 0 * t,
             "line_p0": 1000 + 100 * np.cos(2 * math.pi * t / T),
-            "crest_q": 0.001 + 0 * t, "crest_volume": 0.001 * t}
+            "crest_q": 0.001 + 0 * t, "crest_volume": 0.001 * t,
+            "shore_x": 0 * t, "shore_z": 0.3 + 0.04 * np.sin(2 * math.pi * t / T), "shore_R": 0 * t}
     run = tmp_path / "run"
     run.mkdir()
     lines = [",".join(cols)] + [",".join(f"{cols[c][i]:.12g}" for c in cols) for i in range(t.size)]
     (run / "probes.csv").write_text("\n".join(lines) + "\n")
+    (run / "meta.json").write_text(json.dumps({"config": {"still_water_level": 0.3}}))
     return run
 
 
@@ -89,6 +109,8 @@ def test_analyse_run_reads_a_run_directory(tmp_path):
     assert res["loads"]["wall_fx"]["max"] == pytest.approx(55.0, rel=1e-4)
     assert res["loads"]["line_p0"]["min"] == pytest.approx(900.0, rel=1e-4)
     assert "flat_z_surface" not in res["loads"] and "crest_q" not in res["loads"]
+    assert res["runup"]["shore"]["Rmax"] == pytest.approx(0.04, rel=1e-3)
+    assert res["runup"]["shore"]["n_waves"] == res["waves"]["flat"]["n_waves"]
     assert wavesph.analyse(tmp_path / "run", t_from=3.0)["waves"].keys() == {"flat"}
 
 
@@ -97,6 +119,7 @@ def test_analyse_command(tmp_path, capsys):
     assert wavesph.cli.main(["analyse", str(run), "--from", "3", "--period", str(T)]) == 0
     out = capsys.readouterr().out
     assert "Hm0 [m]" in out and "flat" in out and "mean q [m^2/s]" in out and "wall_fx" in out
+    assert "Ru2% [m]" in out and "shore" in out
     assert wavesph.cli.main(["analyse", str(run), "--json"]) == 0
     assert json.loads(capsys.readouterr().out)["waves"]["flat"]["n_waves"] == 11
     assert wavesph.cli.main(["analyse", str(tmp_path)]) == 2

@@ -31,7 +31,8 @@ RUN_DP = {"still_water_tank.toml": 0.05, "dambreak_martin_moyce.toml": 0.05,
 def test_every_example_is_covered():
     """A new example file must be added here (or this test says which one is not run)."""
     shipped = {p.name for p in SCENES.glob("*.toml")}
-    assert shipped == set(RUN_DP) | {"demo_beach_flume.toml", "flume_case_V.toml"}
+    assert shipped == set(RUN_DP) | {"demo_beach_flume.toml", "flume_case_V.toml",
+                                     "seawall_overtopping.toml"}
 
 
 def _meta(out: Path) -> dict:
@@ -49,14 +50,15 @@ def test_closed_tank_examples_run_to_their_end(tmp_path, name):
     assert meta["excluded"] <= 0.001 * meta["n_fluid"]
 
 
-def _theory_run(scene_file: Path, dp: float, theory: str, **opts):
+def _theory_run(scene_file: Path, dp: float, theory: str, t_end: float | None = None, **opts):
     """An open-boundary example driven by the built-in theory its comment documents, to its end
-    (the standalone path: the same Simulation the server's standalone runs solve)."""
+    or to ``t_end`` (the standalone path: the same Simulation the server's standalone runs
+    solve)."""
     from wavesph.cases.wave_flume import run_wave_flume
     from wave_client.theories import build_theory
 
     data, _ = split_scene_file(tomllib.loads(scene_file.read_text()))
-    scene = make_scene({**data, "dp": dp})
+    scene = make_scene({**data, "dp": dp, **({"t_end": t_end} if t_end else {})})
     model = build_theory(theory, depth=scene.still_water_level, **opts)
     run = run_wave_flume(scene, model, window=opts["period"] / 50, keep_flume=True)
     return scene, run
@@ -70,6 +72,25 @@ def test_demo_beach_flume_with_its_stokes_source_runs_to_its_end():
     sim = run.flume
     assert sim.t == pytest.approx(scene.t_end) and sim.status == "completed"
     assert len(sim.excluded) <= 0.001 * sim.n_fluid0
+
+
+def test_seawall_overtopping_is_the_case_and_runs_with_its_irregular_source():
+    """examples/scenes/seawall_overtopping.toml is wavesph.cases.seawall's scene at Hs/dp 4, and
+    runs with its [source] (JONSWAP) at dp 0.0375 (8 rows) for 6 s: the first waves reach the
+    slope, the toe gauge stays wet and nothing leaves the flume."""
+    from wavesph.cases.seawall import HS, seawall_scene
+
+    path = SCENES / "seawall_overtopping.toml"
+    data, extra = split_scene_file(tomllib.loads(path.read_text()))
+    scene = make_scene(data)
+    assert scene == make_scene(seawall_scene(HS / 4, t_end=scene.t_end))
+    src = {k: v for k, v in extra["source"].items() if k not in ("theory", "H", "T", "ramp_periods")}
+    scene, run = _theory_run(path, 0.0375, "irregular", height=HS, period=1.4,
+                             ramp_time=2 * 1.4, **src, t_end=6.0)
+    sim = run.flume
+    assert sim.status == "completed" and len(sim.excluded) == 0
+    toe = [r["toe_eta"] for r in sim.history if r["t"] > 3.0]
+    assert all(v is not None for v in toe) and max(toe) - min(toe) > 0.02
 
 
 @pytest.mark.slow

@@ -1,7 +1,8 @@
 """Wave-record analysis: RMSE against theory, reflection coefficient (flume validation), and the
-post-processing of a run (wave height and period per gauge, mean overtopping discharge, load
-peaks: ``wave_statistics``, ``mean_overtopping``, ``peaks``, ``analyse_run``; the command
-`wavesph analyse RUN_DIR`).
+post-processing of a run (wave height and period per gauge, mean overtopping discharge, run-up
+Ru2%, load peaks: ``wave_statistics``, ``mean_overtopping``, ``runup_statistics``, ``peaks``,
+``analyse_run``; the command `wavesph analyse RUN_DIR`; the design formulas they are compared
+with are in ``wavesph.eurotop``).
 
 Reflection by least squares over two or more gauges (Goda & Suzuki 1976 for two gauges;
 Mansard & Funke 1980 for more): at the angular frequency omega each gauge j's complex amplitude
@@ -28,6 +29,7 @@ returned here.
 
 from __future__ import annotations
 
+import json
 import math
 from dataclasses import asdict, dataclass
 from pathlib import Path
@@ -227,6 +229,45 @@ def mean_overtopping(t: np.ndarray, volume: np.ndarray, t_from: float | None = N
 
 
 @dataclass(frozen=True)
+class RunupStats:
+    """Run-up of one shoreline record [m above still water]: Ru2 the level that 2 % of the
+    incident waves' run-ups exceed (EurOtop's Ru2%), Rmax the highest, n_events the run-up events
+    (maxima between up-crossings of the record's mean), n_waves the incident waves counted."""
+
+    Ru2: float
+    Rmax: float
+    n_events: int
+    n_waves: int
+
+
+def runup_statistics(t: np.ndarray, rise: np.ndarray, t_from: float | None = None,
+                     n_waves: int | None = None) -> RunupStats:
+    """RunupStats of ``rise(t)``, a run-up probe's shoreline elevation minus the still-water
+    level [m], from ``t_from`` [s] on. Each run-up event is the highest sample between two
+    up-crossings of the record's mean (a swash that stays above the mean merges with its
+    neighbour: only the high events are told apart, which are the ones Ru2 ranks). Ru2 is the
+    event maximum of rank ceil(0.02 n_waves) from the top, with n_waves the incident waves (a
+    toe gauge's wave count: EurOtop's definition); without it, the events' own count. Samples
+    with no shoreline (NaN) are left out."""
+    t, r = _window(t, rise, t_from, "rise")
+    ok = np.isfinite(r)
+    if ok.sum() < 3:
+        raise ValueError("rise: fewer than 3 recorded samples")
+    t, r = t[ok], r[ok]
+    e = r - r.mean()
+    up = np.flatnonzero((e[:-1] < 0.0) & (e[1:] >= 0.0)) + 1
+    events = np.array([r[a:b].max() for a, b in zip(up[:-1], up[1:])])
+    if events.size == 0:
+        raise ValueError("rise: no whole run-up event (fewer than two up-crossings of the mean)")
+    n = events.size if n_waves is None else int(n_waves)
+    if n < 1:
+        raise ValueError(f"n_waves: must be >= 1, got {n_waves}")
+    rank = min(math.ceil(0.02 * n), events.size)
+    return RunupStats(float(np.sort(events)[::-1][rank - 1]), float(events.max()),
+                      int(events.size), n)
+
+
+@dataclass(frozen=True)
 class Peaks:
     """Extremes of a load record (force [N/m], moment [N m/m] or pressure [Pa]) and, given the
     wave period, of its per-period maxima: their mean and the mean of their highest tenth."""
@@ -286,8 +327,9 @@ def analyse_run(run_dir: str | Path, t_from: float | None = None,
         raise ValueError(f"{run_dir}: no {', '.join(RUN_CSVS)} here (a run directory of "
                          "`wavesph run` or of the server)")
     out: dict[str, Any] = {"files": [str(f.relative_to(run_dir)) for f in files], "t_from": t_from,
-                           "period": period, "waves": {}, "overtopping": {}, "loads": {},
-                           "skipped": {}}
+                           "period": period, "waves": {}, "overtopping": {}, "runup": {},
+                           "loads": {}, "skipped": {}}
+    shorelines: list[tuple[str, np.ndarray, np.ndarray]] = []
     for f in files:
         cols = load_gauges(f)
         t = cols.get("t")
@@ -299,11 +341,37 @@ def analyse_run(run_dir: str | Path, t_from: float | None = None,
                     out["waves"][name[:-4]] = asdict(wave_statistics(t, y, t_from))
                 elif name.endswith("_volume"):
                     out["overtopping"][name[:-7]] = {"q_m2_s": mean_overtopping(t, y, t_from)}
+                elif name.endswith("_z") and name[:-2] + "_R" in cols:   # a run-up probe
+                    shorelines.append((name[:-2], t, y))
                 elif _is_load(name) and name not in out["loads"]:
                     out["loads"][name] = asdict(peaks(t, y, t_from, period))
             except ValueError as exc:
                 out["skipped"][name] = str(exc)
+    # run-up counts the incident waves of the first elevation gauge (put the toe gauge first)
+    n_waves = next((w["n_waves"] for w in out["waves"].values() if w["n_waves"]), None)
+    swl = _still_water_level(run_dir) if shorelines else None
+    for name, t, z in shorelines:
+        if swl is None:
+            out["skipped"][name + "_z"] = "no still_water_level in the run's meta.json"
+            continue
+        try:
+            out["runup"][name] = asdict(runup_statistics(t, z - swl, t_from, n_waves))
+        except ValueError as exc:
+            out["skipped"][name + "_z"] = str(exc)
     return out
+
+
+def _still_water_level(run_dir: Path) -> float | None:
+    """The scene's still-water level from the run's meta.json (`wavesph run`, or a server
+    run's sph/), None if neither names one."""
+    for meta in (run_dir / "meta.json", run_dir / "sph" / "meta.json"):
+        try:
+            swl = json.loads(meta.read_text())["config"].get("still_water_level")
+        except (OSError, ValueError, KeyError, AttributeError):
+            continue
+        if swl is not None:
+            return float(swl)
+    return None
 
 
 def _is_load(name: str) -> bool:

@@ -48,6 +48,9 @@ QUESTIONS: dict[str, tuple[str, ...]] = {
     "runup": ("Run-up", "How far up a 1:19.85 plane beach does a solitary wave run in SPH, against "
                         "Synolakis' (1987) law R/d = 2.831 sqrt(cot beta) (H/d)^(5/4)? "
                         "(studies/runup.md)"),
+    "overtopping": ("Overtopping", "How much water does an irregular sea carry over a smooth 1:2 "
+                                   "seawall, against the EurOtop (2018) mean-value formula? "
+                                   "(studies/overtopping.md)"),
     "boussinesq": ("Boussinesq model", "The far-field wave model against its own theory."),
     "stability": ("Stability suite",
                   "Which scenarios each integrator survives: stable (every measure within its "

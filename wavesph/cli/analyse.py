@@ -3,9 +3,11 @@
     wavesph analyse runs/seawall --from 3.0 --period 1.5
 
 Per elevation gauge Hm0, Tp, H1/3, Hmax, Tm and the number of waves; per overtopping probe the
-mean discharge q; per force or pressure-line column the peaks (with --period, the mean of the
-per-period maxima and of their highest tenth). The functions are wavesph.analysis's
-(wave_statistics, mean_overtopping, peaks, analyse_run). Exit status: 0, 2 no gauge files.
+mean discharge q; per run-up probe Ru2% and the highest run-up above still water (Ru2% ranked
+among the first elevation gauge's incident waves); per force or pressure-line column the peaks
+(with --period, the mean of the per-period maxima and of their highest tenth). The functions
+are wavesph.analysis's (wave_statistics, mean_overtopping, runup_statistics, peaks,
+analyse_run). Exit status: 0, 2 no gauge files.
 """
 
 from __future__ import annotations
@@ -50,6 +52,10 @@ def main(args: argparse.Namespace) -> int:
         print(f"\n{'overtopping':<16} {'mean q [m^2/s]':>15}")
         for name, o in res["overtopping"].items():
             print(f"{name:<16} {o['q_m2_s']:>15.4g}")
+    if res["runup"]:
+        print(f"\n{'run-up':<16} {'Ru2% [m]':>9} {'Rmax [m]':>9} {'events':>7} {'waves':>6}")
+        for name, r in res["runup"].items():
+            print(f"{name:<16} {r['Ru2']:>9.4g} {r['Rmax']:>9.4g} {r['n_events']:>7} {r['n_waves']:>6}")
     if res["loads"]:
         print(f"\n{'load [N/m, N m/m, Pa]':<22} {'max':>10} {'at t [s]':>9} {'min':>10} "
               f"{'mean':>10} {'mean/period':>12} {'top 1/10':>10}")
