@@ -41,7 +41,7 @@ def per_step_ms(sim: Simulation, seconds: float) -> float:
     return 1e3 * (time.perf_counter() - tic) / (sim.steps - s0)
 
 
-def measure(dp: float, seconds: float) -> dict:
+def step_costs(dp: float, seconds: float) -> dict:
     data = demo_scene(dp, t_end=1.0 + seconds)
     closed = make_scene({k: v for k, v in data.items() if k != "open_boundaries"})
     ms_closed = per_step_ms(Simulation(closed), seconds)
@@ -63,7 +63,7 @@ def main() -> None:
     ap.add_argument("--seconds", type=float, default=1.0, help="simulated seconds timed")
     a = ap.parse_args()
     for dp in a.dps:
-        print(json.dumps(measure(dp, a.seconds)), flush=True)
+        print(json.dumps(step_costs(dp, a.seconds)), flush=True)
 
 
 if __name__ == "__main__":

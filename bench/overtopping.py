@@ -53,12 +53,12 @@ from sph_core.open_ends import flume_nodes  # noqa: E402
 from sph_core.scene import make_scene  # noqa: E402
 from sph_core.simulation import Simulation, UnstableError  # noqa: E402
 from wavesph.analysis import mean_overtopping, wave_statistics  # noqa: E402
-from wavesph.cases.seawall import (DEPTH, HS, N_COMPONENTS, RC_OVER_HS, TAN_ALPHA, TP,  # noqa: E402
-                                   sea, seawall_scene, spectral_hm0_tm10)
+from wavesph.cases.seawall import (HS, N_COMPONENTS, RC_OVER_HS, SEAWALL_DEPTH,  # noqa: E402
+                                   TAN_ALPHA, TP, sea, seawall_scene, spectral_hm0_tm10)
 from wavesph.eurotop import smooth_slope_overtopping  # noqa: E402
 
 
-def run(waves: int, hs_over_dp: float, rc_over_hs: float, seed: int, out: Path) -> dict:
+def overtopping_run(waves: int, hs_over_dp: float, rc_over_hs: float, seed: int, out: Path) -> dict:
     dp = HS / hs_over_dp
     rc = rc_over_hs * HS
     waves_in = sea(seed)
@@ -70,7 +70,7 @@ def run(waves: int, hs_over_dp: float, rc_over_hs: float, seed: int, out: Path) 
         raise SystemExit(f"the record repeats after {waves_in.repeat_period:.0f} s < t_end {t_end:.0f} s")
     scene = make_scene(seawall_scene(dp, rc, t_end))
     x_crest = next(p.x for p in scene.probes if p.name == "crest")
-    src = WaveModelBoundary(waves_in, flume_nodes(scene)["left"], DEPTH, 0.0)
+    src = WaveModelBoundary(waves_in, flume_nodes(scene)["left"], SEAWALL_DEPTH, 0.0)
     tic = time.perf_counter()
     # spare: the pit fills with up to ~0.4 m^3/m of inflow on top of the flume's ~0.8
     sim = Simulation(scene, run_dir=out, spare=1.0, sources={"left": src})
@@ -102,7 +102,7 @@ def run(waves: int, hs_over_dp: float, rc_over_hs: float, seed: int, out: Path) 
             "q_eurotop_hi": float(f"{q_hi:.4g}"), "ratio": round(q_mean / q_e, 3),
             "Hm0_toe": round(stats.Hm0, 4), "Hm0": round(hm0, 4), "Tm_10": round(tm10, 3),
             "Tp": TP, "Rc": round(rc, 4), "Rc_over_Hm0": round(rc / hm0, 3),
-            "xi": round(xi, 3), "regime": regime, "depth": DEPTH, "tan_alpha": TAN_ALPHA,
+            "xi": round(xi, 3), "regime": regime, "depth": SEAWALL_DEPTH, "tan_alpha": TAN_ALPHA,
             "dp": round(dp, 6), "Hs_over_dp": hs_over_dp, "seed": seed, "components": N_COMPONENTS,
             "dry_toe_samples": int(np.sum(~np.isfinite(eta))), "particles": sim.n_particles,
             "excluded": len(sim.excluded),
@@ -123,7 +123,7 @@ def main() -> None:
     ap.add_argument("--out", type=Path, default=None, help="run directory (default: a temp dir)")
     a = ap.parse_args()
     out = a.out or Path(tempfile.mkdtemp(prefix="wavesph-overtopping-"))
-    print(json.dumps(run(a.waves, a.hs_over_dp, a.rc_over_hs, a.seed, out)), flush=True)
+    print(json.dumps(overtopping_run(a.waves, a.hs_over_dp, a.rc_over_hs, a.seed, out)), flush=True)
 
 
 if __name__ == "__main__":

@@ -24,14 +24,14 @@ from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
+REPO = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(REPO))
 
 from sph_core.simulation import Simulation, UnstableError  # noqa: E402
+from wave_client import G  # noqa: E402
 from wavesph.cases.wall_impact import COLUMN_HEIGHT, lobovsky_scene  # noqa: E402
 
-SENSORS = ROOT / "tests" / "data" / "lobovsky_2014_h300_sensors.csv"
-G = 9.81
+SENSORS = REPO / "tests" / "data" / "lobovsky_2014_h300_sensors.csv"
 
 
 def main() -> None:

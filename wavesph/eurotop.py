@@ -28,7 +28,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-G = 9.80665
+from wave_client import G
 
 # (mean, standard deviation) of the mean-value coefficients, EurOtop (2018) section 5.3
 A_BREAKING = (0.023, 0.003)
