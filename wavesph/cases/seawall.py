@@ -50,9 +50,8 @@ def sea(seed: int = SEED) -> JonswapSea:
 def spectral_hm0_tm10(s: JonswapSea) -> tuple[float, float]:
     """(Hm0, T_m-1,0 = m_-1 / m_0) of a sea's discretised spectrum: the incident sea the inlet
     makes, as EurOtop takes it at the toe."""
-    m0 = float(np.sum(s.spectrum) * s.df)
     m_1 = float(np.sum(s.spectrum / s.frequencies) * s.df)
-    return 4.0 * math.sqrt(m0), m_1 / m0
+    return 4.0 * math.sqrt(s.m0), m_1 / s.m0
 
 
 def seawall_scene(dp: float, rc: float = RC_OVER_HS * HS, t_end: float = 60.0) -> dict:
