@@ -2,7 +2,7 @@
 the EurOtop (2018) mean-value formula for that structure?
 
     NUMBA_NUM_THREADS=2 python bench/overtopping.py [--waves 500] [--hs-over-dp 4] [--rc-over-hs 1.33]
-                                                    [--seed 1] [--out DIR]
+                                                    [--seed 1] [--out DIR] [--constants JSON]
 
 The case is wavesph/cases/seawall.py (examples/scenes/seawall_overtopping.toml at Hs/dp 4): still
 water d = 0.3 m, an open inlet at x = 0 driven by wave_client's `irregular` theory (JONSWAP,
@@ -29,7 +29,7 @@ One JSON object: bench, waves (the record's zero-down-crossing count at the toe 
 q_mean [m^2/s per metre], q_eurotop, q_eurotop_lo, q_eurotop_hi, ratio (q_mean / q_eurotop),
 Hm0_toe (measured at the toe gauge: incident and reflected), Hm0, Tm_10, Rc, xi, regime (which
 equation governs), dp, Hs_over_dp, particles, excluded (excluded_seaward: of them, seaward of
-the crest), steps, t_end, t_reached, stopped (null, or why the run stopped early: the figures are
+the crest; excluded_seaward_m2: their water, m^3 per metre), steps, t_end, t_reached, stopped (null, or why the run stopped early: the figures are
 then over the records before it), wall_s, run_dir (the run's records, for `wavesph analyse`).
 """
 
@@ -58,17 +58,22 @@ from wavesph.cases.seawall import (HS, N_COMPONENTS, RC_OVER_HS, SEAWALL_DEPTH, 
 from wavesph.eurotop import smooth_slope_overtopping  # noqa: E402
 
 
-def overtopping_run(waves: int, hs_over_dp: float, rc_over_hs: float, seed: int, out: Path) -> dict:
+def overtopping_run(waves: int, hs_over_dp: float, rc_over_hs: float, seed: int, out: Path,
+                    constants: dict | None = None) -> dict:
     dp = HS / hs_over_dp
     rc = rc_over_hs * HS
     waves_in = sea(seed)
     hm0, tm10 = spectral_hm0_tm10(waves_in)
-    # mean zero-crossing period ~ Tp / 1.28 for gamma 3.3; waves counted after t_skip
+    # waves counted after t_skip at the toe (zero down-crossings): their mean period there was
+    # 1.30 s, T_m-1,0 (1.27 s) rather than the Tp / 1.28 of a JONSWAP's T_z (the 558 s record
+    # sized by that held 430 waves, not 500)
     t_skip = 5.0 * TP
-    t_end = t_skip + waves * TP / 1.28 * 1.02
+    t_end = t_skip + waves * tm10 * 1.05
     if t_end > waves_in.repeat_period:
         raise SystemExit(f"the record repeats after {waves_in.repeat_period:.0f} s < t_end {t_end:.0f} s")
-    scene = make_scene(seawall_scene(dp, rc, t_end))
+    raw = seawall_scene(dp, rc, t_end)
+    raw["constants"].update(constants or {})
+    scene = make_scene(raw)
     x_crest = next(p.x for p in scene.probes if p.name == "crest")
     src = WaveModelBoundary(waves_in, flume_nodes(scene)["left"], SEAWALL_DEPTH, 0.0)
     tic = time.perf_counter()
@@ -108,8 +113,11 @@ def overtopping_run(waves: int, hs_over_dp: float, rc_over_hs: float, seed: int,
             "excluded": len(sim.excluded),
             # the pit behind the crest is a sink; an exclusion seaward of the crest is the flume's
             "excluded_seaward": sum(1 for e in sim.excluded if e["x"] < x_crest),
+            # their water [m^3/m], against the overtopped volume q_mean (t_end - t_skip)
+            "excluded_seaward_m2": round(dp * dp * sum(1 for e in sim.excluded
+                                                       if e["x"] < x_crest), 5),
             "steps": sim.steps, "t_end": scene.t_end, "t_reached": round(sim.t, 2),
-            "stopped": stopped,
+            "stopped": stopped, "constants": constants or {},
             "wall_s": round(wall, 1), "run_dir": str(out),
             "threads": int(os.environ.get("NUMBA_NUM_THREADS", "0") or 0)}
 
@@ -121,9 +129,12 @@ def main() -> None:
     ap.add_argument("--rc-over-hs", type=float, default=RC_OVER_HS, help="crest freeboard Rc / Hm0")
     ap.add_argument("--seed", type=int, default=1, help="the sea's random phases (1: the example's)")
     ap.add_argument("--out", type=Path, default=None, help="run directory (default: a temp dir)")
+    ap.add_argument("--constants", type=json.loads, default={},
+                    help="scene constants over the case's, JSON (e.g. '{\"exclude_limit\": 0.2}')")
     a = ap.parse_args()
     out = a.out or Path(tempfile.mkdtemp(prefix="wavesph-overtopping-"))
-    print(json.dumps(overtopping_run(a.waves, a.hs_over_dp, a.rc_over_hs, a.seed, out)), flush=True)
+    print(json.dumps(overtopping_run(a.waves, a.hs_over_dp, a.rc_over_hs, a.seed, out,
+                                                a.constants)), flush=True)
 
 
 if __name__ == "__main__":

@@ -3,13 +3,17 @@ Synolakis' (1987) run-up law R/d = 2.831 sqrt(cot beta) (H/d)^(5/4)?
 
     NUMBA_NUM_THREADS=1 python bench/runup.py [--h-over-d 0.05,0.3] [--dp-over-d 0.1] [--depth 0.2]
                                               [--wall-slip free_slip] [--constants JSON]
+                                              [--far-field boussinesq] [--toe-over-d 2]
 
 The canonical case (Synolakis 1987, J. Fluid Mech. 185): still water d on a flat bed, then a
 plane beach of slope 1/19.85 whose toe is L = arccosh(sqrt(20)) / k downstream of the inlet
 (the half-width at which eta = H/20, k = sqrt(3H/(4 d^3))), the beach running on above still
 water. The whole flume is SPH: an open inlet (elevation imposed, no absorption) at x = 0 driven
 by wave_client's `solitary` theory, whose crest passes the inlet at its default t0 (eta there
-starts at 1e-3 H). The wedge of water over the beach is filled to the still shoreline. A
+starts at 1e-3 H). With ``--far-field boussinesq`` the far field is the Boussinesq model instead
+(the model's own solitary wave, timed alike, sampled at the inlet as a coupled run's messages
+are) and ``--toe-over-d`` can shorten the SPH zone to a few depths before the toe: the flat
+approach costs no particles. The wedge of water over the beach is filled to the still shoreline. A
 `runup` probe (near_bed 2 dp) records the shoreline; R is its highest z - still water over the
 run, R0 the same before the wave's front (eta > H/100) reaches the beach's toe: what the
 layout itself gives at rest. The run ends 1.5 L/c after the linear shallow-water travel time
@@ -22,7 +26,7 @@ against the non-breaking law in every case.
 
 One JSON object per H/d: H_over_d, R_over_d, R_over_d_law, R_over_d_breaking_fit, error,
 R0_over_d, stopped (null, or why the run stopped early: R is then over the records before it),
-R_loose_over_d (the same probe counting any particle with one fluid neighbour at any
+far_field, toe_over_d (the inlet-to-toe distance / d), R_loose_over_d (the same probe counting any particle with one fluid neighbour at any
 height: what the wet-film criteria leave out), H_toe_over_H (the highest SPH elevation at the toe up to the run-up peak, over H), dp, d_over_dp, H_over_dp, particles, steps, t_end, wall_s.
 """
 
@@ -45,6 +49,7 @@ from sph_core.boundary_data import WaveModelBoundary  # noqa: E402
 from sph_core.open_ends import flume_nodes  # noqa: E402
 from sph_core.scene import make_scene  # noqa: E402
 from sph_core.simulation import Simulation, UnstableError  # noqa: E402
+from wave_client.boussinesq import solitary_approach  # noqa: E402
 from wave_client.theories import G, SolitaryWave  # noqa: E402
 
 COT_BETA = 19.85
@@ -61,12 +66,14 @@ def breaking_fit(h_over_d: float) -> float:
 
 
 def runup_scene(h_over_d: float, depth: float, dp: float, wall_slip: str = "no_slip",
-                constants: dict | None = None) -> tuple[dict, SolitaryWave, float]:
-    """(scene dict, the inlet's theory, x of the beach's toe [m])."""
+                constants: dict | None = None,
+                toe_distance: float | None = None) -> tuple[dict, SolitaryWave, float]:
+    """(scene dict, the inlet's theory, x of the beach's toe [m]). The toe lies ``toe_distance``
+    [m] downstream of the inlet (default: Synolakis' half-width L)."""
     H = h_over_d * depth
     wave = SolitaryWave(H, depth=depth)
     half = math.acosh(math.sqrt(20.0)) / wave.k
-    x_toe = dp * round(half / dp)
+    x_toe = dp * round((half if toe_distance is None else toe_distance) / dp)
     x_shore = x_toe + COT_BETA * depth
     # beyond the shoreline: twice the expected run-up (the law's, the breaking fit's once the
     # law overshoots it), then 10 dp
@@ -94,11 +101,18 @@ def runup_scene(h_over_d: float, depth: float, dp: float, wall_slip: str = "no_s
 
 
 def run_case(h_over_d: float, depth: float, dp_over_d: float, wall_slip: str = "no_slip",
-             constants: dict | None = None) -> dict:
+             constants: dict | None = None, far_field: str = "theory",
+             toe_over_d: float | None = None) -> dict:
+    """One run-up. far_field "theory": the solitary theory drives the SPH inlet; "boussinesq":
+    the Boussinesq model carries the wave to it (solitary_approach; one-way: the beach's
+    reflection leaves SPH through the inlet's imposed elevation, as with the theory)."""
     dp = dp_over_d * depth
-    data, wave, x_toe = runup_scene(h_over_d, depth, dp, wall_slip, constants)
+    data, wave, x_toe = runup_scene(h_over_d, depth, dp, wall_slip, constants,
+                                    None if toe_over_d is None else toe_over_d * depth)
     scene = make_scene(data)
-    src = WaveModelBoundary(wave, flume_nodes(scene)["left"], depth, 0.0)
+    model = (wave if far_field == "theory" else
+             solitary_approach(wave.height, depth, wave.t0, scene.t_end))
+    src = WaveModelBoundary(model, flume_nodes(scene)["left"], depth, 0.0)
     tic = time.perf_counter()
     sim = Simulation(scene, sources={"left": src})
     stopped = None
@@ -127,6 +141,7 @@ def run_case(h_over_d: float, depth: float, dp_over_d: float, wall_slip: str = "
             "t_R": round(float(t[int(np.nanargmax(rise))]), 3),
             "depth": depth, "dp": round(dp, 6), "d_over_dp": round(depth / dp, 2),
             "H_over_dp": round(h_over_d * depth / dp, 2), "wall_slip": wall_slip,
+            "far_field": far_field, "toe_over_d": round(x_toe / depth, 3),
             **({"constants": constants} if constants else {}), "particles": sim.n_particles,
             "steps": sim.steps, "t_end": scene.t_end, "stopped": stopped, "wall_s": round(wall, 1),
             "threads": int(os.environ.get("NUMBA_NUM_THREADS", "0") or 0)}
@@ -142,9 +157,16 @@ def main() -> None:
                     help="walls and beach (the scene default no_slip holds the film back)")
     ap.add_argument("--constants", type=json.loads, default=None,
                     help='scene constants to override, JSON, e.g. \'{"h_over_dp": 1.5}\'')
+    ap.add_argument("--far-field", choices=("theory", "boussinesq"), default="theory",
+                    help="what drives the SPH inlet: the solitary theory, or the Boussinesq "
+                         "model carrying its own solitary wave")
+    ap.add_argument("--toe-over-d", type=float, default=None,
+                    help="inlet-to-toe distance / d (default Synolakis' half-width L; a short "
+                         "SPH zone with --far-field boussinesq)")
     a = ap.parse_args()
     for hd in (float(v) for v in a.h_over_d.split(",")):
-        print(json.dumps(run_case(hd, a.depth, a.dp_over_d, a.wall_slip, a.constants)), flush=True)
+        print(json.dumps(run_case(hd, a.depth, a.dp_over_d, a.wall_slip, a.constants,
+                                  a.far_field, a.toe_over_d)), flush=True)
 
 
 if __name__ == "__main__":

@@ -2,6 +2,7 @@
 match the experiment's mean over T = t sqrt(g/H) = 3-5 (after the first impact), sensor by sensor?
 
     NUMBA_NUM_THREADS=2 python bench/wall_pressure_means.py [--dp 0.004] [--constants JSON]
+        [--scheme JSON]
 
 The case is wavesph/cases/wall_impact.py (the far-wall sensors 1-4 at 3, 15, 30 and 80 mm above
 the bed, a `pressure_line` on the wall face), run to T = 5.2. The experiment is one realisation of
@@ -38,9 +39,12 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--dp", type=float, default=0.004)
     ap.add_argument("--constants", type=json.loads, default={}, help="scene constants, JSON")
+    ap.add_argument("--scheme", type=json.loads, default=None,
+                    help='the scene\'s [scheme] table, JSON (e.g. \'{"kind": "riemann"}\')')
     a = ap.parse_args()
     scale = math.sqrt(COLUMN_HEIGHT / G)
-    scene = lobovsky_scene(dp=a.dp, t_end=5.2 * scale, probe_every=5e-4, **a.constants)
+    scene = lobovsky_scene(dp=a.dp, t_end=5.2 * scale, probe_every=5e-4,
+                           scheme=a.scheme, **a.constants)
     sim = Simulation(scene)
     tic, stopped = time.perf_counter(), None
     try:
@@ -51,7 +55,8 @@ def main() -> None:
     t = np.array([r["t"] for r in sim.history]) / scale
     exp = np.loadtxt(SENSORS, delimiter=",", skiprows=12)
     rgh = 1000.0 * G * COLUMN_HEIGHT
-    out = {"bench": "wall_pressure_means", "dp": a.dp, "constants": a.constants}
+    out = {"bench": "wall_pressure_means", "dp": a.dp, "constants": a.constants,
+           "scheme": scene.scheme.kind}
     bins = {}
     for k in range(4):
         p = np.array([np.nan if r[f"wall_p{k}"] is None else r[f"wall_p{k}"] for r in sim.history],

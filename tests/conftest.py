@@ -41,6 +41,7 @@ NOT_UNIT: frozenset[str] = frozenset({  # "path" or "path::test_name" (any param
     "test_cli.py::test_python_api_runs_a_scene_as_the_command_does",
     "test_cli.py::test_demo_dambreak_honours_dp_and_t_end",
     "test_wave_client/test_client.py::test_cli_couples_the_boussinesq_model",
+    "test_wave_client/test_solitary_theory.py::test_boussinesq_approach_delivers_the_theorys_wave_at_x0",
     "test_server/test_server_faults.py::test_waiting_coupled_runs_do_not_hold_the_stepping_slots",
     "test_cli.py::test_ctrl_c_is_one_line_exit_130_with_partial_results",
     "test_cli.py::test_first_run_says_it_compiles",

@@ -42,7 +42,10 @@ QUESTIONS: dict[str, tuple[str, ...]] = {
                  "`wcsph_kdk` (h/dp √2, wall AV 1), `wcsph_kdk_h2_wallav0` (today's WCSPH defaults), "
                  "`riemann_muscl`, `isph_bicgstab`; flume cases of Verbrugghe et al. (2019); "
                  "`coupled`: 2 wavelengths of Boussinesq before the SPH zone, against SPH alone over "
-                 "the same length. Wall times under load.",
+                 "the same length. Wall times under load. Filled points: each method's Pareto "
+                 "front (more time bought less error); hollow: a refinement that cost more and "
+                 "erred more; dashed grey: the front over all methods. Redrawn from the shipped "
+                 "data by `python docs/tools/accuracy_chart.py`.",
                  "![speed-accuracy chart, quick preset, under load](figures/accuracy_quick.png)"),
     "bodies": ("Rigid bodies", "Floating and moving bodies against theory."),
     "runup": ("Run-up", "How far up a 1:19.85 plane beach does a solitary wave run in SPH, against "

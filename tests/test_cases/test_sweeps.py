@@ -393,3 +393,11 @@ def test_plan_refuses_a_3d_scene_in_one_line(tmp_path):
                          env={"PYTHONPATH": str(ROOT), "PATH": "/usr/bin:/bin"})
     assert res.returncode == 2
     assert res.stderr.count("\n") == 1 and "3D scene" in res.stderr
+
+
+def test_pareto_front_keeps_the_runs_worth_their_cost():
+    # (wall s, error): the second refinement cost more and erred more (dominated), a tie in cost
+    # keeps the more accurate run, the last one buys accuracy with time
+    pts = [(10.0, 0.05), (30.0, 0.03), (90.0, 0.04), (30.0, 0.035), (200.0, 0.01)]
+    assert sweeps.pareto_front(pts) == [(10.0, 0.05), (30.0, 0.03), (200.0, 0.01)]
+    assert sweeps.pareto_front([]) == []

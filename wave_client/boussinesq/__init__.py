@@ -5,8 +5,8 @@ alone (`wave_scene.py`, `standalone.py`, `wavesph/cli/waves.py`).
 """
 
 from .dispersion import airy_celerity, nwogu_celerity, nwogu_wavenumber
-from .solitary import kdv_solitary, nwogu_solitary
+from .solitary import kdv_solitary, nwogu_solitary, solitary_approach
 from .solver import BoussinesqModel, BoussinesqUnstableError
 
 __all__ = ["BoussinesqModel", "BoussinesqUnstableError", "airy_celerity", "kdv_solitary",
-           "nwogu_celerity", "nwogu_solitary", "nwogu_wavenumber"]
+           "nwogu_celerity", "nwogu_solitary", "nwogu_wavenumber", "solitary_approach"]

@@ -32,6 +32,7 @@ from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
 from .dispersion import BETA, G, alpha
+from .solver import BoussinesqModel
 
 
 def kdv_solitary(x: np.ndarray, height: float, depth: float, x0: float,
@@ -119,3 +120,24 @@ def nwogu_solitary(height: float, depth: float, beta: float = BETA,
         return tw.eta(u), u
 
     return c, profile
+
+
+def solitary_approach(height: float, depth: float, t_crest: float, t_end: float,
+                      g: float = G) -> BoussinesqModel:
+    """A Boussinesq model (flat bed ``depth``) carrying its own solitary wave of ``height``
+    (``nwogu_solitary``: steady in the model, no shed tail) whose crest passes x = 0 at
+    ``t_crest`` [s]: the far field of a run-up or impact case whose SPH zone starts at x = 0.
+    The grid (depth/20) runs downstream far enough, ending in a sponge, that nothing comes back
+    to x = 0 before ``t_end``."""
+    if not (height > 0 and depth > 0 and t_crest > 0 and t_end > t_crest):
+        raise ValueError(f"solitary_approach: need height, depth > 0 and 0 < t_crest < t_end, got "
+                         f"{height}, {depth}, {t_crest}, {t_end}")
+    kappa = math.sqrt(3.0 * height / (4.0 * depth**3))
+    c_model, shape = nwogu_solitary(height, depth, g=g)
+    x_start = -c_model * t_crest
+    sponge = 5.0 / kappa
+    model = BoussinesqModel(x_start - 10.0 / kappa, c_model * t_end + sponge, 0.05 * depth, depth,
+                            sponge_right=sponge, x_couple=0.0, g=g)
+    eta, u = shape(model.x - x_start)
+    model.set_state(eta, u)
+    return model

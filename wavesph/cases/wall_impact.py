@@ -40,13 +40,15 @@ LOBOVSKY_SENSOR1 = (Path(__file__).resolve().parents[2] / "tests" / "data"
 
 def lobovsky_scene(dp: float = 0.004, t_end: float = 2.0, probe_every: float = 2.5e-4,
                    snapshot_every: float = 0.0, tank_length: float = LOBOVSKY_TANK_LENGTH,
-                   wall_height: float = WALL_HEIGHT, **constants) -> Scene:
+                   wall_height: float = WALL_HEIGHT, scheme: dict | None = None,
+                   **constants) -> Scene:
     """The H = 300 mm dam break with the far-wall sensors as a ``pressure_line`` named ``wall``
     (points on the wall face x = tank_length) and the wall's horizontal force (``force`` probe
     ``wall_force``, the dummy particles of the right wall below 0.1 m).
 
     The walls rise to ``wall_height`` (WALL_HEIGHT; the experiment's tank is TANK_HEIGHT high).
-    ``constants`` override the scene constants; alpha defaults to DAMBREAK_ALPHA."""
+    ``constants`` override the scene constants; alpha defaults to DAMBREAK_ALPHA. ``scheme``:
+    the scene's [scheme] table (default wcsph)."""
     constants.setdefault("alpha", DAMBREAK_ALPHA)
     L = tank_length
     return make_scene({
@@ -55,6 +57,7 @@ def lobovsky_scene(dp: float = 0.004, t_end: float = 2.0, probe_every: float = 2
         "tank": {"x0": 0.0, "x1": L, "z0": 0.0, "z1": wall_height},
         "water_blocks": [{"x0": 0.0, "x1": COLUMN_LENGTH, "z0": 0.0, "z1": COLUMN_HEIGHT}],
         "constants": constants,
+        **({"scheme": scheme} if scheme else {}),
         "output": {"probe_every": probe_every, "snapshot_every": snapshot_every},
         "probes": [
             {"kind": "pressure_line", "name": "wall", "points": [[L, z] for z in SENSOR_Z]},

@@ -427,13 +427,27 @@ def read_csv(path: Path) -> list[dict[str, Any]]:
              for k, v in r.items()} for r in rows]
 
 
+def pareto_front(points: Iterable[tuple[float, float]]) -> list[tuple[float, float]]:
+    """The (cost, error) pairs no other pair beats on both (cheaper or as cheap, and at least
+    as accurate, one of them strictly), by rising cost: the runs worth their cost."""
+    front: list[tuple[float, float]] = []
+    for c, e in sorted(points, key=lambda p: (p[0], p[1])):
+        if not front or e < front[-1][1]:
+            front.append((c, e))
+    return front
+
+
 def plot_accuracy(records: list[dict[str, Any]], path: Path, title: str = "") -> None:
     """Error (log y) against wall seconds (log x), one panel per case, one line per method, each
-    point labelled with its dp; unstable/failed points are not drawn (see the CSV)."""
+    point labelled with its dp (3 significant digits). Each method's Pareto front (pareto_front:
+    the points that buy accuracy with time) is drawn filled, its dominated points hollow (a
+    refinement that cost more and erred more); the case's front over all methods is the dashed
+    grey line. Unstable/failed points are not drawn (see the CSV)."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    from matplotlib.ticker import NullFormatter
 
     cases = sorted({r["case"] for r in records})
     n = max(1, len(cases))
@@ -454,13 +468,24 @@ def plot_accuracy(records: list[dict[str, Any]], path: Path, title: str = "") ->
                 ax.plot([], [], "x", color=colour[method], label=f"{method} (all {bad} unstable/failed)")
                 continue
             label = method + (f" ({bad} unstable/failed)" if bad else "")
-            ax.plot([r["wall_s"] for r in pts], [r["error"] for r in pts], "o-", label=label,
-                    color=colour[method])
+            xy = [(r["wall_s"], r["error"]) for r in pts]
+            ax.plot(*zip(*xy), "-", color=colour[method], alpha=0.5)
+            front = set(pareto_front(xy))
+            on = [p for p in xy if p in front]
+            off = [p for p in xy if p not in front]
+            ax.plot(*zip(*on), "o", color=colour[method], label=label)
+            if off:
+                ax.plot(*zip(*off), "o", mfc="none", color=colour[method])
             for r in pts:
                 ax.annotate(f"{r['dp']:.3g}", (r["wall_s"], r["error"]), fontsize=7,
                             xytext=(3, 3), textcoords="offset points")
+        best = pareto_front((r["wall_s"], r["error"]) for r in records if r["case"] == case
+                            and r.get("status") == "ok" and r.get("error") and r.get("wall_s"))
+        if len(best) > 1:
+            ax.step(*zip(*best), where="post", ls="--", color="0.5", lw=1, label="front, all methods")
         ax.set_xscale("log")
         ax.set_yscale("log")
+        ax.xaxis.set_minor_formatter(NullFormatter())   # minor labels overlap on short decades
         ax.set_title(case, fontsize=10)
         ax.set_xlabel("wall time [s]")
         ax.set_ylabel("error (relative)")
