@@ -36,6 +36,46 @@ def simulated() -> bool:
     return os.environ.get("NUMBA_ENABLE_CUDASIM", "0") not in ("", "0")
 
 
+def lock_simulator_shared_arrays() -> None:
+    """Make the simulator's ``cuda.shared.array`` safe for the block's threads (call after
+    numba.cuda is imported, under the simulator only).
+
+    numba-cuda <= 0.30's simulator runs each CUDA thread as a Python thread and hands out a
+    block's shared array from a dict keyed by the calling line, filled on first use without a
+    lock: a thread switched out between its lookup and its store gets an array of its own, never
+    written by the others, and reads np.empty's garbage (a prefix sum gave a cell cursor of
+    -4.6e18, the float bits of -0.4075; a block's max-reduction a wrong |a|^2 and so another dt:
+    the CUDA tests' intermittent failures). Same keys, same arrays, under a lock."""
+    import sys
+    import threading
+
+    from numba.core import types
+    from numba.cuda.simulator import kernelapi
+    from numba.np import numpy_support
+
+    shared = kernelapi.FakeCUDAShared
+    if getattr(shared, "_wavesph_locked", False):
+        return
+    plain = shared.array
+    lock = threading.Lock()
+
+    def array(self, shape, dtype, alignment=None):  # noqa: ANN001, ANN202 (the simulator's API)
+        if shape == 0 or alignment is not None:  # dynamic shared memory is one buffer already
+            return plain(self, shape, dtype, alignment)
+        if isinstance(dtype, types.Type):
+            dtype = numpy_support.as_dtype(dtype)
+        caller = sys._getframe(1)
+        key = (caller.f_code.co_filename, caller.f_lineno)
+        with lock:
+            out = self._allocations.get(key)
+            if out is None:
+                out = self._allocations[key] = np.empty(shape, dtype)
+        return out
+
+    shared.array = array
+    shared._wavesph_locked = True
+
+
 def unavailable_reason() -> str | None:
     """None if CUDA kernels can run here (a GPU, or the simulator), else a one-line reason."""
     try:

@@ -25,7 +25,7 @@ from ..state import particles_view
 from ..wcsph import (ST_DENSITY, ST_LEFT_DOMAIN, ST_NONFINITE, ST_REACHED_T, ST_STEP_LIMIT,
                      adami_state, fluid_rates, stable_dt)
 from ..terms import fluid_consts, fluid_i
-from . import simulated
+from . import lock_simulator_shared_arrays, simulated
 
 # every callee of a kernel is inlined (the form compile_ptx verifies without a GPU): inlined
 # twins of the two plain @njit helpers the fluid pass takes (the same source)
@@ -37,6 +37,10 @@ T, DT, DTS, T_STOP, V2, A2, RMAX, V2LAST = range(8)
 N_CLK = 8
 STOP, STATUS, N_FLAG, STEPS, MAX_STEPS, N_BAD, N_BAND, N_OUT, LAST = range(9)
 N_CTL = 9
+
+# the simulator's shared arrays made thread-safe (lock_simulator_shared_arrays says why)
+if simulated():
+    lock_simulator_shared_arrays()
 
 # threads per block; the simulator runs each thread as a Python thread, so it gets small blocks
 TPB = 32 if simulated() else 256

@@ -219,3 +219,43 @@ def test_graph_replay_matches_plain_launches(sim_factory):
     a = plain._to_host(plain.bufs[plain.cur][0])
     b = graph._to_host(graph.bufs[graph.cur][0])
     np.testing.assert_array_equal(a[:N_SORTED_KDK, : plain.n], b[:N_SORTED_KDK, : graph.n])
+
+
+def test_simulator_shared_arrays_are_one_per_line_under_contention():
+    """sph_core.cuda.lock_simulator_shared_arrays: 32 threads (a simulated block) asking at once
+    for the shared array of one line all get the same array. The simulator's own lookup is not
+    locked: with threads switching every microsecond, 32 of 300 such rounds handed out more than
+    one array (measured), which made the CUDA tests fail now and then."""
+    import sys
+    import threading
+
+    from sph_core.cuda import simulated
+    if not simulated():
+        pytest.skip("the simulator's shared memory only")
+    from numba.cuda.simulator import kernelapi
+
+    from sph_core.cuda import lock_simulator_shared_arrays
+
+    lock_simulator_shared_arrays()
+    old = sys.getswitchinterval()
+    sys.setswitchinterval(1e-6)
+    try:
+        split = 0
+        for _ in range(200):
+            shared = kernelapi.FakeCUDAShared(0)
+            got = [None] * 32
+            go = threading.Barrier(32)
+
+            def take(k):
+                go.wait()
+                got[k] = shared.array(16, np.int64)
+
+            threads = [threading.Thread(target=take, args=(k,)) for k in range(32)]
+            for t in threads:
+                t.start()
+            for t in threads:
+                t.join()
+            split += len({id(a) for a in got}) > 1
+    finally:
+        sys.setswitchinterval(old)
+    assert split == 0
