@@ -94,6 +94,8 @@ def overtopping_run(waves: int, hs_over_dp: float, rc_over_hs: float, seed: int,
     except UnstableError as exc:   # the records up to the stop still give a mean q
         stopped = str(exc)
     wall = time.perf_counter() - tic
+    # the pit behind the crest is a sink; an exclusion seaward of the crest is the flume's
+    seaward = sum(1 for ex in sim.excluded if ex["x"] < x_crest)
     h = sim.history
     t = np.array([r["t"] for r in h])
     vol = np.array([r["crest_volume"] for r in h], dtype=float)
@@ -111,11 +113,8 @@ def overtopping_run(waves: int, hs_over_dp: float, rc_over_hs: float, seed: int,
             "dp": round(dp, 6), "Hs_over_dp": hs_over_dp, "seed": seed, "components": N_COMPONENTS,
             "dry_toe_samples": int(np.sum(~np.isfinite(eta))), "particles": sim.n_particles,
             "excluded": len(sim.excluded),
-            # the pit behind the crest is a sink; an exclusion seaward of the crest is the flume's
-            "excluded_seaward": sum(1 for e in sim.excluded if e["x"] < x_crest),
             # their water [m^3/m], against the overtopped volume q_mean (t_end - t_skip)
-            "excluded_seaward_m2": round(dp * dp * sum(1 for e in sim.excluded
-                                                       if e["x"] < x_crest), 5),
+            "excluded_seaward": seaward, "excluded_seaward_m2": round(dp * dp * seaward, 5),
             "steps": sim.steps, "t_end": scene.t_end, "t_reached": round(sim.t, 2),
             "stopped": stopped, "constants": constants or {},
             "wall_s": round(wall, 1), "run_dir": str(out),

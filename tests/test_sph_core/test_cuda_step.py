@@ -229,12 +229,10 @@ def test_simulator_shared_arrays_are_one_per_line_under_contention():
     import sys
     import threading
 
-    from sph_core.cuda import simulated
+    from sph_core.cuda import lock_simulator_shared_arrays, simulated
     if not simulated():
         pytest.skip("the simulator's shared memory only")
     from numba.cuda.simulator import kernelapi
-
-    from sph_core.cuda import lock_simulator_shared_arrays
 
     lock_simulator_shared_arrays()
     old = sys.getswitchinterval()

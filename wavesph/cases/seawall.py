@@ -10,7 +10,7 @@ Probes: `toe`, the elevation half a dp before the slope's toe; `crest`, the over
 through the crest's landward edge.
 
 The sea: JONSWAP (gamma 3.3) with Hm0 HS and peak period TP, N_COMPONENTS linear components in
-[0.5, 3] fp so the record repeats only after ~900 s (500 waves take ~560 s), ramped over two
+[0.5, 3] fp so the record repeats only after ~900 s (500 waves at the toe take ~680 s), ramped over two
 peak periods (`sea`).
 """
 
