@@ -452,6 +452,9 @@ INLET_PRESSURE = "hydrostatic"
 # buffer holds; in the still open flume (d 0.3 m, dp 0.02, tests/test_sph_core/test_open_boundary.py)
 # that pushed the inlet's surface corner at 0.10 m/s within 0.1 s and the run blew up at 0.87 s;
 # extrapolated, the flume stays still (docs/studies/schemes.md "ISPH with open ends and bodies").
+# Since ISPH solves the pressure of every buffer particle with fluid neighbours with the fluid
+# (isph.passes.buffer_rows), this value only reaches the buffer particles beyond the fluid's
+# support and the warm start of the solve.
 ISPH_INLET_PRESSURE = "extrapolated"
 
 
@@ -484,7 +487,8 @@ class OpenBoundary(_Model):
                           "extrapolated from the fluid through mirrored ghost nodes; None: "
                           "OUTLET_PRESSURE (extrapolated) for an extrapolated elevation, else "
                           "INLET_PRESSURE (hydrostatic; ISPH: ISPH_INLET_PRESSURE, extrapolated); "
-                          "hydrostatic buffers extrapolate within h of their surface")
+                          "hydrostatic buffers extrapolate within h of their surface; ISPH "
+                          "solves the pressure of buffer particles next to the fluid with it")
 
 
 MAX_OUTPUTS = 10_000_000  # probe rows or snapshots of one run (beyond: an interval below dt)

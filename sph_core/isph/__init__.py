@@ -15,7 +15,7 @@ on the sorted state at t^n (docs/studies/schemes.md "## ISPH" has the measuremen
 2. predictor (eq. 7): u*_i = u^n_i + dt (g + nu lap u_i), the Lo & Shao (2002) laminar term of
    wcsph.fluid_pass; walls: Adami et al. (2012) no-slip velocity;
 3. pressure Poisson equation (eq. 9-12), one sparse system over the interior fluid particles
-   and the wall particles that have fluid neighbours:
+   and the wall and open-end buffer particles that have fluid neighbours:
      fluid i:  sum_j B_ij (p_i - p_j) = -div u*_i / dt + relax (rho_k,i - rho_ref) / (rho_ref dt_ref^2)
                B_ij = 8 m_j / (rho_i + rho_j)^2 F_ij r_ij^2 / (r_ij^2 + eta^2),  eta = 0.1 h   (Shao & Lo 2003)
                div u*_i = sum_f V_f (u*_f - u*_i) . grad_i W_if   over fluid f    (Khayyer et al. 2009)
@@ -48,13 +48,17 @@ on the sorted state at t^n (docs/studies/schemes.md "## ISPH" has the measuremen
    open_boundary.py is WCSPH's); sort by cell, then Fickian particle shifting (Lind et al. 2012,
    sph_core.shifting).
 
-Open ends: active buffer particles are Dirichlet neighbours of the PPE: their pressure is known
-(open_boundary.py's rules; ISPH inlets extrapolate by default, scene.ISPH_INLET_PRESSURE) and
-moves to the right-hand side of the fluid and wall rows; they count in div u* (with their imposed
-velocity), the viscous term and the free-surface criterion as fluid neighbours (docs/studies/schemes.md
-"ISPH with open ends and bodies"). Rigid bodies (fixed, prescribed) are WALL rows moving with
-the body; their loads come from the step's pressure after the solve (free and hinged bodies are
-refused by the scene: that explicit coupling is unstable for a body lighter than its added mass).
+Open ends: an active buffer particle with fluid neighbours has a row of the PPE, as a wall
+particle does (passes.buffer_rows: p_b - sum_f w_bf p_f = sum_f w_bf rho_f g . r_bf, the Adami
+sums over its fluid neighbours), so its pressure follows the fluid's within the step; one without
+fluid neighbours keeps the open-end hook's pressure (open_boundary.py's rules) as a known
+value. Buffers count in div u* with u*_b = u_b + dt g (their imposed velocity plus the step's
+gravity, as the fluid's u* carries it), in the viscous term and in the free-surface criterion as
+fluid neighbours (docs/studies/schemes.md "ISPH with open ends and bodies").
+
+Rigid bodies (fixed, prescribed) are WALL rows moving with the body; their loads come from the
+step's pressure after the solve (free and hinged bodies are refused by the scene: that explicit
+coupling is unstable for a body lighter than its added mass).
 
 The PPE is solved at r^n rather than at seed 004's intermediate r* = r^n + dt u* (eq. 8): one
 neighbour search per step instead of two. The time step (no sound speed):

@@ -48,10 +48,12 @@ WALL_ROW_SUMS_ZERO = WallRowSums(0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
 @njit(cache=True, inline="always")
 def wall_pair(i, j, dx, dy, dz, r2, ps, ctx, a):
     """Wall particle i and a fluid or buffer neighbour j: the Adami sums (terms.adami_sum) with
-    the fluid's pressure left out (it is an unknown of the wall's PPE row; a buffer's is known),
-    and the wall normal. ctx = (inv_h, alpha_w, bx, bz), b = g - a_i."""
+    the fluid's pressure left out (an unknown of the row, as is the pressure of a buffer particle
+    with a row of its own, wsum_j > 0; another buffer's is known), and the wall normal.
+    ctx = (inv_h, alpha_w, bx, bz, wsum), b = g - a_i."""
     w = w_of_q(math.sqrt(r2) * ctx[0], ctx[1])
-    pj = 0.0 if ps.kind[j] == FLUID else ps.p[j]
+    kj = ps.kind[j]
+    pj = 0.0 if kj == FLUID or (kj != WALL and ctx[4][j] > 0.0) else ps.p[j]
     s = adami_sum(WallSums(a.sw, a.sp, a.svx, 0.0, a.svz), w, pj, ps.rho[j],
                   ctx[2] * dx + ctx[3] * dz, ps.vx[j], 0.0, ps.vz[j])   # ISPH is 2D (x-z)
     return WallRowSums(s.sw, s.sp, s.svx, s.svz, a.nx - dx * w, a.nz - dz * w)
@@ -94,21 +96,27 @@ def viscous_pair(i, j, dx, dy, dz, r2, ps, ctx, a):
 def fluid_row_pair(i, j, dx, dy, dz, r2, ps, ctx, a):
     """Fluid particle i's PPE row and neighbour j (fluid, wall, buffer): the Shao & Lo (2003)
     Laplacian coefficient B_ij into the diagonal and, for an unknown j, the row's column
-    (written into ``indices``, ``data`` at base + count); a buffer's known pressure goes to
-    the right-hand side; the Khayyer et al. (2009) divergence of u* over fluid and buffer
+    (written into ``indices``, ``data`` at base + count: fluid, wall and buffer particles with a
+    row); the known pressure of a buffer particle without one goes to the right-hand side; the Khayyer et al. (2009) divergence of u* over fluid and buffer
     neighbours (the walls' part is their ghost pressure: the Neumann condition).
-    ctx = (inv_h, alpha_f, eta2, vx_i, vz_i, rho_i, idx, indices, data, base);
+    ctx = (inv_h, alpha_f, eta2, vx_i, vz_i, rho_i, idx, indices, data, base, dt gx, dt gz);
     a = (diag, div, known, count)."""
     fij = f_of_q(math.sqrt(r2) * ctx[0], ctx[1])
     kj = ps.kind[j]
     mj = ps.m[j]
     rhoj = ps.rho[j]
     div = a[1]
-    # fluid, or an open end's buffer with its imposed velocity (with an outlet's buffer in
-    # through its pressure only, the outlet's bottom corner drained: 1.4 m/s there at 0.7 s;
-    # docs/studies/schemes.md "ISPH with open ends and bodies")
-    if kj != WALL:
+    if kj == FLUID:
         div -= mj / rhoj * fij * ((ps.vx[j] - ctx[3]) * dx + (ps.vz[j] - ctx[4]) * dz)
+    elif kj != WALL:
+        # an open end's buffer with its imposed velocity as a u*: u_b + dt g, the velocity the
+        # projection's hydrostatic gradient takes back to u_b, as the fluid's u* carries the
+        # step's gravity (compared with u_b itself, a buffer at rest was a source of divergence
+        # wherever its support is one-sided, the surface rows and the bed, and the still open
+        # flume broke down at 2.8 s; left out, the inlet cannot drive a wave;
+        # docs/studies/schemes.md "ISPH with open ends and bodies")
+        div -= mj / rhoj * fij * ((ps.vx[j] + ctx[10] - ctx[3]) * dx
+                                  + (ps.vz[j] + ctx[11] - ctx[4]) * dz)
     rs = ctx[5] + rhoj
     bij = 8.0 * mj / (rs * rs) * fij * r2 / (r2 + ctx[2])
     known = a[2]

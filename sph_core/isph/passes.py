@@ -10,7 +10,7 @@ import numpy as np
 from numba import njit, prange
 
 from ..pairs import fluid_only, fluidlike, gather, interacting
-from ..particles import FLUID, WALL
+from ..particles import FLUID, INLET, OUTLET, WALL
 from ..renormalisation import moments, solve
 from ..terms import fluid_consts, fluid_i
 from ..wcsph import FASTMATH
@@ -57,13 +57,15 @@ def wall_state(ps, n, cells, prm, dt, stop, wsum, dwall):
     s2 = 4.0 * h * h
     aw = prm.alpha_w
     tau = stop * dt
+    buffer_rows(ps, n, cells, prm, wsum, dwall)   # first: the wall rows read a buffer's wsum
     for i in prange(n):
-        wsum[i] = 0.0
-        dwall[i] = 0.0
+        if kind[i] != INLET and kind[i] != OUTLET:
+            wsum[i] = 0.0
+            dwall[i] = 0.0
         if kind[i] == WALL:
             xi = ps.x[i]
             zi = ps.z[i]
-            ctx = (inv_h, aw, prm.gx - ps.ax[i], prm.gz - ps.az[i])
+            ctx = (inv_h, aw, prm.gx - ps.ax[i], prm.gz - ps.az[i], wsum)
             s = gather(i, xi, ps.y[i], zi, ps.cell[i], ps, cells, s2, fluidlike, wall_pair, ctx,
                        WALL_ROW_SUMS_ZERO)
             sd = s.sp
@@ -84,6 +86,27 @@ def wall_state(ps, n, cells, prm, dt, stop, wsum, dwall):
                 p[i] = 0.0
                 vwx[i] = vx[i]
                 vwz[i] = vz[i]
+
+
+@njit(parallel=True, cache=True, fastmath=FASTMATH)
+def buffer_rows(ps, n, cells, prm, wsum, dwall):
+    """wsum[b], dwall[b] of every active buffer particle b of an open end: the Adami sums over
+    its fluid neighbours, p_b - sum_f w_bf p_f = sum_f w_bf rho_f g . r_bf, a row of the PPE
+    (with wsum > 0) solved with the fluid rows: the buffer's pressure follows the fluid's within
+    the step, as a wall's does. (Taken from the last step's fluid, the open-end hook's ghost
+    extrapolation, it lagged the solve by a step, and the still open flume broke down.)"""
+    kind = ps.kind
+    inv_h = 1.0 / prm.h
+    s2 = 4.0 * prm.h * prm.h
+    for i in prange(n):
+        if kind[i] == INLET or kind[i] == OUTLET:
+            wsum[i] = 0.0
+            dwall[i] = 0.0
+            s = gather(i, ps.x[i], ps.y[i], ps.z[i], ps.cell[i], ps, cells, s2, fluid_only,
+                       wall_pair, (inv_h, prm.alpha_w, prm.gx, prm.gz, wsum), WALL_ROW_SUMS_ZERO)
+            wsum[i] = s.sw
+            if s.sw > 0.0:
+                dwall[i] = s.sp / s.sw
 
 
 @njit(parallel=True, cache=True, fastmath=FASTMATH)

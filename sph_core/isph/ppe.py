@@ -11,8 +11,8 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from numba import njit, prange
 
-from ..pairs import fluid_only, gather, interacting
-from ..particles import FLUID, WALL
+from ..pairs import fluid_only, fluidlike, gather, interacting
+from ..particles import FLUID, INLET, OUTLET, WALL
 from ..wcsph import FASTMATH
 from .isph_terms import MAX_ROW, fluid_row_pair, wall_row_pair
 
@@ -21,10 +21,12 @@ PPE_SOLVERS = ("bicgstab", "amg")
 
 @njit(cache=True)
 def ppe_unknowns(ps, n, flag, wsum, idx):
-    """idx[i] = the unknown of slot i (interior fluid, wetted wall), -1 if none; returns the count."""
+    """idx[i] = the unknown of slot i (interior fluid, wetted wall, active buffer particle with
+    fluid neighbours), -1 if none; returns the count."""
     k = 0
     for i in range(n):
-        if flag[i] == 0 or (ps.kind[i] == WALL and wsum[i] > 0.0):
+        kd = ps.kind[i]
+        if flag[i] == 0 or ((kd == WALL or kd == INLET or kd == OUTLET) and wsum[i] > 0.0):
             idx[i] = k
             k += 1
         else:
@@ -62,19 +64,23 @@ def _assemble_row(ps, i, k, cells, prm, inv_dt, idx, wsum, dwall, wscale, indptr
     indices[base] = k   # position 0 of the row: the diagonal
     if ps.kind[i] == FLUID:
         ctx = (1.0 / h, prm.alpha_f, 0.01 * h * h, ps.vx[i], ps.vz[i], ps.rho[i], idx, indices,
-               data, base)
+               data, base, prm.gx / inv_dt, prm.gz / inv_dt)
         diag, div, known, cnt = gather(i, ps.x[i], ps.y[i], ps.z[i], ps.cell[i], ps, cells, s2,
                                        interacting, fluid_row_pair, ctx, (0.0, 0.0, 0.0, 1))
         data[base] = diag
         # density-invariance relaxation (Asai et al. 2012): a kernel density above the lattice's
         # pushes apart, below pulls together, so volume errors do not accumulate
         b[k] = -div * inv_dt + relax * (rho_k[i] - rho_ref) / rho_ref + known
-    else:  # wall: p_s - sum_f w_sf p_f = dwall_s, scaled
+    else:  # wall or buffer: p_s - sum_f w_sf p_f = dwall_s, scaled
         data[base] = wscale
         b[k] = wscale * dwall[i]
         ctx = (1.0 / h, prm.alpha_w, wscale / wsum[i], idx, indices, data, base)
-        cnt = gather(i, ps.x[i], ps.y[i], ps.z[i], ps.cell[i], ps, cells, s2, fluid_only, wall_row_pair,
-                     ctx, 1)
+        if ps.kind[i] == WALL:   # fluid and buffer unknowns (wall_state's sums)
+            cnt = gather(i, ps.x[i], ps.y[i], ps.z[i], ps.cell[i], ps, cells, s2, fluidlike,
+                         wall_row_pair, ctx, 1)
+        else:   # a buffer's row: fluid unknowns (passes.buffer_rows)
+            cnt = gather(i, ps.x[i], ps.y[i], ps.z[i], ps.cell[i], ps, cells, s2, fluid_only,
+                         wall_row_pair, ctx, 1)
     for c in range(cnt, MAX_ROW):
         indices[base + c] = -1
     return cnt
