@@ -85,8 +85,8 @@ def test_isph_still_open_flume_stays_still_for_two_seconds():
     """ISPH's buffer particles enter div u* with u_b + dt g (the step's gravity, as the fluid's
     u* carries it) and have PPE rows of their own: with the imposed velocity itself the
     buffers at rest were a source of divergence at the surface rows and the bed, and this flume
-    reached 0.98 m/s at 1.5 s (unstable at 2.6 s); now 7 mm/s at 2 s (docs/studies/schemes.md
-    "ISPH with open ends and bodies")."""
+    reached 0.98 m/s at 1.5 s and had lost 13 particles over the top by 2 s; now 7 mm/s at 2 s
+    (docs/studies/schemes.md "ISPH open ends: the buffers in the projection")."""
     fl = Simulation(flume_scene(scheme="isph"))
     fl.advance_to(2.0)
     st = fl.fluid_state()
