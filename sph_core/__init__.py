@@ -17,28 +17,14 @@ over a run). Named cases (dam break, flumes) live in `wavesph.cases`; the comman
 `wavesph.cli`.
 
 The compiled kernels are cached on disk (numba ``cache=True``) in a folder named by a hash of
-this package's sources: numba checks only a function's own file, and a kernel holds the code of
-every function it calls from other modules (``step.run`` holds every pass), so after an edit of
-one module the old folder would serve stale machine code. ``NUMBA_CACHE_DIR`` (if set) is the
-parent of that folder, else ``~/.cache/wavesph``.
+this package's sources, under a lock that lets several processes compile and load at once
+(``kernel_cache``).
 """
-
-import hashlib
-import os
-from pathlib import Path
 
 import numba
 
-
-def _kernel_cache_dir() -> str:
-    """The on-disk kernel cache of this exact source tree (module docstring)."""
-    h = hashlib.sha1()
-    for path in sorted(Path(__file__).parent.rglob("*.py")):
-        h.update(path.read_bytes())
-    base = os.environ.get("NUMBA_CACHE_DIR") or os.path.join(
-        os.environ.get("XDG_CACHE_HOME") or os.path.join(Path.home(), ".cache"), "wavesph")
-    return os.path.join(base, f"kernels-{h.hexdigest()[:16]}")
-
+from .kernel_cache import kernel_cache_dir, lock_cache_files
 
 # before any submodule's @njit(cache=True) builds its cache locator
-numba.config.CACHE_DIR = _kernel_cache_dir()
+numba.config.CACHE_DIR = kernel_cache_dir()
+lock_cache_files()
