@@ -102,3 +102,25 @@ def test_geometry_vtu_is_line_cells_that_meshio_reads(tmp_path):
     mesh = meshio.read(path)
     assert [c.type for c in mesh.cells] == ["line"] and len(mesh.cells[0].data) == 5
     assert mesh.cell_data["part"][0].ravel().tolist() == [0, 0, 0, 1, 3]
+
+
+def full_tank(length: float) -> dict:
+    return {"name": "tank", "dp": 0.02, "t_end": 0.1, "still_water_level": 0.24,
+            "tank": {"x0": 0.0, "x1": length, "z0": 0.0, "z1": 0.36},
+            "water_blocks": [{"x0": 0.0, "x1": length, "z0": 0.0, "z1": 0.24}]}
+
+
+def test_water_short_of_the_right_wall_by_a_fraction_of_dp_is_warned():
+    # 1.99 m = 99.5 dp: the lattice from x0 leaves 0.5 dp at the right wall (a slump at the start)
+    with pytest.warns(UserWarning, match=r"0\.50 dp short of the right wall"):
+        build_layout(make_scene(full_tank(1.99)))
+
+
+def test_a_whole_number_of_dp_and_a_dam_break_column_are_not_warned():
+    import warnings
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        build_layout(make_scene(full_tank(2.0)))
+        column = full_tank(1.99)
+        column["water_blocks"][0]["x1"] = 0.5   # the water does not reach the wall
+        build_layout(make_scene(column))

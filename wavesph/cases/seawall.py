@@ -32,7 +32,7 @@ SEED = 1
 SEA_RAMP_PERIODS = 2.0
 TAN_ALPHA = 0.5       # seaward slope 1:2
 CREST_WIDTH = 0.10    # [m]
-PIT_LENGTH = 1.2      # [m], behind the 1:1 back slope
+PIT_LENGTH = 1.2      # [m], behind the 1:1 back slope (to within dp/2: the far wall on the lattice)
 POOL_DEPTH = 0.1      # [m] of water at rest in the pit: overtopped water lands in it (on a dry
 #                       floor its thin fast sheets left the density band at the pit's far wall)
 # excluded particles (density out of band; DualSPHysics' RhopOut removes them without limit):
@@ -65,14 +65,17 @@ def seawall_scene(dp: float, rc: float = RC_OVER_HS * HS, t_end: float = 60.0) -
     x_c0 = x_toe + z_crest / TAN_ALPHA
     x_c1 = x_c0 + CREST_WIDTH
     x_back = x_c1 + z_crest
+    # the far wall a whole number of dp from x0: the pool then meets it at spacing dp (a fraction
+    # of dp left a gap the pool slumped into at the start; sph_core.geometry warns of it)
+    x_end = dp * round((x_back + PIT_LENGTH) / dp)
     return {
         "name": "seawall-overtopping", "dp": dp, "t_end": round(t_end, 4),
         "still_water_level": SEAWALL_DEPTH,
-        "tank": {"x0": 0.0, "x1": round(x_back + PIT_LENGTH, 6), "z0": 0.0,
+        "tank": {"x0": 0.0, "x1": round(x_end, 6), "z0": 0.0,
                  "z1": round(z_crest + 2.5 * HS, 6)},
         "water_blocks": [{"x0": 0.0, "x1": round(x_toe + SEAWALL_DEPTH / TAN_ALPHA, 6), "z0": 0.0,
                           "z1": SEAWALL_DEPTH},
-                         {"x0": round(x_c1, 6), "x1": round(x_back + PIT_LENGTH, 6), "z0": 0.0,
+                         {"x0": round(x_c1, 6), "x1": round(x_end, 6), "z0": 0.0,
                           "z1": POOL_DEPTH}],
         "beds": [{"points": [[x_toe, 0.0], [round(x_c0, 6), z_crest], [round(x_c1, 6), z_crest],
                              [round(x_back, 6), 0.0]]}],
