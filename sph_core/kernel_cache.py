@@ -14,9 +14,11 @@ process that loads it crashes (a segfault in the first kernel call; seen on this
 machine: a closed-tank run segfaulted in ``step.initialise`` on every start after it had
 compiled into one cache beside two benches). A reader between the index and the data write gets
 the same mismatch, and two checkouts of the same sources share the folder but not their files'
-modification times, so each discards the other's index and numbers its files from 1 again. ``lock_cache_files`` takes an exclusive ``flock`` on a lock file
-next to the index for a save and a shared one for a load, so a reader sees an index and its data
-files as one writer left them. It costs one lock per kernel compile or load, not per call.
+modification times, so each discards the other's index and numbers its files from 1 again.
+``lock_cache_files`` takes an exclusive ``flock`` on a lock file next to the index for a save and
+a shared one for a load, so a reader sees an index and its data files as one writer left them.
+It costs one lock per kernel compile or load, not per call; where the lock file cannot be made
+(a read-only cache) numba's own, unlocked handling goes on.
 """
 
 from __future__ import annotations
@@ -46,8 +48,13 @@ def kernel_cache_dir() -> str:
 
 @contextlib.contextmanager
 def _locked(index_path: str, exclusive: bool) -> Iterator[None]:
-    os.makedirs(os.path.dirname(index_path) or ".", exist_ok=True)
-    with open(index_path + ".lock", "a") as fh:
+    try:
+        os.makedirs(os.path.dirname(index_path) or ".", exist_ok=True)
+        fh = open(index_path + ".lock", "a")
+    except OSError:   # a cache folder we cannot write: numba's own handling, unlocked
+        yield
+        return
+    with fh:
         fcntl.flock(fh, fcntl.LOCK_EX if exclusive else fcntl.LOCK_SH)
         try:
             yield

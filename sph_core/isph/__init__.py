@@ -54,7 +54,8 @@ sums over its fluid neighbours), so its pressure follows the fluid's within the 
 fluid neighbours keeps the open-end hook's pressure (open_boundary.py's rules) as a known
 value. Buffers count in div u* with u*_b = u_b + dt g (their imposed velocity plus the step's
 gravity, as the fluid's u* carries it), in the viscous term and in the free-surface criterion as
-fluid neighbours (docs/studies/schemes.md "ISPH with open ends and bodies").
+fluid neighbours (docs/studies/schemes.md "ISPH with open ends and bodies" and "ISPH open ends:
+the buffers in the projection").
 
 Rigid bodies (fixed, prescribed) are WALL rows moving with the body; their loads come from the
 step's pressure after the solve (free and hinged bodies are refused by the scene: that explicit

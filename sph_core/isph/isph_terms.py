@@ -97,8 +97,9 @@ def fluid_row_pair(i, j, dx, dy, dz, r2, ps, ctx, a):
     """Fluid particle i's PPE row and neighbour j (fluid, wall, buffer): the Shao & Lo (2003)
     Laplacian coefficient B_ij into the diagonal and, for an unknown j, the row's column
     (written into ``indices``, ``data`` at base + count: fluid, wall and buffer particles with a
-    row); the known pressure of a buffer particle without one goes to the right-hand side; the Khayyer et al. (2009) divergence of u* over fluid and buffer
-    neighbours (the walls' part is their ghost pressure: the Neumann condition).
+    row); the known pressure of a buffer particle without one goes to the right-hand side; the
+    Khayyer et al. (2009) divergence of u* over fluid and buffer neighbours (the walls' part is
+    their ghost pressure: the Neumann condition).
     ctx = (inv_h, alpha_f, eta2, vx_i, vz_i, rho_i, idx, indices, data, base, dt gx, dt gz);
     a = (diag, div, known, count)."""
     fij = f_of_q(math.sqrt(r2) * ctx[0], ctx[1])
@@ -114,7 +115,7 @@ def fluid_row_pair(i, j, dx, dy, dz, r2, ps, ctx, a):
         # step's gravity (compared with u_b itself, a buffer at rest was a source of divergence
         # wherever its support is one-sided, the surface rows and the bed, and the still open
         # flume broke down at 2.8 s; left out, the inlet cannot drive a wave;
-        # docs/studies/schemes.md "ISPH with open ends and bodies")
+        # docs/studies/schemes.md "ISPH open ends: the buffers in the projection")
         div -= mj / rhoj * fij * ((ps.vx[j] + ctx[10] - ctx[3]) * dx
                                   + (ps.vz[j] + ctx[11] - ctx[4]) * dz)
     rs = ctx[5] + rhoj

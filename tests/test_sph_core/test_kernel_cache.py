@@ -54,3 +54,13 @@ def test_the_cache_folder_is_named_by_the_sources(monkeypatch, tmp_path):
     d = kernel_cache_dir()
     assert d.startswith(str(tmp_path)) and d.rsplit("kernels-", 1)[1].isalnum()
     assert kernel_cache_dir() == d
+
+
+def test_a_cache_folder_that_cannot_be_written_is_used_unlocked(tmp_path):
+    """numba falls back on its own where the cache cannot be written; the lock must not raise
+    first (here the folder would have to be made inside a file)."""
+    blocker = tmp_path / "a_file"
+    blocker.write_text("")
+    entry = caching.IndexDataCacheFile(str(blocker / "cache"), "kern", (1.0, 10))
+    assert lock_cache_files()
+    assert entry.load("sig") is None   # no index, no error
