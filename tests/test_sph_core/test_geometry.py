@@ -116,7 +116,7 @@ def test_water_short_of_the_right_wall_by_a_fraction_of_dp_is_warned():
         build_layout(make_scene(full_tank(1.99)))
 
 
-def test_a_whole_number_of_dp_and_a_dam_break_column_are_not_warned():
+def test_a_whole_number_of_dp_a_dam_break_column_and_a_beach_are_not_warned():
     import warnings
     with warnings.catch_warnings():
         warnings.simplefilter("error")
@@ -124,3 +124,6 @@ def test_a_whole_number_of_dp_and_a_dam_break_column_are_not_warned():
         column = full_tank(1.99)
         column["water_blocks"][0]["x1"] = 0.5   # the water does not reach the wall
         build_layout(make_scene(column))
+        beach = full_tank(1.99)                 # a beach up to the wall holds the corner
+        beach["beds"] = [{"points": [[1.0, 0.0], [1.99, 0.3]]}]
+        build_layout(make_scene(beach))
