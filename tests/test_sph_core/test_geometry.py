@@ -4,6 +4,7 @@
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -117,7 +118,6 @@ def test_water_short_of_the_right_wall_by_a_fraction_of_dp_is_warned():
 
 
 def test_a_whole_number_of_dp_a_dam_break_column_and_a_beach_are_not_warned():
-    import warnings
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         build_layout(make_scene(full_tank(2.0)))
