@@ -10,7 +10,7 @@
 # JSON lines go to stdout and $OUT/gpu.jsonl, the whole log to $OUT/gpu_check.log.
 # Every phase runs under `timeout`, capped by what is left of TOTAL_S, so the script ends in time.
 # Overrides (a rerun, or a dry run here): GPU_DPS, CPU_DP, CPU_STEPS, THREADS (empty: no CPU runs), TEST_S,
-# FLUMES (non-empty: the H/dp 8 wave flumes on the GPU), HOST_THREADS (16: pytest and the GPU runs'
+# FLUMES (non-empty: the H/dp 8 wave flumes on the GPU, three lanes side by side), HOST_THREADS (16: pytest and the GPU runs'
 # host side), TOTAL_S, PYTHON, SKIP_WHEELS, SKIP_TESTS,
 # NUMBA_ENABLE_CUDASIM.
 set -u
@@ -92,13 +92,30 @@ if [ -n "$THREADS" ]; then
     done
 fi
 if [ -n "${FLUMES:-}" ]; then
-    # the wave flumes at H/dp 8 on the GPU (minutes each): the long flume's loss per wavelength
-    # (H 0.04 m, dp 0.005 m) and seed 002's case II (H 0.02 m in 1 m of water, dp 0.0025 m, ~540k
-    # particles); each prints its JSON line with device, particles, wall_s (and wall_s_per_sim_s)
-    say "GPU wave flumes at H/dp 8"
-    NUMBA_NUM_THREADS=$HT timeout "$(left 400)" $PY bench/wave_decay.py --long --dp 0.005 \
-        --device cuda 2>>"$LOG" | tee -a "$JSONL" "$LOG"
-    NUMBA_NUM_THREADS=$HT timeout "$(left 400)" $PY bench/flume_accuracy.py --case II --dp 0.0025 \
-        --device cuda 2>>"$LOG" | tee -a "$JSONL" "$LOG"
+    # the wave flumes at H/dp 8 on the GPU, three lanes side by side (one process each, its own
+    # numba cache; the small flumes leave the GPU idle between launches, so lanes overlap):
+    #   a: seed 002's case II (H 0.02 m in 1 m of water, dp 0.0025 m, ~540k particles)
+    #   b: the long flume's loss per wavelength (H 0.04 m, dp 0.005 m), then case III at H/dp 16
+    #   c: cases III, IV, V, I at H/dp 8 (IV and I: dp 0.7 m / 38, a whole number of layers)
+    # each run prints its JSON line (device, particles, wall_s, wall_s_per_sim_s) when it ends
+    say "GPU wave flumes at H/dp 8, three lanes"
+    FA="bench/flume_accuracy.py --device cuda"
+    lane() {  # lane NAME 'ARGS' ['ARGS' ...]: the runs one after another, each capped by what is left
+        local name=$1; shift
+        for args in "$@"; do
+            say "lane $name: $args"
+            NUMBA_CACHE_DIR=/tmp/nc_$name NUMBA_NUM_THREADS=4 timeout "$(left 600)" $PY $args \
+                2>>"$OUT/lane_$name.log" | tee -a "$OUT/lane_$name.log" >> "$JSONL"
+            say "lane $name: exit ${PIPESTATUS[0]}"
+        done
+    }
+    lane a "$FA --case II --dp 0.0025 --periods 4" &
+    lane b "bench/wave_decay.py --long --dp 0.005 --device cuda" \
+           "$FA --case III --dp 0.005 --periods 3 --steady" &
+    lane c "$FA --case III --dp 0.01 --periods 3 --steady" \
+           "$FA --case IV --dp 0.0184210526 --periods 4 --steady" \
+           "$FA --case V --dp 0.0075 --periods 4 --steady" \
+           "$FA --case I --dp 0.0184210526 --periods 4 --steady" &
+    wait
 fi
 say "done: $(wc -l < "$JSONL") JSON lines in $JSONL"

@@ -35,7 +35,7 @@ _bodies_v2max = njit(inline="always")(bodies_v2max.py_func)
 BODY_FIELDS_READ = ("q", "qd", "acc", "qn", "qdn", "load", "fk_x", "fk_z", "fk_m")
 
 
-@cuda.jit
+@K.kernel
 def k_stage(bd, stage, clk, ctl):
     """bodies_advance (one thread): one integrator stage of every body at this step's t, dt."""
     if cuda.grid(1) != 0 or ctl[K.STOP] != 0:
@@ -43,7 +43,7 @@ def k_stage(bd, stage, clk, ctl):
     _bodies_advance(bd, clk[K.T], clk[K.DTS], stage)
 
 
-@cuda.jit
+@K.kernel
 def k_place(buf, n, bd, ctl):
     """place_bodies: x, v, a of every body particle from its body's state."""
     if ctl[K.STOP] != 0:
@@ -61,7 +61,7 @@ def k_place(buf, n, bd, ctl):
             ps.az[i] = az
 
 
-@cuda.jit
+@K.kernel
 def k_particle_loads(buf, n, cells, prm, bd, ctl):
     """_particle_loads: each body particle's reaction on its fluid neighbours and moment."""
     if ctl[K.STOP] != 0:
@@ -75,7 +75,7 @@ def k_particle_loads(buf, n, cells, prm, bd, ctl):
                                                                   _fluid_consts(prm))
 
 
-@cuda.jit
+@K.kernel
 def k_accelerations(bd, prm, ctl):
     """body_loads' second half (one thread): loads summed per body, accelerations."""
     if cuda.grid(1) != 0 or ctl[K.STOP] != 0:
@@ -83,7 +83,7 @@ def k_accelerations(bd, prm, ctl):
     body_accelerations(bd, prm)
 
 
-@cuda.jit
+@K.kernel
 def k_v2(bd, clk, ctl):
     """The step's max |v|^2 takes the body particles' (step.run: max(v2, bodies_v2max))."""
     if cuda.grid(1) != 0 or ctl[K.STOP] != 0:

@@ -18,7 +18,7 @@ launch.
 
 from __future__ import annotations
 
-from numba import cuda, float64, int64, njit
+from numba import cuda, float64, int64, njit, types
 
 from ..particles import FLUID, N_SORTED_KDK, WALL
 from ..state import particles_view
@@ -45,6 +45,24 @@ if simulated():
 # threads per block; the simulator runs each thread as a Python thread, so it gets small blocks
 TPB = 32 if simulated() else 256
 SCAN_B = 64 if simulated() else 1024   # elements per block of the cell-count prefix sum
+
+
+class _NoneArgs:
+    """numba-cuda's launch marshals no None, and a 2D step's ``Params.three`` and
+    ``Cells.three`` are None (2D is decided when compiled: terms.py): such a field goes in as
+    the null pointer numba-cuda's data model passes for it (OpaqueModel: one i8* parameter).
+    The simulator takes None as it is."""
+
+    def prepare_args(self, ty, val, **kwargs):
+        if isinstance(ty, types.NoneType):
+            return types.CPointer(types.int8), 0
+        return ty, val
+
+
+def kernel(fn):
+    """``fn`` as a CUDA kernel whose tuple arguments may hold None (``_NoneArgs``): every
+    kernel of the step is made here."""
+    return cuda.jit(fn) if simulated() else cuda.jit(extensions=[_NoneArgs()])(fn)
 
 
 def _schedule_py(clk, ctl):
@@ -93,7 +111,7 @@ else:
     _stable_dt = njit(inline="always")(stable_dt.py_func)
 
 
-@cuda.jit
+@kernel
 def k_begin(clk, ctl):
     """Start a run call: clear the stop flag and schedule the first step."""
     if cuda.grid(1) == 0:
@@ -102,7 +120,7 @@ def k_begin(clk, ctl):
         _schedule(clk, ctl)
 
 
-@cuda.jit
+@kernel
 def k_finish(prm, clk, ctl):
     """End of a step (one thread): the clock, the verdict (step._verdict), the next dt
     (wcsph.stable_dt; unchanged after a tripped guard, as in step.run), the reductions cleared,
@@ -142,7 +160,7 @@ def k_finish(prm, clk, ctl):
     _schedule(clk, ctl)
 
 
-@cuda.jit
+@kernel
 def k_kick_drift_bin(buf, n, prm, cells, count, clk, ctl):
     """kdk first half-kick + drift (fluid), then the cell of every slot and its count."""
     if ctl[STOP] != 0:
@@ -172,7 +190,7 @@ def _block_scan(s, t, v):
         off *= 2
 
 
-@cuda.jit
+@kernel
 def k_bin(buf, n, cells, count, ctl):
     """The cell of every slot and its count (compute_cells + the counting sort's counts): the
     sort's first launch where kick and drift are not fused with it (symplectic_pc, open ends,
@@ -187,7 +205,7 @@ def k_bin(buf, n, cells, count, ctl):
         cuda.atomic.add(count, c, 1)
 
 
-@cuda.jit
+@kernel
 def k_scan_blocks(count, start, bsum, m, ctl):
     """Exclusive prefix sum of count[0:m] within blocks of SCAN_B (Hillis-Steele in shared
     memory); each block's total goes to bsum."""
@@ -204,7 +222,7 @@ def k_scan_blocks(count, start, bsum, m, ctl):
         bsum[cuda.blockIdx.x] = s[t]
 
 
-@cuda.jit
+@kernel
 def k_scan_sums(bsum, nb, ctl):
     """Exclusive prefix sum of the block totals bsum[0:nb] (one block, chunks of SCAN_B)."""
     if ctl[STOP] != 0:
@@ -224,7 +242,7 @@ def k_scan_sums(bsum, nb, ctl):
         base += SCAN_B
 
 
-@cuda.jit
+@kernel
 def k_scan_add(start, bsum, cursor, count, m, ctl):
     """Add the block offsets: start = first slot of each cell; cursor = start; counts cleared."""
     if ctl[STOP] != 0:
@@ -237,7 +255,7 @@ def k_scan_add(start, bsum, cursor, count, m, ctl):
         count[g] = 0
 
 
-@cuda.jit
+@kernel
 def k_scatter(buf, n, cursor, order, ctl):
     """order[k] = slot that goes to position k (unordered within a cell)."""
     if ctl[STOP] != 0:
@@ -248,7 +266,7 @@ def k_scatter(buf, n, cursor, order, ctl):
         order[k] = i
 
 
-@cuda.jit
+@kernel
 def k_cell_order(start, order, ncells, ctl):
     """Sort each cell's slots by index (insertion sort, a few per cell), so the order is the
     stable counting sort's of neighbours.counting_sort, whatever order the atomics gave."""
@@ -271,7 +289,7 @@ def _named_kernel(fn, name, doc):
     """fn as the CUDA kernel ``name`` (its __name__, __qualname__ and docstring set first)."""
     fn.__name__ = fn.__qualname__ = name
     fn.__doc__ = doc
-    return cuda.jit(fn)
+    return kernel(fn)
 
 
 def permute_kernel(name, nrows, doc):
@@ -292,7 +310,7 @@ k_permute = permute_kernel(
     """neighbours.permute: gather the carried rows, kind, ids and cell into the twin.""")
 
 
-@cuda.jit
+@kernel
 def k_wall(buf, n, cells, prm, ctl):
     """wcsph.wall_pass (Adami walls)."""
     if ctl[STOP] != 0:
@@ -354,7 +372,7 @@ _block_max = (cuda.jit(device=True)(_block_max_py) if simulated()
               else njit(inline="always")(_block_max_py))
 
 
-@cuda.jit
+@kernel
 def k_kick(buf, n, prm, clk, ctl):
     """wcsph.kdk_kick: second half-kick, guard counts, block-reduced max |v|^2, |a|^2, rho."""
     if ctl[STOP] != 0:

@@ -61,7 +61,7 @@ END_FIELDS_WINDOW = ("win_t", "win_u", "win_w", "win_eta", "win_etag")
 END_FIELDS_READ = ("eta_meas", "zs", "counters", "next_id", "filt_x")
 
 
-@cuda.jit
+@K.kernel
 def k_kick_drift(buf, n, prm, clk, ctl):
     """kdk first half-kick + drift of the fluid (binning comes after the buffers moved)."""
     if ctl[K.STOP] != 0:
@@ -72,7 +72,7 @@ def k_kick_drift(buf, n, prm, clk, ctl):
             cuda.atomic.add(ctl, K.N_OUT, 1)
 
 
-@cuda.jit
+@K.kernel
 def k_boundary(ends, clk, ctl, oe):
     """update_buffers' per-end part (one thread): the window weight at t + dt, each end's
     surface and absorption correction (the filter state advanced by dt)."""
@@ -92,7 +92,7 @@ def k_boundary(ends, clk, ctl, oe):
     f[DU1] = du1
 
 
-@cuda.jit
+@K.kernel
 def k_buffers(buf, n, ends, prm, clk, ctl, oe):
     """buffer_update: every buffer particle imposed, moved, (de)activated."""
     if ctl[K.STOP] != 0:
@@ -115,7 +115,7 @@ def k_buffers(buf, n, ends, prm, clk, ctl, oe):
             ps.az[i] = 0.0
 
 
-@cuda.jit
+@K.kernel
 def k_mark(buf, n, ends, ctl, oe):
     """Each slot's crossing (transition_of) and its clone flag; thread 0 keeps the next id."""
     if ctl[K.STOP] != 0:
@@ -133,7 +133,7 @@ def k_mark(buf, n, ends, ctl, oe):
         oe[FLAG][i] = 0
 
 
-@cuda.jit
+@K.kernel
 def k_apply(buf, n, ends, ctl, oe):
     """buffer_transitions: the new kinds, the counters and the clones at slots n_live + their
     prefix sum (the CPU's serial order); the run stops with ST_CAPACITY where they overflow."""
@@ -176,7 +176,7 @@ def k_apply(buf, n, ends, ctl, oe):
     ps.kind[i] = oe[KNEW][i]
 
 
-@cuda.jit
+@K.kernel
 def k_extrapolate(buf, n, cells, ends, prm, ctl, oe):
     """buffer_extrapolate (after the sort); thread 0 records the live count."""
     if ctl[K.STOP] != 0:
@@ -192,7 +192,7 @@ def k_extrapolate(buf, n, cells, ends, prm, ctl, oe):
             ps.rho[i] = rho
 
 
-@cuda.jit
+@K.kernel
 def k_gauge_line(buf, cells, ends, prm, ctl, oe):
     """measure_boundaries' line densities: one thread per (end, point)."""
     if ctl[K.STOP] != 0:
@@ -208,7 +208,7 @@ def k_gauge_line(buf, cells, ends, prm, ctl, oe):
                                       ends.z_bed[b] + k * ends.dz_gauge, prm)
 
 
-@cuda.jit
+@K.kernel
 def k_gauge(ends, prm, ctl, oe):
     """measure_boundaries (one thread): each gauge's surface from its line, top down."""
     if cuda.grid(1) != 0 or ctl[K.STOP] != 0:

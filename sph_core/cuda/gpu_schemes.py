@@ -32,7 +32,7 @@ from ..riemann import muscl_gradients
 from ..shifting import FS_ISOLATED, dplus_surface, dplus_tangential, fickian_shift, move_particle
 from ..wcsph import pc_correct_particle, pc_predict_particle
 from .gpu_kernels import (DTS, N_BAD, N_BAND, N_OUT, STOP, V2, _block_max, _view, fluid_kernel,
-                          permute_kernel)
+                          kernel, permute_kernel)
 from .per_particle import clear_rows
 
 k_permute_pc = permute_kernel(
@@ -40,7 +40,7 @@ k_permute_pc = permute_kernel(
     """neighbours.permute with the symplectic step's rows (N_SORTED_PC: x..m and xn..rhon).""")
 
 
-@cuda.jit
+@kernel
 def k_predict(buf, n, prm, clk, ctl):
     """wcsph.pc_predict: state n saved, half step of x, v, rho with the rates at x^n."""
     if ctl[STOP] != 0:
@@ -50,7 +50,7 @@ def k_predict(buf, n, prm, clk, ctl):
         pc_predict_particle(buf[0], i, clk[DTS], prm)
 
 
-@cuda.jit
+@kernel
 def k_correct(buf, n, prm, clk, ctl):
     """wcsph.pc_correct: the corrector, guard counts, block-reduced max |v|^2, |a|^2, rho."""
     if ctl[STOP] != 0:
@@ -70,7 +70,7 @@ def k_correct(buf, n, prm, clk, ctl):
     _block_max(clk, v2, a2, r)
 
 
-@cuda.jit
+@kernel
 def k_shift_fickian(buf, n, cells, prm, clk, ctl):
     """shifting.shift_particles' first loop: the Fickian shift and carries of every fluid
     particle into the scratch rows xn, zn, rhon, vxn, vzn (zero for the other slots)."""
@@ -85,7 +85,7 @@ def k_shift_fickian(buf, n, cells, prm, clk, ctl):
                 i, ps, cells, prm, clk[DTS])
 
 
-@cuda.jit
+@kernel
 def k_dplus_surface(buf, n, cells, prm, clk, ctl):
     """shift_particles_dplus' pass 1 (scratch rows zeroed first): B, lambda, the normal, the
     shift, the renormalised gradients and the surface flag; U = max |v| of this step (clk[V2],
@@ -105,7 +105,7 @@ def k_dplus_surface(buf, n, cells, prm, clk, ctl):
              ps.xn[i], ps.zn[i], ps.gpx[i], ps.gpz[i]) = dplus_surface(i, ps, cells, prm, coef)
 
 
-@cuda.jit
+@kernel
 def k_dplus_tangential(buf, n, cells, prm, ctl):
     """shift_particles_dplus' pass 2: surface particles and their vicinity shift tangentially;
     the carries into _move's rows."""
@@ -119,7 +119,7 @@ def k_dplus_tangential(buf, n, cells, prm, ctl):
                 i, ps, cells, prm)
 
 
-@cuda.jit
+@kernel
 def k_shift_move(buf, n, ctl):
     """shifting._move: apply the gathered shifts and carries (after every particle's sums)."""
     if ctl[STOP] != 0:
@@ -129,7 +129,7 @@ def k_shift_move(buf, n, ctl):
         move_particle(buf[0], i)
 
 
-@cuda.jit
+@kernel
 def k_muscl_gradients(buf, n, cells, prm, ctl):
     """riemann.riemann_gradients: the MUSCL gradients of p, vx, vz (rows gpx..gwz)."""
     if ctl[STOP] != 0:

@@ -257,3 +257,72 @@ def test_simulator_shared_arrays_are_one_per_line_under_contention():
     finally:
         sys.setswitchinterval(old)
     assert split == 0
+
+
+_MARSHAL_CHECK = """
+import pickle, sys
+import numba
+import sph_core.cuda
+from numba import typeof
+from numba.cuda.dispatcher import CUDADispatcher, _Kernel
+from sph_core.cuda import gpu_bodies, gpu_kernels, gpu_open_ends, gpu_schemes
+
+class Launch:   # numba-cuda's own marshalling of one launch's arguments, the kernels' extensions
+    extensions = [gpu_kernels._NoneArgs()]
+    _prepare_args = _Kernel._prepare_args
+
+for tup in pickle.load(open(sys.argv[1], "rb")):
+    out = []
+    Launch()._prepare_args(typeof(tup), tup, 0, [], out)
+    assert len(out) >= len(tup) and 0 in out, (type(tup).__name__, out)
+plain = [f"{m.__name__}.{k}" for m in (gpu_kernels, gpu_open_ends, gpu_schemes, gpu_bodies)
+         for k, v in vars(m).items() if isinstance(v, CUDADispatcher)
+         and not v.targetoptions.get("device")
+         and not any(isinstance(e, gpu_kernels._NoneArgs)
+                     for e in v.targetoptions.get("extensions") or [])]
+assert not plain, plain
+print("ok")
+"""
+
+
+def test_launch_arguments_marshal_on_a_gpu(sim_factory, tmp_path):
+    """Every launch's arguments are what numba-cuda's launch can marshal on a GPU (the simulator
+    takes anything, so a None in Params went unseen until the H200 refused it): the plan's leaves
+    are arrays, numbers, booleans or None; the tuples holding None (a 2D step's Params.three,
+    Cells.three) go through numba-cuda's own marshalling with the kernels' extension, and every
+    kernel carries it (a process without the simulator: scalars and tuples need no GPU)."""
+    import os
+    import pickle
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    st = stepper(sim_factory())
+    bad, with_none = [], []
+
+    def leaves(v, where):
+        if v is None:
+            return True
+        if isinstance(v, tuple):
+            found = [leaves(x, f"{where}.{i}") for i, x in enumerate(v)]
+            if any(f is True for f in found) and all(
+                    not hasattr(x, "shape") and not isinstance(x, tuple) for x in v):
+                with_none.append(v)
+            return False
+        if not (hasattr(v, "shape") or isinstance(v, (bool, int, float, np.bool_, np.integer,
+                                                      np.floating))):
+            bad.append(f"{where}: {type(v).__name__}")
+        return False
+
+    for parity in (0, 1):
+        for name, _, args in st._plan[parity]:
+            leaves(tuple(args), name)
+    assert not bad, bad
+    assert with_none, "the 2D step's Params.three is None: a tuple with None was expected"
+    data = tmp_path / "tuples.pkl"
+    data.write_bytes(pickle.dumps(list({type(t).__name__: t for t in with_none}.values())))
+    root = Path(__file__).resolve().parents[2]
+    env = {**os.environ, "NUMBA_ENABLE_CUDASIM": "0"}
+    res = subprocess.run([sys.executable, "-c", _MARSHAL_CHECK, str(data)], cwd=root, env=env,
+                         capture_output=True, text=True, timeout=300)
+    assert res.returncode == 0 and res.stdout.strip() == "ok", res.stderr[-3000:]
