@@ -261,8 +261,7 @@ def test_simulator_shared_arrays_are_one_per_line_under_contention():
 
 _MARSHAL_CHECK = """
 import pickle, sys
-import numba
-import sph_core.cuda
+import sph_core.cuda   # numpy's row_stack for numba-cuda, before numba.cuda
 from numba import typeof
 from numba.cuda.dispatcher import CUDADispatcher, _Kernel
 from sph_core.cuda import gpu_bodies, gpu_kernels, gpu_open_ends, gpu_schemes
@@ -300,23 +299,21 @@ def test_launch_arguments_marshal_on_a_gpu(sim_factory, tmp_path):
     st = stepper(sim_factory())
     bad, with_none = [], []
 
-    def leaves(v, where):
-        if v is None:
-            return True
+    def check(v, where):
+        """Record a leaf numba-cuda cannot marshal, and every all-scalar tuple holding None."""
         if isinstance(v, tuple):
-            found = [leaves(x, f"{where}.{i}") for i, x in enumerate(v)]
-            if any(f is True for f in found) and all(
-                    not hasattr(x, "shape") and not isinstance(x, tuple) for x in v):
+            for i, x in enumerate(v):
+                check(x, f"{where}.{i}")
+            if any(x is None for x in v) and not any(
+                    hasattr(x, "shape") or isinstance(x, tuple) for x in v):
                 with_none.append(v)
-            return False
-        if not (hasattr(v, "shape") or isinstance(v, (bool, int, float, np.bool_, np.integer,
-                                                      np.floating))):
+        elif v is not None and not (hasattr(v, "shape") or isinstance(
+                v, (bool, int, float, np.bool_, np.integer, np.floating))):
             bad.append(f"{where}: {type(v).__name__}")
-        return False
 
     for parity in (0, 1):
         for name, _, args in st._plan[parity]:
-            leaves(tuple(args), name)
+            check(tuple(args), name)
     assert not bad, bad
     assert with_none, "the 2D step's Params.three is None: a tuple with None was expected"
     data = tmp_path / "tuples.pkl"
