@@ -10,9 +10,9 @@
 # JSON lines go to stdout and $OUT/gpu.jsonl, the whole log to $OUT/gpu_check.log.
 # Every phase runs under `timeout`, capped by what is left of TOTAL_S, so the script ends in time.
 # Overrides (a rerun, or a dry run here): GPU_DPS, CPU_DP, CPU_STEPS, THREADS (empty: no CPU runs), TEST_S,
-# FLUMES (non-empty: the H/dp 8 wave flumes on the GPU, three lanes side by side), HOST_THREADS (16: pytest and the GPU runs'
-# host side), TOTAL_S, PYTHON, SKIP_WHEELS, SKIP_TESTS,
-# NUMBA_ENABLE_CUDASIM.
+# FLUMES (non-empty: the H/dp 8 wave flumes on the GPU, two lanes side by side; II: case II
+# alone), HOST_THREADS (16: pytest and the GPU runs' host side), TOTAL_S, PYTHON, SKIP_WHEELS,
+# SKIP_TESTS, NUMBA_ENABLE_CUDASIM.
 set -u
 cd "$(dirname "$0")/.."
 OUT=${OUT:-/tmp/gpu_check_out}
@@ -91,14 +91,20 @@ if [ -n "$THREADS" ]; then
             --steps 20 --model-threads "$TMAX" 2>>"$LOG" | tee -a "$JSONL" "$LOG"
     done
 fi
-if [ -n "${FLUMES:-}" ]; then
-    # the wave flumes at H/dp 8 on the GPU, three lanes side by side (one process each, its own
+if [ "${FLUMES:-}" = "II" ]; then
+    # seed 002's case II at H/dp 8 (H 0.02 m in 1 m of water, dp 0.0025 m, ~536k particles, ~1.2e11
+    # particle-steps) alone: beside the lanes below it did not finish in 500 s (H200, 2026-11-27)
+    say "GPU wave flume: case II at H/dp 8, alone"
+    NUMBA_NUM_THREADS=$HT timeout "$(left 580)" $PY bench/flume_accuracy.py --device cuda --case II \
+        --dp 0.0025 --periods 4 2>>"$LOG" | tee -a "$JSONL" "$LOG"
+elif [ -n "${FLUMES:-}" ]; then
+    # the wave flumes at H/dp 8 on the GPU, two lanes side by side (one process each, its own
     # numba cache; the small flumes leave the GPU idle between launches, so lanes overlap):
-    #   a: seed 002's case II (H 0.02 m in 1 m of water, dp 0.0025 m, ~540k particles)
     #   b: the long flume's loss per wavelength (H 0.04 m, dp 0.005 m), then case III at H/dp 16
     #   c: cases III, IV, V, I at H/dp 8 (IV and I: dp 0.7 m / 38, a whole number of layers)
-    # each run prints its JSON line (device, particles, wall_s, wall_s_per_sim_s) when it ends
-    say "GPU wave flumes at H/dp 8, three lanes"
+    # each run prints its JSON line (device, particles, wall_s, wall_s_per_sim_s) when it ends;
+    # with case II beside them (FLUMES=II alone) lane c took 382 s, the long flume 217 s
+    say "GPU wave flumes at H/dp 8, two lanes"
     FA="bench/flume_accuracy.py --device cuda"
     lane() {  # lane NAME 'ARGS' ['ARGS' ...]: the runs one after another, each capped by what is left
         local name=$1; shift
@@ -109,7 +115,6 @@ if [ -n "${FLUMES:-}" ]; then
             say "lane $name: exit ${PIPESTATUS[0]}"
         done
     }
-    lane a "$FA --case II --dp 0.0025 --periods 4" &
     lane b "bench/wave_decay.py --long --dp 0.005 --device cuda" \
            "$FA --case III --dp 0.005 --periods 3 --steady" &
     lane c "$FA --case III --dp 0.01 --periods 3 --steady" \
