@@ -103,7 +103,7 @@ elif [ -n "${FLUMES:-}" ]; then
     #   b: the long flume's loss per wavelength (H 0.04 m, dp 0.005 m), then case III at H/dp 16
     #   c: cases III, IV, V, I at H/dp 8 (IV and I: dp 0.7 m / 38, a whole number of layers)
     # each run prints its JSON line (device, particles, wall_s, wall_s_per_sim_s) when it ends;
-    # with case II beside them (FLUMES=II alone) lane c took 382 s, the long flume 217 s
+    # measured with case II as a third lane (H200, 2026-11-27): lane c 382 s, the long flume 217 s
     say "GPU wave flumes at H/dp 8, two lanes"
     FA="bench/flume_accuracy.py --device cuda"
     lane() {  # lane NAME 'ARGS' ['ARGS' ...]: the runs one after another, each capped by what is left

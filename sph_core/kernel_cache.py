@@ -13,9 +13,7 @@ the same name: the index then maps one overload to the other's machine code, and
 process that loads it crashes (a segfault in the first kernel call; seen on this project's
 machine: a closed-tank run segfaulted in ``step.initialise`` on every start after it had
 compiled into one cache beside two benches). A reader between the index and the data write gets
-the same mismatch, and two checkouts of the same sources share the folder but not their files'
-modification times, so each discards the other's index and numbers its files from 1 again.
-``lock_cache_files`` takes an exclusive ``flock`` on a lock file next to the index for a save and
+the same mismatch. ``lock_cache_files`` takes an exclusive ``flock`` on a lock file next to the index for a save and
 a shared one for a load, so a reader sees an index and its data files as one writer left them.
 It costs one lock per kernel compile or load, not per call; where the lock file cannot be made
 (a read-only cache) numba's own, unlocked handling goes on.
