@@ -150,6 +150,9 @@ def flume_case(model: Any, *, height: float, period: float, depth: float, wavele
     level_drift_m: change of the flume's water volume per length since the start (fluid
     particles x dp^2 / length; None unless a regular progressive wave); level_last_period_m:
     the reflection gauges' (else mid) time mean over the last period minus the model's.
+    speed_max_m_s: the fastest fluid particle within 4h of each face ("left", "right") and within
+    L/4 of mid-flume ("mid"), sampled every 10 coupling windows: an end whose near-face fluid
+    runs many times faster than mid-flume's is disordered (its gauge then reads glitches).
     ``steady`` (progressive regular waves): run on until ``periods`` more have passed after the
     outlet's start-up has gone by the gauges and score reflection_steady (nine gauges, decay)
     there. The model starts everywhere at once, so until SPH's ramped wave reaches the outlet
@@ -175,8 +178,23 @@ def flume_case(model: Any, *, height: float, period: float, depth: float, wavele
                              right_elevation="imposed" if standing else "extrapolated",
                              probe_every=period / 40, name=name, **constants)
     x_left = -0.5 * scene.tank.x1 if standing else 0.0
+    speed_max = {"left": 0.0, "right": 0.0, "mid": 0.0}
+
+    def watch(flume: Simulation) -> None:
+        # the fastest fluid particle within 4h of each face (the boundary gauge's support
+        # reaches 2h inside) and within L/4 of mid-flume: a blow-up at an open end shows as a
+        # face speed many times the wave's own (docs/studies/absorption.md, "Case III at H/dp 6")
+        fl = flume.fluid_state()
+        speed = np.hypot(fl["vx"], fl["vz"])
+        zones = {side: np.abs(fl["x"] - nd.x_face) < 4.0 * scene.h
+                 for side, nd in flume.nodes.items()}
+        zones["mid"] = np.abs(fl["x"] - 0.5 * scene.tank.x1) < 0.25 * wavelength
+        for name, m in zones.items():
+            if m.any():
+                speed_max[name] = max(speed_max[name], float(speed[m].max()))
+
     res = run_wave_flume(scene, model, window=period / window_per_period, x_model_left=x_left,
-                         device=device)
+                         device=device, sample=watch)
     sel = (res.t >= t_start - 1e-9) & (res.t <= t_start + periods * period + 1e-9)
     refl = refl_3g = refl_steady = None
     refl_h: list[float] | None = None
@@ -219,4 +237,5 @@ def flume_case(model: Any, *, height: float, period: float, depth: float, wavele
             "particle_steps_per_s": round(res.particles * res.steps / max(res.wall_s, 1e-9)),
             "fluid_change": int(nf[-1, 1] - nf[0, 1]), "boundary_counts": res.counts,
             "mean_level_m": float(np.mean(res.eta["mid"][sel]) - np.mean(res.theory["mid"][sel])),
-            "level_drift_m": level_drift, "level_last_period_m": level_last}
+            "level_drift_m": level_drift, "level_last_period_m": level_last,
+            "speed_max_m_s": {k: round(v, 3) for k, v in speed_max.items()}}
