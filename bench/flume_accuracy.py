@@ -22,7 +22,7 @@ last period (level_last_period_m) and the fastest fluid particle near each face 
 (speed_max_m_s: an end many times faster than mid-flume is disordered).
 
 One run is one realisation: the step is deterministic, but a flume whose open end blows up
-near the surface (case III at H/dp 6) scores 3.7-8.6 % RMSE/H from round-off-sized
+near the surface (case III at H/dp 6) scores 2.7-8.6 % RMSE/H from round-off-sized
 differences (docs/studies/absorption.md, "Case III at H/dp 6").
 """
 

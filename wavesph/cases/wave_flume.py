@@ -189,9 +189,9 @@ def flume_case(model: Any, *, height: float, period: float, depth: float, wavele
         zones = {side: np.abs(fl["x"] - nd.x_face) < 4.0 * scene.h
                  for side, nd in flume.nodes.items()}
         zones["mid"] = np.abs(fl["x"] - 0.5 * scene.tank.x1) < 0.25 * wavelength
-        for name, m in zones.items():
+        for zone, m in zones.items():
             if m.any():
-                speed_max[name] = max(speed_max[name], float(speed[m].max()))
+                speed_max[zone] = max(speed_max[zone], float(speed[m].max()))
 
     res = run_wave_flume(scene, model, window=period / window_per_period, x_model_left=x_left,
                          device=device, sample=watch)
