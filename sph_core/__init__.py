@@ -17,14 +17,15 @@ over a run). Named cases (dam break, flumes) live in `wavesph.cases`; the comman
 `wavesph.cli`.
 
 The compiled kernels are cached on disk (numba ``cache=True``) in a folder named by a hash of
-this package's sources, under a lock that lets several processes compile and load at once
-(``kernel_cache``).
+this package's sources, under a lock that lets several processes compile and load at once, with
+numba's threading layer started on import so no cached kernel finds it missing (``kernel_cache``).
 """
 
 import numba
 
-from .kernel_cache import kernel_cache_dir, lock_cache_files
+from .kernel_cache import kernel_cache_dir, launch_threading_layer, lock_cache_files
 
 # before any submodule's @njit(cache=True) builds its cache locator
 numba.config.CACHE_DIR = kernel_cache_dir()
 lock_cache_files()
+launch_threading_layer()   # before any cached kernel's first call (kernel_cache)

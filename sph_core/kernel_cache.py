@@ -17,6 +17,15 @@ the same mismatch. ``lock_cache_files`` takes an exclusive ``flock`` on a lock f
 a shared one for a load, so a reader sees an index and its data files as one writer left them.
 It costs one lock per kernel compile or load, not per call; where the lock file cannot be made
 (a read-only cache) numba's own, unlocked handling goes on.
+
+The threading layer: a cached parallel kernel needs numba's threading layer started before its
+first call (its machine code calls the layer's ``numba_parallel_for``), and numba starts it when
+it compiles or loads a parallel function. A kernel compiled while the parallel functions it calls
+were loaded from the cache forgets that need (numba copies it only from callees it compiled
+itself: numba issue #8578, fix proposed in numba PR #9950), so a later process that loads that
+kernel first calls a null pointer: the segfault in ``step.initialise`` seen on this project's
+machine with no two processes at once (a closed-tank run's overload compiled beside the flume
+runs' helpers). ``launch_threading_layer`` starts the layer once, when sph_core is imported.
 """
 
 from __future__ import annotations
@@ -58,6 +67,14 @@ def _locked(index_path: str, exclusive: bool) -> Iterator[None]:
             yield
         finally:
             fcntl.flock(fh, fcntl.LOCK_UN)
+
+
+def launch_threading_layer() -> None:
+    """Start numba's threading layer now (module docstring), as numba does on loading a parallel
+    kernel it compiled with its callees; idempotent."""
+    from numba.np.ufunc.parallel import _launch_threads
+
+    _launch_threads()
 
 
 def lock_cache_files() -> bool:

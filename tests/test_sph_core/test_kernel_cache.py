@@ -3,6 +3,10 @@ an overload to another overload's machine code (sph_core.kernel_cache's docstrin
 
 from __future__ import annotations
 
+import os
+import subprocess
+import sys
+import textwrap
 import threading
 
 import pytest
@@ -47,6 +51,38 @@ def test_two_writers_of_one_index_leave_every_entry_with_its_own_data(tmp_path):
     reader = caching.IndexDataCacheFile(str(tmp_path), "kern", (1.0, 10))
     assert reader.load("sig_a") == ("code", "A")
     assert reader.load("sig_b") == ("code", "B")
+
+
+NESTED = textwrap.dedent("""
+    import numpy as np
+    from numba import njit, prange
+
+    @njit(parallel=True, cache=True)
+    def inner(n):
+        a = np.zeros(n)
+        for i in prange(n):
+            a[i] = i
+        return a
+
+    @njit(cache=True)
+    def outer(n):
+        return inner(n).sum()
+    """)
+
+
+def test_a_kernel_compiled_against_cached_parallel_callees_loads_in_a_new_process(tmp_path):
+    """The closed-tank segfault in miniature (kernel_cache's docstring): process 1 caches the
+    parallel ``inner``; process 2 compiles ``outer`` with ``inner`` loaded from that cache; process
+    3 loads ``outer`` first. Without the threading layer started on import, process 3 calls a
+    null pointer (numba 0.68.1, numba issue #8578)."""
+    (tmp_path / "nested.py").write_text(NESTED)
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "cache"), "NUMBA_NUM_THREADS": "1",
+           "PYTHONPATH": os.pathsep.join([str(tmp_path), *sys.path])}
+    for call in ("nested.inner(10)", "nested.outer(10)", "print(nested.outer(10))"):
+        r = subprocess.run([sys.executable, "-c", f"import sph_core, nested; {call}"], env=env,
+                           capture_output=True, text=True, timeout=120)
+        assert r.returncode == 0, (call, r.returncode, r.stderr[-2000:])
+    assert r.stdout.strip() == "45.0"
 
 
 def test_the_cache_folder_is_named_by_the_sources(monkeypatch, tmp_path):
