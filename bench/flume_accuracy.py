@@ -22,10 +22,9 @@ last period (level_last_period_m) and the fastest fluid particle near each face 
 (speed_max_m_s: an end many times faster than mid-flume is disordered).
 
 One run is one realisation: the step is deterministic, but a flume whose open end blows up
-near the surface scores differently after round-off-sized changes (case III at H/dp 6: 2.7-8.6 %
-RMSE/H with the buffer moved in x only, 3.5-5.4 % moved in x and z; docs/studies/absorption.md,
-"Case III at H/dp 6" and "The buffer moves as the flow it carries"). The boundary counts'
-IN - OUT at the inlet is the net inflow, to compare with the wave's mass transport.
+near the surface (case III at H/dp 6) scores 2.7-8.6 % RMSE/H from round-off-sized
+differences (docs/studies/absorption.md, "Case III at H/dp 6"). An end's IN - OUT boundary
+count is its net inflow in particles, to compare with the wave's mass transport g H^2 / (8 c).
 """
 
 from __future__ import annotations

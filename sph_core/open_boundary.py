@@ -12,8 +12,7 @@ x_f, outward normal n_x (-1 left, +1 right); d = (x - x_f) n_x is the depth into
 
 Every step, for buffer particle i of end b (the window [t0, t1] holds the source's samples,
 interpolated linearly in time and linearly in z between the nodes):
-    u_i = u(z_i, t) + du_b P_b(z_i),  w_i = w(z_i, t),  x_i += dt u_i,  z_i += dt w_i
-    (each particle follows the orbit whose velocity it carries; kept between bed and tank top)
+    u_i = u(z_i, t) + du_b P_b(z_i),  w_i = w(z_i, t),  x_i += dt u_i  (z_i fixed: layers level)
     du_b = n_x G[eta_meas,b - eta_gauge,b(t)]  if absorbing   (seed 002 correction; G a causal
            filter of the mismatch following Biesel's piston gain per frequency, its direct
            gain in the ends' sqgd, see sph_core.absorption); P_b the correction's vertical
@@ -124,15 +123,6 @@ def profile_value(zn, a, r, z):
 
 
 @njit(cache=True, inline="always")
-def profile_slope(zn, a, r, z):
-    """d/dz of profile_value at height z (0 outside the nodes, where the profile is clamped)."""
-    k = node_index(zn, z)
-    if k <= 0 or k >= zn.size:
-        return 0.0
-    return (_blend(a, k, r) - _blend(a, k - 1, r)) / (zn[k] - zn[k - 1])
-
-
-@njit(cache=True, inline="always")
 def node_value(zn, a, z):
     """Profile a[node] at height z: linear in z between nodes zn (clamped at the ends)."""
     nn = zn.size
@@ -195,31 +185,23 @@ def _end_of(k):
 
 @njit(cache=True, inline="always")
 def buffer_particle(i, ps, dt, r, zs0, du0, zs1, du1, ends, prm):
-    """Buffer slot i imposed and moved (``buffer_update``'s body): returns (b, u, w, x, z,
-    kind, rho, p) with b = -1 (nothing to write) when slot i is not a buffer particle. The
-    particle moves with the source's (u, w): moved in x only, it would sit off the orbit whose
-    velocity it carries by the orbit's vertical excursion (2-4 dp at H/dp 4-8), a divergence its
-    fluid neighbours' continuity sees and the flow has not."""
+    """Buffer slot i imposed and moved (``buffer_update``'s body): returns (b, u, w, x, kind,
+    rho, p) with b = -1 (nothing to write) when slot i is not a buffer particle."""
     b = _end_of(ps.kind[i])
     if b < 0:
-        return -1, 0.0, 0.0, 0.0, 0.0, 0, 0.0, 0.0
+        return -1, 0.0, 0.0, 0.0, 0, 0.0, 0.0
     zi = ps.z[i]
     zs = zs0 if b == 0 else zs1
     du = du0 if b == 0 else du1
     zn = ends.zn[b]
-    # u carried off the face by continuity, du/dx = -dw/dz: an x-uniform u with the vertical
-    # strain of w would make the buffer's particle density breathe with the wave, a spurious
-    # second-order flux through the face
-    u = (profile_value(zn, ends.win_u[b], r, zi) + du * node_value(zn, ends.corr_prof[b], zi)
-         - (ps.x[i] - ends.x_face[b]) * profile_slope(zn, ends.win_w[b], r, zi))
+    u = profile_value(zn, ends.win_u[b], r, zi) + du * node_value(zn, ends.corr_prof[b], zi)
     w = profile_value(zn, ends.win_w[b], r, zi)
     xi = ps.x[i] + dt * u
-    zi = min(max(zi + dt * w, ends.z_bed[b]), ends.z_top[b])
     if zi < zs:
         rho0 = prm.rho0
         rho = rho0 * (1.0 + rho0 * (-prm.gz) * (zs - zi) / prm.b) ** (1.0 / prm.gamma)
-        return b, u, w, xi, zi, INLET + b, rho, pressure(rho, rho0, prm.b, prm.gamma)
-    return b, u, w, xi, zi, INLET_IDLE + b, prm.rho0, 0.0
+        return b, u, w, xi, INLET + b, rho, pressure(rho, rho0, prm.b, prm.gamma)
+    return b, u, w, xi, INLET_IDLE + b, prm.rho0, 0.0
 
 
 @njit(parallel=True, cache=True)
@@ -227,7 +209,6 @@ def buffer_update(ps, n, dt, r, zs0, du0, zs1, du1, ends, prm):
     """Impose velocity, move, (de)activate and set hydrostatic density of every buffer particle."""
     # the rows written as locals (``ps.x[i] = ...`` inside a prange writes nothing, numba 0.68.1)
     x = ps.x
-    z = ps.z
     vx = ps.vx
     vy = ps.vy
     vz = ps.vz
@@ -239,14 +220,12 @@ def buffer_update(ps, n, dt, r, zs0, du0, zs1, du1, ends, prm):
     az = ps.az
     kind = ps.kind
     for i in prange(n):
-        b, u, w, xi, zi, k, rho, pi = buffer_particle(i, ps, dt, r, zs0, du0, zs1, du1, ends,
-                                                      prm)
+        b, u, w, xi, k, rho, pi = buffer_particle(i, ps, dt, r, zs0, du0, zs1, du1, ends, prm)
         if b < 0:
             continue
         vx[i] = u
         vz[i] = w
         x[i] = xi
-        z[i] = zi
         kind[i] = k
         rho_[i] = rho
         p[i] = pi
