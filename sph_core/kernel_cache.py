@@ -10,11 +10,11 @@ The lock: numba saves a new overload by reading the function's index, picking th
 file name, writing the index, then the data, with nothing held in between. Two processes
 compiling overloads of one function at once (dask workers of a sweep, runs side by side) can pick
 the same name: the index then maps one overload to the other's machine code, and every later
-process that loads it crashes (a segfault in the first kernel call; seen on this project's
-machine: a closed-tank run segfaulted in ``step.initialise`` on every start after it had
-compiled into one cache beside two benches). A reader between the index and the data write gets
-the same mismatch. ``lock_cache_files`` takes an exclusive ``flock`` on a lock file next to the index for a save and
-a shared one for a load, so a reader sees an index and its data files as one writer left them.
+process that loads it crashes (a segfault in the first kernel call; reproduced with six
+processes compiling overloads of one toy function, docs/developer/testing.md). A reader between
+the index and the data write gets the same mismatch. ``lock_cache_files`` takes an exclusive
+``flock`` on a lock file next to the index for a save and a shared one for a load, so a reader
+sees an index and its data files as one writer left them.
 It costs one lock per kernel compile or load, not per call; where the lock file cannot be made
 (a read-only cache) numba's own, unlocked handling goes on.
 
