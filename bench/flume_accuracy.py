@@ -7,8 +7,10 @@
 
 Runs one case of the seed 002 validation table (tests/data/wave_cases_seed002.csv, cases I-VI)
 or any regular wave through a flume one wavelength long (standing wave: half a wavelength, faces
-at the nodes of eta) with open ends driven by the theory. Prints one JSON line:
-case, theory, H, T, d, dp, H_over_dp, periods, rmse_over_H (mid-flume gauge vs theory over the
+at the nodes of eta) with open ends driven by the theory (the table's names and orders:
+wavesph/cases/seed002_waves.py; the standing wave is second order). Prints one JSON line:
+case, theory, order (of a stokes or standing wave; --order overrides the table's), H, T, d, dp,
+H_over_dp, periods, rmse_over_H (mid-flume gauge vs theory over the
 periods after the ramp), reflection (first harmonic, least squares over nine gauges within L/4
 of mid-flume with a fitted spatial decay of both waves: the coarse flume damps its waves, and a
 fit without decay reads that as reflection), reflection_3g (the plain fit over mid-flume and L/8
@@ -30,37 +32,22 @@ count is its net inflow in particles, to compare with the wave's mass transport 
 from __future__ import annotations
 
 import argparse
-import csv
 import json
 import math
 import sys
-from pathlib import Path
 
+from wavesph.cases.seed002_waves import case_theory, read_cases
 from wavesph.cases.wave_flume import flume_case
-from wave_client.theories import build_theory, wavenumber
-
-CASES_CSV = Path(__file__).resolve().parents[1] / "tests" / "data" / "wave_cases_seed002.csv"
-THEORY_OF = {"standing": ("standing", {}), "linear": ("linear", {}),
-             "stokes2": ("stokes", {"order": 2}), "stokes3": ("stokes", {"order": 3}),
-             "stream_function": ("stream", {"n_fourier": 16}), "irregular": ("irregular", {})}
-
-
-def read_cases(path: Path = CASES_CSV) -> dict[str, dict]:
-    with open(path) as fh:
-        rows = csv.DictReader(line for line in fh if not line.startswith("#"))
-        return {r["test"]: r for r in rows}
-
-
-def case_theory(theory: str, height: float, period: float, depth: float, ramp: float):
-    name, opts = THEORY_OF.get(theory, (theory, {}))
-    return build_theory(name, height=height, period=period, depth=depth, ramp_time=ramp, **opts)
+from wave_client.theories import wavenumber
 
 
 def run_flume_case(theory: str, height: float, period: float, depth: float, dp: float, periods: float,
                    ramp_periods: float = 1.0, absorb: bool = True, case: str | None = None,
-                   steady: bool = False, device: str | None = None, **constants) -> dict:
+                   steady: bool = False, device: str | None = None, order: int | None = None,
+                   **constants) -> dict:
     ramp = ramp_periods * period
-    model = case_theory(theory, height, period, depth, ramp)
+    model = case_theory(theory, height=height, period=period, depth=depth, ramp_time=ramp,
+                        **({} if order is None else {"order": order}))
     if theory == "irregular":  # flume length and gauges from the peak wave
         wavelength = 2 * math.pi / float(wavenumber(2 * math.pi / period, depth))
     else:
@@ -69,7 +56,8 @@ def run_flume_case(theory: str, height: float, period: float, depth: float, dp: 
                      dp=dp, periods=periods, ramp=ramp, standing=theory == "standing",
                      absorb=(absorb, absorb), regular=theory != "irregular",
                      name=f"flume_{case or theory}", steady=steady, device=device, **constants)
-    return {"case": case, "theory": theory, "device": device or "cpu", **constants, **out}
+    return {"case": case, "theory": theory, "order": getattr(model, "order", None),
+            "device": device or "cpu", **constants, **out}
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -91,6 +79,8 @@ def main(argv: list[str] | None = None) -> int:
                          "and print reflection_steady over --periods periods after it")
     ap.add_argument("--h-over-dp", type=float, help="smoothing length / dp (default: the scene's)")
     ap.add_argument("--alpha-wall", type=float, help="wall viscosity factor (scene default)")
+    ap.add_argument("--order", type=int, help="the theory's order instead of the table's "
+                                               "(stokes 2-5, standing 1-2)")
     ap.add_argument("--device", choices=["cpu", "cuda"], default=None,
                     help="where the SPH steps run (default: the scene's, cpu)")
     a = ap.parse_args(argv)
@@ -105,14 +95,13 @@ def main(argv: list[str] | None = None) -> int:
         theory, height, depth = a.theory, a.H, a.d
         periods_s = [a.T] if a.T else [2 * math.pi / math.sqrt(9.81 * kd / a.d * math.tanh(kd))
                                        for kd in a.kd]
-        if theory.startswith("stokes") and theory not in THEORY_OF:
-            THEORY_OF[theory] = ("stokes", {"order": int(theory[-1])})
     else:
         ap.error("give --case, or --theory with --H --d and --T or --kd")
     dp = a.dp if a.dp else height / 10.0
     for period in periods_s:
         out = run_flume_case(theory, height, period, depth, dp, a.periods, a.ramp_periods,
-                             not a.no_absorb, a.case, a.steady, device=a.device, **constants)
+                             not a.no_absorb, a.case, a.steady, device=a.device, order=a.order,
+                             **constants)
         print(json.dumps(out), flush=True)
     return 0
 

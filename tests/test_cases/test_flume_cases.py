@@ -1,6 +1,7 @@
 """Wave cases of the seed 002 validation table through the open-boundary flume.
 
-The table is tests/data/wave_cases_seed002.csv. The default suite runs case V (stream-function
+The table is tests/data/wave_cases_seed002.csv (read, and each case's theory built, by
+wavesph/cases/seed002_waves.py from the package's copy). The default suite runs case V (stream-function
 wave in shallow water: the cheapest) at a coarse resolution; the accuracy goal of issue 3 (RMSE/H
 <= 5 % at H/dp >= 10, seed 002 reports <= 4.3 %), the reflection of the absorbing outlet and the
 long-run water level are slow tests (``pytest -m slow``).
@@ -8,22 +9,17 @@ long-run water level are slow tests (``pytest -m slow``).
 
 from __future__ import annotations
 
-import csv
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
 
+from wavesph.cases.seed002_waves import case_theory, read_cases
 from wavesph.cases.wave_flume import flume_case
 from wavesph.studies.planning import depth_divisor
 
 theories = pytest.importorskip("wave_client.theories")
 
-DATA = Path(__file__).resolve().parents[1] / "data" / "wave_cases_seed002.csv"
-THEORY = {"standing": ("standing", {}), "linear": ("linear", {}),
-          "stokes2": ("stokes", {"order": 2}), "stokes3": ("stokes", {"order": 3}),
-          "stream_function": ("stream", {"n_fourier": 16})}
 
 
 # measured (docs/studies/schemes.md "ISPH open ends: the buffers in the projection"): the open
@@ -35,18 +31,17 @@ ISPH_WAVE_FLUME = ("ISPH: unstable at t = 3.94 s (2 particles excluded before, t
 
 
 def cases() -> dict[str, dict]:
-    with open(DATA) as fh:
-        return {r["test"]: r for r in csv.DictReader(ln for ln in fh if not ln.startswith("#"))}
+    """The package's copy of the table (test_sweeps checks it is tests/data's)."""
+    return read_cases()
 
 
 def run_case(test: str, dp: float, periods: float, ramp_periods: float = 1.0, **kw) -> dict:
     row = cases()[test]
     h, t, d = float(row["H"]), float(row["T"]), float(row["d"])
-    name, opts = THEORY[row["theory"]]
-    model = theories.build_theory(name, height=h, period=t, depth=d,
-                                  ramp_time=ramp_periods * t, **opts)
+    model = case_theory(row["theory"], height=h, period=t, depth=d, ramp_time=ramp_periods * t)
     return flume_case(model, height=h, period=t, depth=d, wavelength=model.length, dp=dp,
-                      periods=periods, ramp=ramp_periods * t, standing=name == "standing", **kw)
+                      periods=periods, ramp=ramp_periods * t,
+                      standing=row["theory"] == "standing", **kw)
 
 
 def test_case_table_wavelengths_are_linear_dispersion():
@@ -82,9 +77,8 @@ def test_case_V_coarse_flume_generates_the_wave(scheme):
 def crest_speed(test: str) -> float:
     """The largest horizontal fluid speed of the case's wave (at the crest's surface) [m/s]."""
     row = cases()[test]
-    name, opts = THEORY[row["theory"]]
-    model = theories.build_theory(name, height=float(row["H"]), period=float(row["T"]),
-                                  depth=float(row["d"]), **opts)
+    model = case_theory(row["theory"], height=float(row["H"]), period=float(row["T"]),
+                        depth=float(row["d"]))
     model.advance_to(0.0)
     x = np.linspace(0.0, float(model.length), 201)
     u, _ = model.velocity(x, model.elevation(x))

@@ -216,6 +216,96 @@ def test_standing_wave_nodes_and_walls():
         np.testing.assert_allclose(wave.elevation(x), right + opposite, atol=1e-12)
 
 
+
+def _surface_residuals(wave: StandingWave) -> tuple[float, float]:
+    """Largest residuals over a wavelength and a period of the exact free-surface conditions at
+    z = eta, written with velocities only (no potential needed): kinematic
+    eta_t + u eta_x - w, and the x-derivative along the surface of Bernoulli's
+    g eta + phi_t + |u|^2/2 = C(t): g eta_x + u_t + w_t eta_x + d/dx (|u|^2/2)."""
+    h = 1e-6
+    x = np.linspace(0.0, wave.length, 41)
+    res_k = res_d = 0.0
+    for t in np.linspace(0.0, wave.period, 17):
+        eta = wave._eta(x, t)
+        eta_x = (wave._eta(x + h, t) - wave._eta(x - h, t)) / (2 * h)
+        eta_t = (wave._eta(x, t + h) - wave._eta(x, t - h)) / (2 * h)
+        u, w = wave._uw(x, eta, t, eta)
+        (u1, w1), (u0, w0) = wave._uw(x, eta, t + h, eta), wave._uw(x, eta, t - h, eta)
+        ke = [0.5 * (a ** 2 + b ** 2) for a, b in
+              (wave._uw(x + s, wave._eta(x + s, t), t, eta) for s in (h, -h))]
+        res_k = max(res_k, np.abs(eta_t + u * eta_x - w).max())
+        res_d = max(res_d, np.abs(G * eta_x + (u1 - u0) / (2 * h) + (w1 - w0) / (2 * h) * eta_x
+                                  + (ke[0] - ke[1]) / (2 * h)).max())
+    return res_k, res_d
+
+
+@pytest.mark.parametrize("depth", [0.7, 0.25, 5.0])
+def test_second_order_standing_wave_satisfies_the_surface_conditions_to_third_order(depth):
+    """Halving the amplitude divides the exact conditions' residual by ~4 at first order
+    (the neglected terms are quadratic) and by ~8 at second order: the second-order terms are
+    the right ones, in deep (kd 6.8), intermediate (case I, kd 0.95) and shallow (kd 0.47) water."""
+    for order, expected in ((1, 4.0), (2, 8.0)):
+        big = _surface_residuals(StandingWave(0.02, 2.0, depth, order=order))
+        small = _surface_residuals(StandingWave(0.01, 2.0, depth, order=order))
+        for b, s_ in zip(big, small):
+            assert b / s_ == pytest.approx(expected, rel=0.12), (order, depth)
+
+
+def test_second_order_standing_wave_set_up_and_deep_water_limit():
+    wave = StandingWave(0.15, 2.0, 0.7, order=2)  # seed 002 case I
+    a, k, kd = 0.075, wave.k, wave.k * 0.7
+    ts = np.linspace(0.0, 2.0, 64, endpoint=False)
+    x = np.array([0.0, 0.5 * np.pi / wave.k])  # an antinode, a node
+    mean = np.mean([wave._eta(x, t) for t in ts], axis=0)
+    setup = k * a ** 2 / 4.0 / np.tanh(2.0 * kd)   # 2.0 mm
+    np.testing.assert_allclose(mean, [setup, -setup], rtol=1e-12)
+    assert 1.9e-3 < setup < 2.1e-3
+    # the range at the antinode is still H (crest and trough carry the same second order)
+    assert wave._eta(0.0, 0.0) - wave._eta(0.0, 1.0) == pytest.approx(0.15, rel=1e-12)
+    # no net volume at any time, and u2 = 0 at the nodes (the flume's faces)
+    xs = np.linspace(0.0, wave.length, 256, endpoint=False)
+    lin = StandingWave(0.15, 2.0, 0.7)
+    z = np.linspace(-0.7, 0.0, 9)
+    for t in (0.3, 0.7):
+        assert abs(wave._eta(xs, t).mean()) < 1e-12
+        np.testing.assert_allclose(wave._uw(x[1], z, t, None)[0], lin._uw(x[1], z, t, None)[0],
+                                   atol=1e-12)
+    # deep water: Penney & Price (1952), eta2 = (k A^2 / 2) cos 2kx cos^2 wt, phi2 = 0
+    deep = StandingWave(0.05, 1.0, 50.0, order=2)
+    first = StandingWave(0.05, 1.0, 50.0)
+    kd_, a_ = deep.k, 0.025
+    xs = np.linspace(0.0, deep.length, 7)
+    for t in (0.1, 0.35):
+        np.testing.assert_allclose(
+            deep._eta(xs, t) - first._eta(xs, t),
+            kd_ * a_ ** 2 / 2 * np.cos(2 * kd_ * xs) * np.cos(deep.omega * t) ** 2, atol=1e-15)
+        for q, q1 in zip(deep._uw(xs, -0.1 + 0 * xs, t, None), first._uw(xs, -0.1 + 0 * xs, t, None)):
+            np.testing.assert_allclose(q, q1, atol=1e-15)
+    with pytest.raises(ValueError, match="order"):
+        StandingWave(0.15, 2.0, 0.7, order=3)
+
+
+def test_couple_cli_passes_the_order_to_stokes_and_standing_only():
+    import argparse
+
+    from wavesph.cli.couple import add_arguments, model_factory
+
+    p = argparse.ArgumentParser()
+    add_arguments(p)
+
+    def build(*extra: str):
+        make, _ = model_factory(p.parse_args(["--H", "0.15", "--T", "2", "--d", "0.7", *extra]))
+        return make(None)
+
+    assert build("--model", "standing").order == 1
+    assert build("--model", "standing", "--order", "2").order == 2
+    assert build("--model", "stokes").order == 5
+    assert build("--model", "stokes", "--order", "3").order == 3
+    with pytest.raises(ValueError, match="--order is for"):
+        build("--model", "linear", "--order", "2")
+    with pytest.raises(ValueError, match="order"):
+        build("--model", "standing", "--order", "3")
+
 # --- irregular sea --------------------------------------------------------------------------
 def test_jonswap_shape_matches_wavespectra():
     from wavespectra.construct.frequency import jonswap

@@ -47,7 +47,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     p.add_argument("--t0", type=float, default=None,
                    help="time [s] the crest passes the SPH inlet (--model solitary; default: "
                         "when the elevation there starts at 1e-3 H)")
-    p.add_argument("--order", type=int, default=5, help="Stokes order, 2-5 (--model stokes)")
+    p.add_argument("--order", type=int, default=None,
+                   help="--model stokes: order 2-5 (default 5); --model standing: 1 or 2 (default 1)")
     p.add_argument("--n-fourier", type=int, default=10, help="Fourier modes (--model stream)")
     p.add_argument("--gamma", type=float, default=3.3, help="JONSWAP peak enhancement (irregular)")
     p.add_argument("--components", type=int, default=200, help="wave components (irregular)")
@@ -109,7 +110,9 @@ def model_factory(args: argparse.Namespace) -> tuple[Callable[[Welcome], Any], f
         if args.t0 is not None:
             raise ValueError("--t0 is for --model solitary")
         options = {"ramp_time": args.ramp_periods * args.T}
-    if args.model == "stokes":
+    if args.order is not None:
+        if args.model not in ("stokes", "standing"):
+            raise ValueError(f"--order is for --model stokes or standing, not {args.model}")
         options["order"] = args.order
     elif args.model == "stream":
         options["n_fourier"] = args.n_fourier

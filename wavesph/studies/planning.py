@@ -145,9 +145,9 @@ def fit_error(rows: list[dict[str, Any]], method: str,
 
 def _wave_distance(case: str, wave: tuple[float, float, float]) -> float:
     """Distance of a seed 002 flume case from the wave (H, T, d) in (log kd, log H/L)."""
-    from .sweeps import _read_cases
+    from ..cases.seed002_waves import read_cases
 
-    row = _read_cases().get(case.removeprefix("flume_"))
+    row = read_cases().get(case.removeprefix("flume_"))
     if row is None:
         return math.inf
 

@@ -41,6 +41,7 @@ from typing import Any, Callable, Iterable
 from sph_core.scene import ISPH_H_OVER_DP
 
 from ..cases.schemes import RIEMANN_VARIANTS
+from ..cases.seed002_waves import read_cases
 
 # name -> sph_core.scene.Constants overrides, and "scheme": the scene's [scheme] table (every
 # case builder takes ``scheme=``). The solver's schemes and options today: delta-SPH
@@ -105,7 +106,7 @@ def accuracy_points(quick: bool = False, methods: Iterable[str] | None = None) -
     unknown = [m for m in methods if m not in METHODS]
     if unknown:
         raise ValueError(f"unknown methods {unknown}; known: {sorted(METHODS)}")
-    cases = _read_cases()
+    cases = read_cases()
     pts: list[Point] = []
     flumes = ("I", "IV", "V") if quick else FLUME_CASES   # quick: the cheap ones (few particles)
     ratios = (2.0, 3.0) if quick else (3.0, 5.0, 8.0)          # H/dp of the wave cases
@@ -123,13 +124,6 @@ def accuracy_points(quick: bool = False, methods: Iterable[str] | None = None) -
     c_dps = (0.03,) if quick else (0.04, 0.02, 0.01)
     pts += [Point("coupled", m, dp, c_opts) for m in COUPLED_METHODS for dp in c_dps]
     return pts
-
-
-def _read_cases() -> dict[str, dict[str, str]]:
-    """Seed 002's validation table (a copy of tests/data/wave_cases_seed002.csv shipped in wavesph/cases/data)."""
-    text = _data_text("wave_cases_seed002.csv")
-    return {r["test"]: r for r in csv.DictReader(ln for ln in text.splitlines()
-                                                 if not ln.startswith("#"))}
 
 
 def _data_text(name: str) -> str:
@@ -207,20 +201,16 @@ def _assert_finite(rec: dict[str, Any]) -> None:
 
 
 def _flume(point: Point) -> dict[str, Any]:
-    from wave_client.theories import build_theory
-
+    from ..cases.seed002_waves import case_theory
     from ..cases.wave_flume import flume_case
 
-    row = _read_cases()[point.case.split("_", 1)[1]]
-    theory = {"standing": ("standing", {}), "linear": ("linear", {}),
-              "stokes2": ("stokes", {"order": 2}), "stokes3": ("stokes", {"order": 3}),
-              "stream_function": ("stream", {"n_fourier": 16})}[row["theory"]]
+    row = read_cases()[point.case.split("_", 1)[1]]
     h, t, d = float(row["H"]), float(row["T"]), float(row["d"])
     ramp = point.options.get("ramp_periods", 1.0) * t
-    model = build_theory(theory[0], height=h, period=t, depth=d, ramp_time=ramp, **theory[1])
+    model = case_theory(row["theory"], height=h, period=t, depth=d, ramp_time=ramp)
     res = flume_case(model, height=h, period=t, depth=d, wavelength=float(model.length),
                      dp=point.dp, periods=point.options.get("periods", 1.0), ramp=ramp,
-                     standing=theory[0] == "standing", name=point.key,
+                     standing=row["theory"] == "standing", name=point.key,
                      **METHODS[point.method])
     return {"H_over_dp": h / point.dp, "error": res["rmse_over_H"], "wall_s": res["wall_s"],
             "particles": res["particles"], "steps": res["steps"],
