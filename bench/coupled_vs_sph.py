@@ -20,7 +20,12 @@ Boussinesq source --wavelengths wavelengths (12: 23.6 m) up-flume of an SPH zone
                    reached the gauge). --sph-only-seconds 0 runs it to the end.
 rmse_over_H: elevation at the flat-bed gauge inside the SPH zone (0.8 m past the inlet) against
 the reference, over t >= compare_from (ramp + front travel + 1 period) to t_end (4 periods).
-What bounds it: the SPH wave's own loss over those 0.8 m (bench/wave_decay.py, no coupling).
+What bounds it (measured at dp 0.01, 4.76 % absorption-only): the free second harmonic the SPH
+inlet radiates (its buffer particles carry the orbit's w but hold their height; 3.16 % with them
+moved as the flow, not on main), the beach (SPH's breaking beach reflects 2.8 %, the reference's
+0.6 %), the SPH wave's own loss over those 0.8 m (bench/wave_decay.py, no coupling) and the
+Boussinesq model's own bound second harmonic (3.6 mm against Stokes' 3.1 mm here);
+docs/studies/absorption.md, "The inlet's free second harmonic".
 Speed figures want a quiet machine and OpenMP's default (active) wait policy: on a shared,
 loaded machine set OMP_WAIT_POLICY=passive, which costs the small SPH zone ~27 % of its
 throughput (its parallel regions are short; a sleeping worker takes ~0.1 ms to wake).
