@@ -216,7 +216,6 @@ def test_standing_wave_nodes_and_walls():
         np.testing.assert_allclose(wave.elevation(x), right + opposite, atol=1e-12)
 
 
-
 def _surface_residuals(wave: StandingWave) -> tuple[float, float]:
     """Largest residuals over a wavelength and a period of the exact free-surface conditions at
     z = eta, written with velocities only (no potential needed): kinematic
@@ -305,6 +304,7 @@ def test_couple_cli_passes_the_order_to_stokes_and_standing_only():
         build("--model", "linear", "--order", "2")
     with pytest.raises(ValueError, match="order"):
         build("--model", "standing", "--order", "3")
+
 
 # --- irregular sea --------------------------------------------------------------------------
 def test_jonswap_shape_matches_wavespectra():

@@ -5,10 +5,10 @@
 
 One table and one theory per name for the flume bench (bench/flume_accuracy.py), the accuracy
 sweep (wavesph.studies.sweeps) and the tests. The table names a theory but not always its order:
-"standing" is run to second order (case I, H/d 0.21: its mean set-up of (k A^2/4) coth 2kd is 2 mm,
-3 % of the wave at the antinode, and its second harmonic 8 % of A; the linear reference lacks
-both, and open ends imposing the linear level at the nodes fill the flume by twice the set-up,
-docs/studies/absorption.md "Case I").
+"standing" is run to second order (case I, H/d 0.21: its mean set-up (k A^2/4) coth 2kd is 2.0 mm
+at the antinode and its second harmonic 5.8 mm, 8 % of A; the linear reference lacks both, and
+open ends imposing the linear level at the nodes fill the flume by twice the set-up:
+docs/studies/absorption.md "Case I against the second-order standing wave").
 """
 
 from __future__ import annotations
