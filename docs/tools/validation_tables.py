@@ -44,8 +44,12 @@ QUESTIONS: dict[str, tuple[str, ...]] = {
                  "`coupled`: 2 wavelengths of Boussinesq before the SPH zone, against SPH alone over "
                  "the same length. Wall times under load. Filled points: each method's Pareto "
                  "front (more time bought less error); hollow: a refinement that cost more and "
-                 "erred more; dashed grey: the front over all methods. Redrawn from the shipped "
-                 "data by `python docs/tools/accuracy_chart.py`.",
+                 "erred more; dashed grey: the front over all methods; `--repeats N` runs each "
+                 "point N times (a flume's ramp 0.1 % longer each) and draws the run-to-run "
+                 "scatter as bars. Its flume_I points were scored against the linear standing "
+                 "wave; the sweep now scores case I against the second-order one (2.6 % at H/dp 8 "
+                 "against 5.2 %). Redrawn from the shipped data by "
+                 "`python docs/tools/accuracy_chart.py`.",
                  "![speed-accuracy chart, quick preset, under load](figures/accuracy_quick.png)"),
     "bodies": ("Rigid bodies", "Floating and moving bodies against theory."),
     "runup": ("Run-up", "How far up a 1:19.85 plane beach does a solitary wave run in SPH, against "

@@ -96,6 +96,42 @@ def test_presets_cover_every_method_and_case():
         sweeps.accuracy_points(methods=["no_such_scheme"])
 
 
+
+def test_repeats_are_other_realisations_and_the_chart_shows_their_scatter(tmp_path):
+    one = sweeps.accuracy_points(quick=True)
+    two = sweeps.accuracy_points(quick=True, repeats=2)
+    assert two[: len(one)] == one and len(two) == 2 * len(one)
+    assert len({p.key for p in two}) == len(two)             # each repeat has its own record
+    for p, q in zip(one, two[len(one):]):
+        assert (q.case, q.method, q.dp, q.repeat) == (p.case, p.method, p.dp, 1)
+        if p.case.startswith("flume_"):   # a round-off-sized change: another realisation
+            assert q.options["ramp_periods"] == pytest.approx(
+                p.options["ramp_periods"] * (1 + sweeps.REPEAT_RAMP_STEP))
+        else:
+            assert q.options == p.options
+    assert sweeps.point_from_dict({"case": "flume_V", "method": "m", "dp": 0.02,
+                                   "repeat": 1}).key.endswith("__r1")
+    with pytest.raises(ValueError, match="repeats"):
+        sweeps.accuracy_points(quick=True, repeats=0)
+
+    def rec(dp, repeat, err, wall, status="ok"):
+        return {"case": "flume_V", "method": "wcsph_kdk", "dp": dp, "repeat": repeat,
+                "H_over_dp": 0.06 / dp, "error": err, "wall_s": wall, "status": status}
+
+    records = [rec(0.02, 0, 0.05, 10.0), rec(0.02, 1, 0.07, 14.0), rec(0.02, 2, 0.06, 12.0),
+               rec(0.01, 0, 0.03, 80.0), rec(0.01, 1, None, None, "unstable")]
+    groups = sweeps.repeat_groups(records)
+    assert [(g["dp"], g["n"]) for g in groups] == [(0.02, 3), (0.01, 1)]
+    g = groups[0]
+    assert (g["error"], g["error_min"], g["error_max"]) == pytest.approx((0.06, 0.05, 0.07))
+    assert (g["wall_s"], g["wall_min"], g["wall_max"]) == pytest.approx((12.0, 10.0, 14.0))
+    path = tmp_path / "accuracy.csv"
+    sweeps.write_csv(records, path)
+    assert [r["repeat"] for r in sweeps.read_csv(path)] == [0, 1, 2, 0, 1]
+    png = tmp_path / "accuracy.png"
+    sweeps.plot_accuracy(records, png)
+    assert png.stat().st_size > 10_000
+
 def test_stability_unstable_run_has_a_reason_and_no_nan(tmp_path):
     """CFL 1.5 (three times the scene's limit, set through the suite's unchecked path) blows the
     dam break up: status unstable, the solver's cause and time, finite numbers only."""

@@ -31,6 +31,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         p.add_argument("--methods", default=None,
                        help=f"comma-separated subset of {','.join(sweeps.METHODS)}")
         p.add_argument("--retry-failed", action="store_true", help="rerun points that failed")
+        if name == "accuracy":
+            p.add_argument("--repeats", type=int, default=1,
+                           help="realisations of every point (a flume's ramp 0.1 %% longer per "
+                                "repeat); the chart draws their run-to-run scatter")
 
 
 def main(args: argparse.Namespace) -> int:
@@ -39,7 +43,7 @@ def main(args: argparse.Namespace) -> int:
     kw = {"scheduler": args.scheduler, "n_workers": args.workers, "retry_failed": args.retry_failed}
     try:
         if args.what == "accuracy":
-            points = sweeps.accuracy_points(args.quick, methods)
+            points = sweeps.accuracy_points(args.quick, methods, args.repeats)
         else:
             points = stability.stability_points(args.quick, methods)
     except ValueError as exc:

@@ -76,8 +76,13 @@ METHODS: dict[str, dict[str, Any]] = {
 # the coupled case's two ways to compute the same flume
 COUPLED_METHODS = ("coupled", "sph_only")
 
-ACCURACY_COLUMNS = ["case", "method", "dp", "H_over_dp", "error", "wall_s", "particles", "steps",
-               "status", "reason"]
+ACCURACY_COLUMNS = ["case", "method", "dp", "repeat", "H_over_dp", "error", "wall_s", "particles",
+                    "steps", "status", "reason"]
+# a repeat of a flume point starts its ramp 0.1 % longer per repeat: the step is deterministic,
+# and a round-off-sized change is what makes another realisation (case III at H/dp 6 scored
+# 2.7-8.6 % RMSE/H over three, docs/studies/absorption.md "Case III at H/dp 6"); the dam break and
+# the coupled flume repeat as they are (their scatter is the wall time's)
+REPEAT_RAMP_STEP = 1e-3
 FLUME_CASES = ("I", "II", "III", "IV", "V")
 
 
@@ -89,17 +94,24 @@ class Point:
     method: str
     dp: float
     options: dict[str, Any] = field(default_factory=dict, hash=False, compare=False)
+    repeat: int = 0   # the realisation (REPEAT_RAMP_STEP); 0: the point itself
 
     @property
     def key(self) -> str:
-        return f"{self.case}__{self.method}__dp{self.dp:.6g}"
+        base = f"{self.case}__{self.method}__dp{self.dp:.6g}"
+        return f"{base}__r{self.repeat}" if self.repeat else base
 
 
 # ---------------------------------------------------------------------------- presets
-def accuracy_points(quick: bool = False, methods: Iterable[str] | None = None) -> list[Point]:
+def accuracy_points(quick: bool = False, methods: Iterable[str] | None = None,
+                    repeats: int = 1) -> list[Point]:
     """The points of the accuracy sweep. quick: <= 10 min on 2 quiet cores (two methods, two or
     three coarse spacings, one measured period, flume cases I, IV, V); full: every method, three
-    spacings, every case (hours on 2 cores: case II at H/dp = 8 has 0.5 M particles)."""
+    spacings, every case (hours on 2 cores: case II at H/dp = 8 has 0.5 M particles).
+    ``repeats``: realisations of every point (REPEAT_RAMP_STEP), for the chart's run-to-run
+    scatter."""
+    if int(repeats) != repeats or repeats < 1:
+        raise ValueError(f"repeats must be an integer >= 1, got {repeats!r}")
     if methods is None:
         methods = ["wcsph_kdk", "wcsph_symplectic"] if quick else list(METHODS)
     methods = list(methods)
@@ -123,7 +135,14 @@ def accuracy_points(quick: bool = False, methods: Iterable[str] | None = None) -
     c_opts = {"wavelengths": 2.0 if quick else 6.0, "compare_periods": 2.0 if quick else 4.0}
     c_dps = (0.03,) if quick else (0.04, 0.02, 0.01)
     pts += [Point("coupled", m, dp, c_opts) for m in COUPLED_METHODS for dp in c_dps]
-    return pts
+    return [p if j == 0 else _repeat(p, j) for j in range(int(repeats)) for p in pts]
+
+
+def _repeat(point: Point, j: int) -> Point:
+    opts = dict(point.options)
+    if point.case.startswith("flume_"):
+        opts["ramp_periods"] = opts.get("ramp_periods", 1.0) * (1.0 + REPEAT_RAMP_STEP * j)
+    return Point(point.case, point.method, point.dp, opts, repeat=j)
 
 
 def _data_text(name: str) -> str:
@@ -146,7 +165,7 @@ def run_point(point: Point) -> dict[str, Any]:
     from sph_core.simulation import UnstableError
 
     rec: dict[str, Any] = {"key": point.key, "case": point.case, "method": point.method,
-                           "dp": point.dp, "options": point.options}
+                           "dp": point.dp, "repeat": point.repeat, "options": point.options}
     tic = time.perf_counter()
     try:
         rec["warmup_s"] = round(warm_up_method(point.method), 3)
@@ -366,7 +385,7 @@ def run_sweep(points: list[Point], out: Path, scheduler: str | None = None,
                     rec = fut.result()
                 except Exception as exc:   # the worker died (KilledWorker) or the task could not run
                     rec = {"key": p.key, "case": p.case, "method": p.method, "dp": p.dp,
-                           "options": p.options, "status": "failed",
+                           "repeat": p.repeat, "options": p.options, "status": "failed",
                            "reason": f"{type(exc).__name__}: {exc}"}
                 save_record(out, rec)
                 bar.set_postfix_str(f"{p.key}: {rec.get('status')}", refresh=False)
@@ -411,10 +430,14 @@ def read_csv(path: Path) -> list[dict[str, Any]]:
     versions began with a # line, skipped)."""
     with open(path) as fh:
         rows = list(csv.DictReader(ln for ln in fh if not ln.startswith("#")))
-    num = {"dp": float, "H_over_dp": float, "error": float, "wall_s": float, "particles": int,
-           "steps": int}
-    return [{k: (num[k](v) if k in num and v not in ("", None) else (None if v == "" else v))
-             for k, v in r.items()} for r in rows]
+    num = {"dp": float, "repeat": int, "H_over_dp": float, "error": float, "wall_s": float,
+           "particles": int, "steps": int}
+    out = [{k: (num[k](v) if k in num and v not in ("", None) else (None if v == "" else v))
+            for k, v in r.items()} for r in rows]
+    for r in out:   # files of earlier versions have no repeat column
+        if r.get("repeat") is None:
+            r["repeat"] = 0
+    return out
 
 
 def pareto_front(points: Iterable[tuple[float, float]]) -> list[tuple[float, float]]:
@@ -427,12 +450,33 @@ def pareto_front(points: Iterable[tuple[float, float]]) -> list[tuple[float, flo
     return front
 
 
+def repeat_groups(records: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """The finished records (status ok, error and wall time known) grouped by (case, method, dp)
+    over their repeats: n, the mean error and wall time, and their smallest and largest, by
+    case, method and falling dp."""
+    groups: dict[tuple[str, str, float], list[dict[str, Any]]] = {}
+    for r in records:
+        if r.get("status") == "ok" and r.get("error") and r.get("wall_s"):
+            groups.setdefault((r["case"], r["method"], float(r["dp"])), []).append(r)
+    out = []
+    for (case, method, dp), rs in sorted(groups.items(), key=lambda kv: (kv[0][0], kv[0][1], -kv[0][2])):
+        err = [float(r["error"]) for r in rs]
+        wall = [float(r["wall_s"]) for r in rs]
+        out.append({"case": case, "method": method, "dp": dp, "n": len(rs),
+                    "error": sum(err) / len(err), "error_min": min(err), "error_max": max(err),
+                    "wall_s": sum(wall) / len(wall), "wall_min": min(wall), "wall_max": max(wall)})
+    return out
+
+
 def plot_accuracy(records: list[dict[str, Any]], path: Path, title: str = "") -> None:
     """Error (log y) against wall seconds (log x), one panel per case, one line per method, each
-    point labelled with its dp (3 significant digits). Each method's Pareto front (pareto_front:
-    the points that buy accuracy with time) is drawn filled, its dominated points hollow (a
-    refinement that cost more and erred more); the case's front over all methods is the dashed
-    grey line. Unstable/failed points are not drawn (see the CSV)."""
+    point labelled with its dp (3 significant digits). Repeats of a point (``--repeats``) are
+    drawn at their mean with bars from the smallest to the largest error and wall time: the
+    run-to-run scatter a rise or fall along a line must exceed to mean anything. Each method's
+    Pareto front (pareto_front over the means: the points that buy accuracy with time) is drawn
+    filled, its dominated points hollow (a refinement that cost more and erred more); the
+    case's front over all methods is the dashed grey line. Unstable/failed points are not drawn
+    (see the CSV)."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -447,11 +491,10 @@ def plot_accuracy(records: list[dict[str, Any]], path: Path, title: str = "") ->
     # one colour per method on every panel, so a line reads the same across cases
     methods = sorted({r["method"] for r in records})
     colour = {m: f"C{k % 10}" for k, m in enumerate(methods)}
+    groups = repeat_groups(records)
     for ax, case in zip(axes.flat, cases):
         for method in sorted({r["method"] for r in records if r["case"] == case}):
-            pts = sorted((r for r in records if r["case"] == case and r["method"] == method
-                          and r.get("status") == "ok" and r.get("error") and r.get("wall_s")),
-                         key=lambda r: -r["dp"])
+            pts = [g for g in groups if g["case"] == case and g["method"] == method]
             bad = sum(1 for r in records if r["case"] == case and r["method"] == method
                       and r.get("status") != "ok")
             if not pts:  # named in the legend, so a missing line is not read as not run
@@ -466,11 +509,16 @@ def plot_accuracy(records: list[dict[str, Any]], path: Path, title: str = "") ->
             ax.plot(*zip(*on), "o", color=colour[method], label=label)
             if off:
                 ax.plot(*zip(*off), "o", mfc="none", color=colour[method])
-            for r in pts:
-                ax.annotate(f"{r['dp']:.3g}", (r["wall_s"], r["error"]), fontsize=7,
-                            xytext=(3, 3), textcoords="offset points")
-        best = pareto_front((r["wall_s"], r["error"]) for r in records if r["case"] == case
-                            and r.get("status") == "ok" and r.get("error") and r.get("wall_s"))
+            for g in pts:
+                if g["n"] > 1:   # the run-to-run scatter of the repeats
+                    ax.errorbar(g["wall_s"], g["error"], fmt="none", color=colour[method],
+                                alpha=0.6, lw=1, capsize=2,
+                                xerr=[[g["wall_s"] - g["wall_min"]], [g["wall_max"] - g["wall_s"]]],
+                                yerr=[[g["error"] - g["error_min"]], [g["error_max"] - g["error"]]])
+                ax.annotate(f"{g['dp']:.3g}" + (f" ×{g['n']}" if g["n"] > 1 else ""),
+                            (g["wall_s"], g["error"]), fontsize=7, xytext=(3, 3),
+                            textcoords="offset points")
+        best = pareto_front((g["wall_s"], g["error"]) for g in groups if g["case"] == case)
         if len(best) > 1:
             ax.step(*zip(*best), where="post", ls="--", color="0.5", lw=1, label="front, all methods")
         ax.set_xscale("log")
@@ -498,5 +546,6 @@ def records_summary(records: list[dict[str, Any]]) -> dict[str, int]:
 
 
 def point_from_dict(d: dict[str, Any]) -> Point:
-    return Point(d["case"], d["method"], float(d["dp"]), dict(d.get("options") or {}))
+    return Point(d["case"], d["method"], float(d["dp"]), dict(d.get("options") or {}),
+                 int(d.get("repeat") or 0))
 
