@@ -1,10 +1,10 @@
 """Wave cases of the seed 002 validation table through the open-boundary flume.
 
 The table is tests/data/wave_cases_seed002.csv (read, and each case's theory built, by
-wavesph/cases/seed002_waves.py from the package's copy). The default suite runs case V (stream-function
-wave in shallow water: the cheapest) at a coarse resolution; the accuracy goal of issue 3 (RMSE/H
-<= 5 % at H/dp >= 10, seed 002 reports <= 4.3 %), the reflection of the absorbing outlet and the
-long-run water level are slow tests (``pytest -m slow``).
+wavesph/cases/seed002_waves.py from the package's copy). The default suite runs case V
+(stream-function wave in shallow water: the cheapest) at a coarse resolution; the accuracy goal
+of issue 3 (RMSE/H <= 5 % at H/dp >= 10, seed 002 reports <= 4.3 %), the reflection of the
+absorbing outlet and the long-run water level are slow tests (``pytest -m slow``).
 """
 
 from __future__ import annotations

@@ -48,7 +48,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                    help="time [s] the crest passes the SPH inlet (--model solitary; default: "
                         "when the elevation there starts at 1e-3 H)")
     p.add_argument("--order", type=int, default=None,
-                   help="--model stokes: order 2-5 (default 5); --model standing: 1 or 2 (default 1)")
+                   help="--model stokes: order 2-5 (default 5); --model standing: 1 or 2 "
+                        "(default 1)")
     p.add_argument("--n-fourier", type=int, default=10, help="Fourier modes (--model stream)")
     p.add_argument("--gamma", type=float, default=3.3, help="JONSWAP peak enhancement (irregular)")
     p.add_argument("--components", type=int, default=200, help="wave components (irregular)")

@@ -459,7 +459,7 @@ def repeat_groups(records: list[dict[str, Any]]) -> list[dict[str, Any]]:
         if r.get("status") == "ok" and r.get("error") and r.get("wall_s"):
             groups.setdefault((r["case"], r["method"], float(r["dp"])), []).append(r)
     out = []
-    for (case, method, dp), rs in sorted(groups.items(), key=lambda kv: (kv[0][0], kv[0][1], -kv[0][2])):
+    for (case, method, dp), rs in sorted(groups.items(), key=lambda kv: (*kv[0][:2], -kv[0][2])):
         err = [float(r["error"]) for r in rs]
         wall = [float(r["wall_s"]) for r in rs]
         out.append({"case": case, "method": method, "dp": dp, "n": len(rs),
