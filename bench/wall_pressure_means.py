@@ -2,15 +2,17 @@
 match the experiment's mean over T = t sqrt(g/H) = 3-5 (after the first impact), sensor by sensor?
 
     NUMBA_NUM_THREADS=2 python bench/wall_pressure_means.py [--dp 0.004] [--constants JSON]
-        [--scheme JSON]
+        [--scheme JSON] [--gate-speed V]
 
 The case is wavesph/cases/wall_impact.py (the far-wall sensors 1-4 at 3, 15, 30 and 80 mm above
 the bed, a `pressure_line` on the wall face), run to T = 5.2. The experiment is one realisation of
 all four sensors, tests/data/lobovsky_2014_h300_sensors.csv (2 kHz block means of the 20 kHz
-record). A dry probe sample counts as 0 (``dry``: its share).
+record). A dry probe sample counts as 0 (``dry``: its share). ``--gate-speed``: the column released
+by a gate lifted at that speed [m/s] (``lobovsky_scene``'s gate) instead of all at once.
 
 One JSON object: bench, dp, constants, per sensor s1..s4 {sph, exp (mean p / rho g H), err
 (sph / exp - 1), dry}, bins (the same means per T-interval of 0.25 from 2.5, "sph/exp"),
+impact_T {sph, exp} (the first T at which sensor 1 exceeds IMPACT_LEVEL rho g H), gate_speed,
 particles, steps, excluded, stopped, wall_s.
 """
 
@@ -33,6 +35,7 @@ from wave_client import G  # noqa: E402
 from wavesph.cases.wall_impact import COLUMN_HEIGHT, lobovsky_scene  # noqa: E402
 
 SENSORS = REPO / "tests" / "data" / "lobovsky_2014_h300_sensors.csv"
+IMPACT_LEVEL = 0.05  # p / rho g H at sensor 1 that marks the surge's arrival
 
 
 def main() -> None:
@@ -41,10 +44,12 @@ def main() -> None:
     ap.add_argument("--constants", type=json.loads, default={}, help="scene constants, JSON")
     ap.add_argument("--scheme", type=json.loads, default=None,
                     help='the scene\'s [scheme] table, JSON (e.g. \'{"kind": "riemann"}\')')
+    ap.add_argument("--gate-speed", type=float, default=None,
+                    help="release the column by lifting a gate at this speed [m/s]")
     a = ap.parse_args()
     scale = math.sqrt(COLUMN_HEIGHT / G)
     scene = lobovsky_scene(dp=a.dp, t_end=5.2 * scale, probe_every=5e-4,
-                           scheme=a.scheme, **a.constants)
+                           scheme=a.scheme, gate_speed=a.gate_speed, **a.constants)
     sim = Simulation(scene)
     tic, stopped = time.perf_counter(), None
     try:
@@ -56,7 +61,7 @@ def main() -> None:
     exp = np.loadtxt(SENSORS, delimiter=",", skiprows=12)
     rgh = 1000.0 * G * COLUMN_HEIGHT
     out = {"bench": "wall_pressure_means", "dp": a.dp, "constants": a.constants,
-           "scheme": scene.scheme.kind}
+           "scheme": scene.scheme.kind, "gate_speed": a.gate_speed}
     bins = {}
     for k in range(4):
         p = np.array([np.nan if r[f"wall_p{k}"] is None else r[f"wall_p{k}"] for r in sim.history],
@@ -68,9 +73,19 @@ def main() -> None:
         bins[f"s{k + 1}"] = [f"{np.nan_to_num(p[(t >= b) & (t < b + 0.25)]).mean():.2f}/"
                              f"{exp[(exp[:, 0] >= b) & (exp[:, 0] < b + 0.25), k + 1].mean():.2f}"
                              for b in np.arange(2.5, 5.0, 0.25)]
+    p1 = np.nan_to_num(np.array([np.nan if r["wall_p0"] is None else r["wall_p0"]
+                                 for r in sim.history], dtype=float)) / rgh
+    out["impact_T"] = {"sph": _first_above(t, p1, IMPACT_LEVEL),
+                       "exp": _first_above(exp[:, 0], exp[:, 1], IMPACT_LEVEL)}
     out.update(bins=bins, particles=sim.n_particles, steps=sim.steps, excluded=len(sim.excluded),
                stopped=stopped, wall_s=round(wall, 1))
     print(json.dumps(out), flush=True)
+
+
+def _first_above(t: np.ndarray, p: np.ndarray, level: float) -> float | None:
+    """The first t at which p exceeds level (None if it never does), to 3 decimals."""
+    k = np.flatnonzero(p > level)
+    return round(float(t[k[0]]), 3) if k.size else None
 
 
 if __name__ == "__main__":

@@ -31,6 +31,7 @@ UNIT: tuple[str, ...] = (
 NOT_UNIT: frozenset[str] = frozenset({  # "path" or "path::test_name" (any parametrisation)
     # numba kernels: a real SPH engine, a Simulation, the Boussinesq model
     "test_server/test_server_flume.py",
+    "test_cases/test_wall_impact.py::test_gate_holds_the_column_above_its_edge",
     "test_server/test_server_basin_3d.py",
     "test_server/test_standalone_theory.py::test_standalone_theory_run_equals_the_coupled_run",
     "test_server/test_standalone_theory.py::test_cancelled_theory_run_keeps_its_data_and_resumes_to_the_end",

@@ -40,3 +40,29 @@ def test_violent_impact_keeps_every_particle_in_the_tank(h_over_dp):
     assert sim.n_fluid == n0 and not sim.excluded
     hd = 0.5 * dp   # the first dummy layer: a centre beyond it went through the wall
     assert np.all((st["x"] >= -hd) & (st["x"] <= length + hd) & (st["z"] >= -hd))
+
+
+def test_gate_holds_the_column_above_its_edge():
+    """The column released by a gate lifted at 1 m/s: after 0.2 s the plate's bottom edge is
+    0.2 m up, so no fluid beyond the gate stands above it (a leaking gate fails this; one that
+    does not move lets nothing out), and the front is behind the instant release's."""
+    from wavesph.cases.wall_impact import COLUMN_LENGTH, GATE_THICKNESS_DP
+
+    dp, t_end = 0.02, 0.2
+    fronts = {}
+    for speed in (1.0, None):
+        scene = lobovsky_scene(dp=dp, t_end=t_end, probe_every=0.0, gate_speed=speed)
+        sim = Simulation(scene)
+        sim.advance_to(t_end)
+        st = sim.fluid_state()
+        out = st["x"] > COLUMN_LENGTH + GATE_THICKNESS_DP * dp
+        fronts[speed] = float(st["x"].max())
+        if speed is not None:
+            assert scene.bodies[0].motion == "prescribed"
+            assert out.any() and st["z"][out].max() < speed * t_end + dp
+    assert fronts[1.0] < fronts[None] - 2 * dp
+
+
+def test_gate_speed_must_be_positive():
+    with pytest.raises(ValueError, match="gate_speed"):
+        lobovsky_scene(dp=0.02, gate_speed=0.0)

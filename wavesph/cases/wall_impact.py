@@ -34,6 +34,14 @@ WALL_HEIGHT = 1.2     # [m]
 COLUMN_LENGTH = 0.6   # [m]
 COLUMN_HEIGHT = 0.3   # [m] = H, the scale of the experiment's units
 SENSOR_Z = (0.003, 0.015, 0.030, 0.080)  # [m] above the bed, on the far wall
+# the gate (``gate_speed``): a plate GATE_THICKNESS_DP spacings thick at the column's face, from
+# the bed to GATE_TOP, lifted GATE_LIFT at constant speed from t = 0 (the experiment's gate is
+# pulled up; its speed is not reported, and its impact time says it was fast:
+# docs/studies/wall_pressure.md, "Friction: what it moves and what it does not"). Thicker than
+# the kernel support 2h at any h/dp <= 2, so the water beyond it does not feel the column through it
+GATE_THICKNESS_DP = 5
+GATE_TOP = 0.4        # [m]
+GATE_LIFT = 0.45      # [m]: the plate's bottom clears the column's top by 0.15 m
 LOBOVSKY_SENSOR1 = (Path(__file__).resolve().parents[2] / "tests" / "data"
                     / "lobovsky_2014_h300_sensor1.csv")
 
@@ -41,16 +49,25 @@ LOBOVSKY_SENSOR1 = (Path(__file__).resolve().parents[2] / "tests" / "data"
 def lobovsky_scene(dp: float = 0.004, t_end: float = 2.0, probe_every: float = 2.5e-4,
                    snapshot_every: float = 0.0, tank_length: float = LOBOVSKY_TANK_LENGTH,
                    wall_height: float = WALL_HEIGHT, scheme: dict | None = None,
-                   **constants) -> Scene:
+                   gate_speed: float | None = None, **constants) -> Scene:
     """The H = 300 mm dam break with the far-wall sensors as a ``pressure_line`` named ``wall``
     (points on the wall face x = tank_length) and the wall's horizontal force (``force`` probe
     ``wall_force``, the dummy particles of the right wall below 0.1 m).
 
     The walls rise to ``wall_height`` (WALL_HEIGHT; the experiment's tank is TANK_HEIGHT high).
     ``constants`` override the scene constants; alpha defaults to DAMBREAK_ALPHA. ``scheme``:
-    the scene's [scheme] table (default wcsph)."""
+    the scene's [scheme] table (default wcsph). ``gate_speed`` [m/s]: release the column by
+    lifting a gate at that speed (a prescribed body named ``gate``) instead of all at once."""
     constants.setdefault("alpha", DAMBREAK_ALPHA)
     L = tank_length
+    bodies = []
+    if gate_speed is not None:
+        if not gate_speed > 0:
+            raise ValueError(f"gate_speed: must be > 0 m/s, got {gate_speed}")
+        bodies = [{"name": "gate", "shape": "box", "x0": COLUMN_LENGTH,
+                   "x1": COLUMN_LENGTH + GATE_THICKNESS_DP * dp, "z0": 0.0, "z1": GATE_TOP,
+                   "motion": "prescribed",
+                   "series": [(0.0, 0.0, 0.0, 0.0), (GATE_LIFT / gate_speed, 0.0, GATE_LIFT, 0.0)]}]
     return make_scene({
         "name": "lobovsky_2014_h300",
         "dp": dp, "t_end": t_end,
@@ -58,6 +75,7 @@ def lobovsky_scene(dp: float = 0.004, t_end: float = 2.0, probe_every: float = 2
         "water_blocks": [{"x0": 0.0, "x1": COLUMN_LENGTH, "z0": 0.0, "z1": COLUMN_HEIGHT}],
         "constants": constants,
         **({"scheme": scheme} if scheme else {}),
+        **({"bodies": bodies} if bodies else {}),
         "output": {"probe_every": probe_every, "snapshot_every": snapshot_every},
         "probes": [
             {"kind": "pressure_line", "name": "wall", "points": [[L, z] for z in SENSOR_Z]},
