@@ -63,9 +63,11 @@ def main() -> None:
     out = {"bench": "wall_pressure_means", "dp": a.dp, "constants": a.constants,
            "scheme": scene.scheme.kind, "gate_speed": a.gate_speed}
     bins = {}
+    sensors = []
     for k in range(4):
         p = np.array([np.nan if r[f"wall_p{k}"] is None else r[f"wall_p{k}"] for r in sim.history],
                      dtype=float) / rgh
+        sensors.append(p)
         m, me = (t >= 3) & (t <= 5), (exp[:, 0] >= 3) & (exp[:, 0] <= 5)
         s, e = float(np.nan_to_num(p[m]).mean()), float(exp[me, k + 1].mean())
         out[f"s{k + 1}"] = {"sph": round(s, 3), "exp": round(e, 3), "err": round(s / e - 1, 3),
@@ -73,9 +75,7 @@ def main() -> None:
         bins[f"s{k + 1}"] = [f"{np.nan_to_num(p[(t >= b) & (t < b + 0.25)]).mean():.2f}/"
                              f"{exp[(exp[:, 0] >= b) & (exp[:, 0] < b + 0.25), k + 1].mean():.2f}"
                              for b in np.arange(2.5, 5.0, 0.25)]
-    p1 = np.nan_to_num(np.array([np.nan if r["wall_p0"] is None else r["wall_p0"]
-                                 for r in sim.history], dtype=float)) / rgh
-    out["impact_T"] = {"sph": _first_above(t, p1, IMPACT_LEVEL),
+    out["impact_T"] = {"sph": _first_above(t, np.nan_to_num(sensors[0]), IMPACT_LEVEL),
                        "exp": _first_above(exp[:, 0], exp[:, 1], IMPACT_LEVEL)}
     out.update(bins=bins, particles=sim.n_particles, steps=sim.steps, excluded=len(sim.excluded),
                stopped=stopped, wall_s=round(wall, 1))

@@ -96,7 +96,6 @@ def test_presets_cover_every_method_and_case():
         sweeps.accuracy_points(methods=["no_such_scheme"])
 
 
-
 def test_repeats_are_other_realisations_and_the_chart_shows_their_scatter(tmp_path):
     one = sweeps.accuracy_points(quick=True)
     two = sweeps.accuracy_points(quick=True, repeats=2)
@@ -131,6 +130,7 @@ def test_repeats_are_other_realisations_and_the_chart_shows_their_scatter(tmp_pa
     png = tmp_path / "accuracy.png"
     sweeps.plot_accuracy(records, png)
     assert png.stat().st_size > 10_000
+
 
 def test_stability_unstable_run_has_a_reason_and_no_nan(tmp_path):
     """CFL 1.5 (three times the scene's limit, set through the suite's unchecked path) blows the

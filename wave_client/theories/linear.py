@@ -123,8 +123,8 @@ class StandingWave(_LinearMode):
         kd = self.k * self.depth
         th = np.tanh(kd)
         a = 0.5 * self.height
-        # cosh(2kd) / sinh^4(kd) = 8 e^{-2kd} (1 + e^{-4kd}) / (1 - e^{-2kd})^4 (finite in deep
-        # water)
+        # cosh(2kd) / sinh^4(kd) = 8 e^{-2kd} (1 + e^{-4kd}) / (1 - e^{-2kd})^4, finite in deep
+        # water
         e2 = np.exp(-2.0 * kd)
         ch2_sh4 = 8.0 * e2 * (1.0 + e2 * e2) / (1.0 - e2) ** 4
         self._setup = self.k * a * a * (th + 1.0 / th) / 8.0
