@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import math
 import warnings
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
@@ -37,6 +38,13 @@ class Layout:
 
 def wall_layers(scene: Scene) -> int:
     return int(math.ceil(2.0 * scene.h / scene.dp - 1e-9))
+
+
+def buffer_layers(scene: Scene, width: float | None) -> int:
+    """Columns of an open end's buffer ``width`` [m] wide (rounded up), at least the walls'
+    ``wall_layers``; None: the walls'."""
+    nl = wall_layers(scene)
+    return nl if width is None else max(nl, int(math.ceil(width / scene.dp - 1e-9)))
 
 
 def wall_dx(scene: Scene) -> float:
@@ -84,8 +92,10 @@ def _rect_shell(scene: Scene, r: Rect, thickness: float) -> tuple[np.ndarray, np
     return x[keep], z[keep]
 
 
-def build_layout(scene: Scene) -> Layout:
-    """Place fluid and wall particles for a 2D ``scene`` (3D: geometry3d.build_layout_3d)."""
+def build_layout(scene: Scene, buffers: Mapping[str, int] | None = None) -> Layout:
+    """Place fluid and wall particles for a 2D ``scene`` (3D: geometry3d.build_layout_3d).
+    ``buffers``: side -> columns of an open end's buffer (``buffer_layers``) where it is wider
+    than the walls; those columns are wall columns here, which open_ends turns into the buffer."""
     if scene.dim != 2:
         raise ValueError("build_layout: a 2D scene's; geometry3d.build_layout_3d places a 3D one")
     dp, t = scene.dp, scene.tank
@@ -103,6 +113,11 @@ def build_layout(scene: Scene) -> Layout:
             wz.append(zs)
         wx.append(xs_bottom)
         wz.append(np.full(xs_bottom.size, t.z0 - (k + 0.5) * dp))
+    for side, nb in (buffers or {}).items():   # a wider open end: more columns outside its face
+        for k in range(nl, nb):
+            wx.append(np.full(zs.size, t.x0 - (k + 0.5) * dp if side == "left"
+                              else t.x1 + (k + 0.5) * dp))
+            wz.append(zs)
     # sloping beds: lattice points below the line, within the wall thickness of it
     for bed in scene.beds:
         pts = np.asarray(bed.points)

@@ -16,6 +16,7 @@ puts them), or vertical cylinders of concentric rings (``_cylinder_shell``).
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 
 import numpy as np
 
@@ -83,8 +84,10 @@ def _unique(x: np.ndarray, y: np.ndarray, z: np.ndarray, dp: float) -> np.ndarra
     return first
 
 
-def build_layout_3d(scene: Scene) -> Layout:
-    """Place fluid and wall particles for a 3D ``scene``."""
+def build_layout_3d(scene: Scene, buffers: Mapping[str, int] | None = None) -> Layout:
+    """Place fluid and wall particles for a 3D ``scene``; ``buffers`` as geometry.build_layout's
+    (the extra columns span the y walls too: those beyond the tank's width stay walls, the
+    buffer's sides)."""
     dp, t = scene.dp, scene.tank
     nl = wall_layers(scene)
     th = nl * dp
@@ -99,6 +102,9 @@ def build_layout_3d(scene: Scene) -> Layout:
     parts = [_grid(np.concatenate([xlo, xhi]), yall, zcol),     # x walls with the edges
              _grid(xin, np.concatenate([ylo, yhi]), zcol),       # y walls
              _grid(xin, yin, zfl)]                               # floor
+    for side, nb in (buffers or {}).items():                     # wider open ends
+        k = np.arange(nl, nb) + 0.5
+        parts.append(_grid(t.x0 - k * dp if side == "left" else t.x1 + k * dp, yall, zcol))
     for bed in scene.beds:                                       # extruded across the width
         pts = np.asarray(bed.points)
         bx = _even(t.x0, t.x1, dp)

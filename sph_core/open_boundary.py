@@ -8,11 +8,15 @@ The Python side (settings, sources, windows, validation) is open_ends.OpenBounda
 
 A flume has at most two open ends, index b = 0 (left, particle kinds INLET / INLET_IDLE) and
 b = 1 (right, OUTLET / OUTLET_IDLE). Each end is a buffer of width L >= 2h outside the tank face
-x_f, outward normal n_x (-1 left, +1 right); d = (x - x_f) n_x is the depth into the buffer.
+x_f (the wave's surface orbit wide: open_ends.buffer_widths), outward normal n_x (-1 left, +1
+right); d = (x - x_f) n_x is the depth into the buffer.
 
 Every step, for buffer particle i of end b (the window [t0, t1] holds the source's samples,
 interpolated linearly in time and linearly in z between the nodes):
-    u_i = u(z_i, t) + du_b P_b(z_i),  w_i = w(z_i, t),  x_i += dt u_i  (z_i fixed: layers level)
+    u_i = u(z_i, t) + du_b P_b(z_i) - (x_i - x_f) dw/dz(z_i, t),  w_i = w(z_i, t),
+    x_i += dt u_i,  z_i += dt w_i
+    (each particle follows the orbit whose velocity it carries, u carried off the face by
+    continuity; kept between bed and tank top)
     du_b = n_x G[eta_meas,b - eta_gauge,b(t)]  if absorbing   (seed 002 correction; G a causal
            filter of the mismatch following Biesel's piston gain per frequency, its direct
            gain in the ends' sqgd, see sph_core.absorption); P_b the correction's vertical
@@ -123,6 +127,15 @@ def profile_value(zn, a, r, z):
 
 
 @njit(cache=True, inline="always")
+def profile_slope(zn, a, r, z):
+    """d/dz of profile_value at height z (0 outside the nodes, where the profile is clamped)."""
+    k = node_index(zn, z)
+    if k <= 0 or k >= zn.size:
+        return 0.0
+    return (_blend(a, k, r) - _blend(a, k - 1, r)) / (zn[k] - zn[k - 1])
+
+
+@njit(cache=True, inline="always")
 def node_value(zn, a, z):
     """Profile a[node] at height z: linear in z between nodes zn (clamped at the ends)."""
     nn = zn.size
@@ -185,23 +198,31 @@ def _end_of(k):
 
 @njit(cache=True, inline="always")
 def buffer_particle(i, ps, dt, r, zs0, du0, zs1, du1, ends, prm):
-    """Buffer slot i imposed and moved (``buffer_update``'s body): returns (b, u, w, x, kind,
-    rho, p) with b = -1 (nothing to write) when slot i is not a buffer particle."""
+    """Buffer slot i imposed and moved (``buffer_update``'s body): returns (b, u, w, x, z,
+    kind, rho, p) with b = -1 (nothing to write) when slot i is not a buffer particle. The
+    particle moves with the source's (u, w): moved in x only, it would sit off the orbit whose
+    velocity it carries by the orbit's vertical excursion (2-4 dp at H/dp 4-8), a divergence its
+    fluid neighbours' continuity sees and the flow has not."""
     b = _end_of(ps.kind[i])
     if b < 0:
-        return -1, 0.0, 0.0, 0.0, 0, 0.0, 0.0
+        return -1, 0.0, 0.0, 0.0, 0.0, 0, 0.0, 0.0
     zi = ps.z[i]
     zs = zs0 if b == 0 else zs1
     du = du0 if b == 0 else du1
     zn = ends.zn[b]
-    u = profile_value(zn, ends.win_u[b], r, zi) + du * node_value(zn, ends.corr_prof[b], zi)
+    # u carried off the face by continuity, du/dx = -dw/dz: an x-uniform u with the vertical
+    # strain of w would make the buffer's particle density breathe with the wave, a spurious
+    # second-order flux through the face
+    u = (profile_value(zn, ends.win_u[b], r, zi) + du * node_value(zn, ends.corr_prof[b], zi)
+         - (ps.x[i] - ends.x_face[b]) * profile_slope(zn, ends.win_w[b], r, zi))
     w = profile_value(zn, ends.win_w[b], r, zi)
     xi = ps.x[i] + dt * u
+    zi = min(max(zi + dt * w, ends.z_bed[b]), ends.z_top[b])
     if zi < zs:
         rho0 = prm.rho0
         rho = rho0 * (1.0 + rho0 * (-prm.gz) * (zs - zi) / prm.b) ** (1.0 / prm.gamma)
-        return b, u, w, xi, INLET + b, rho, pressure(rho, rho0, prm.b, prm.gamma)
-    return b, u, w, xi, INLET_IDLE + b, prm.rho0, 0.0
+        return b, u, w, xi, zi, INLET + b, rho, pressure(rho, rho0, prm.b, prm.gamma)
+    return b, u, w, xi, zi, INLET_IDLE + b, prm.rho0, 0.0
 
 
 @njit(parallel=True, cache=True)
@@ -209,6 +230,7 @@ def buffer_update(ps, n, dt, r, zs0, du0, zs1, du1, ends, prm):
     """Impose velocity, move, (de)activate and set hydrostatic density of every buffer particle."""
     # the rows written as locals (``ps.x[i] = ...`` inside a prange writes nothing, numba 0.68.1)
     x = ps.x
+    z = ps.z
     vx = ps.vx
     vy = ps.vy
     vz = ps.vz
@@ -220,12 +242,14 @@ def buffer_update(ps, n, dt, r, zs0, du0, zs1, du1, ends, prm):
     az = ps.az
     kind = ps.kind
     for i in prange(n):
-        b, u, w, xi, k, rho, pi = buffer_particle(i, ps, dt, r, zs0, du0, zs1, du1, ends, prm)
+        b, u, w, xi, zi, k, rho, pi = buffer_particle(i, ps, dt, r, zs0, du0, zs1, du1, ends,
+                                                      prm)
         if b < 0:
             continue
         vx[i] = u
         vz[i] = w
         x[i] = xi
+        z[i] = zi
         kind[i] = k
         rho_[i] = rho
         p[i] = pi
@@ -293,16 +317,24 @@ def buffer_transitions(ps, n, ends, r, zs0, du0, zs1, du1):
     # without calling transition_of, whose reads of ``ends`` cost ~0.6 us a particle in this
     # serial loop (the demo flume at dp 0.01: 8.4 ms a step with open ends, 4.1 without the
     # calls; closed 3.3; bench/open_end_cost.py)
+    # likewise a buffer particle inside its buffer (0 <= d < L: most of a buffer the wave's
+    # orbit wide)
     on0, on1 = ends.on[0], ends.on[1]
     xf0, xf1 = ends.x_face[0], ends.x_face[1]
     nx0, nx1 = ends.nx[0], ends.nx[1]
+    len0, len1 = ends.length[0], ends.length[1]
     for i in range(n0):
         k = kind[i]
         if k == FLUID:
             if not ((on0 and (x[i] - xf0) * nx0 >= 0.0) or (on1 and (x[i] - xf1) * nx1 >= 0.0)):
                 continue
-        elif _end_of(k) < 0:
-            continue
+        else:
+            b = _end_of(k)
+            if b < 0:
+                continue
+            d = (x[i] - xf0) * nx0 if b == 0 else (x[i] - xf1) * nx1
+            if d >= 0.0 and d < (len0 if b == 0 else len1):
+                continue
         act, b, knew = transition_of(i, ps, ends, r, zs0, du0, zs1, du1)
         if act == T_NONE:
             continue
@@ -416,8 +448,8 @@ def buffer_extrapolate(ps, n, cells, ends, prm):
 @njit(cache=True, inline="always")
 def extrapolated_state(i, ps, cells, ends, prm):
     """(written, p, rho) of slot i (``buffer_extrapolate``'s body): written False where slot i
-    keeps its pressure (not an active buffer particle, below a hydrostatic end's band, or a
-    ghost node without fluid)."""
+    keeps its pressure (not an active buffer particle, below a hydrostatic end's band, out of
+    every fluid particle's reach, or a ghost node without fluid)."""
     k = ps.kind[i]
     if k != INLET and k != OUTLET:
         return False, 0.0, 0.0
@@ -426,6 +458,11 @@ def extrapolated_state(i, ps, cells, ends, prm):
     if not ends.ghost[b] and zi < ends.zs[b] - SURFACE_BAND_H * prm.h:
         return False, 0.0, 0.0
     xi = ps.x[i]
+    # fluid stands at most dp past the face (transition_of), so a buffer particle 4h beyond
+    # that is neither a fluid particle's neighbour nor a neighbour of a wall particle whose
+    # extrapolated state a fluid particle reads: its pressure would serve nothing
+    if (xi - ends.x_face[b]) * ends.nx[b] >= 4.0 * prm.h + ends.dp:
+        return False, 0.0, 0.0
     xg = 2.0 * ends.x_face[b] - xi
     pg, px, pz, order = ghost_pressure(ps, cells, xg, ps.y[i], zi, prm)
     if order < 0:

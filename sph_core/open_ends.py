@@ -23,8 +23,8 @@ from typing import Mapping
 
 import numpy as np
 
-from .absorption import (absorption_filter, correction_profile, profile_wavenumber,
-                         source_period)
+from .absorption import (absorption_filter, correction_profile, linear_wavenumber,
+                         profile_wavenumber, source_period)
 from .boundary_data import (BoundaryData, BoundaryDataError, BoundaryNodes, BoundarySample,
                             still_sample, validate_sample)
 from .eos import GAMMA, hydrostatic_density
@@ -68,6 +68,46 @@ def check_open_end_layout(scene: Scene) -> None:
                 # buffers stand on the tank floor: a bed there would cut through them
                 raise ValueError(f"beds.{i}: comes within {reach:.3g} m of the {o.side} open "
                                  "end; open ends need the flat tank floor there")
+
+
+def orbit_diameter(height: float, period: float, depth: float, g: float = 9.81) -> float:
+    """Horizontal diameter [m] of a wave's surface orbit, H / tanh kd (linear theory): how far
+    the water at the face travels in and out over a period."""
+    kd = linear_wavenumber(2.0 * math.pi / period, depth, g) * depth
+    return height / math.tanh(kd)
+
+
+def source_orbit_diameter(source: BoundaryData | None, depth: float, g: float) -> float | None:
+    """``orbit_diameter`` of the wave a source carries (a spectrum's H taken as 2 Hs, about its
+    largest wave in 1,000); None when the source has no wave height and period (pushed data, a
+    solitary wave)."""
+    model = getattr(source, "model", None)
+    period = source_period(source)
+    height = getattr(model, "height", None)
+    if height is None and getattr(model, "hs", None) is not None:
+        height = 2.0 * float(model.hs)
+    if period is None or height is None or not depth > 0:
+        return None
+    return orbit_diameter(float(height), period, depth, g)
+
+
+def buffer_widths(scene: Scene, sources: Mapping[str, BoundaryData] | None = None
+                  ) -> dict[str, float]:
+    """Each open end's buffer width [m] (before rounding up to whole columns): the scene's
+    ``buffer_width``, else the source wave's surface orbit diameter plus the kernel support
+    (``source_orbit_diameter``), else the kernel support 2h. A buffer narrower than the orbit is
+    emptied and refilled from the fluid every period, and its particles then stand where fluid
+    crossed the face: at H/dp 8 (case V) the flume lost its reflection goal that way
+    (docs/studies/absorption.md, 'The buffer's width')."""
+    if not scene.open_boundaries:
+        return {}
+    depth = scene.still_water_level - scene.tank.z0
+    out = {}
+    for o in scene.open_boundaries:
+        orbit = source_orbit_diameter((sources or {}).get(o.side), depth, scene.constants.g)
+        out[o.side] = (o.buffer_width if o.buffer_width is not None
+                       else 2.0 * scene.h + (orbit or 0.0))
+    return out
 
 
 class OpenBoundaries:
@@ -152,14 +192,17 @@ class OpenBoundaries:
     def active(self) -> bool:
         return bool(self.ends.active)
 
-    def attach(self, ps: ParticleSet, scene: Scene, b_tait: float, buffer_length: float) -> None:
+    def attach(self, ps: ParticleSet, scene: Scene, b_tait: float,
+               buffer_length: Mapping[str, float]) -> None:
         """Turn the tank wall columns of the open sides into buffer particles of ``ps`` and size
-        the jitted state for its capacity."""
+        the jitted state for its capacity; ``buffer_length``: side -> the buffer's width [m]
+        (its columns times dp)."""
         self.ends = self.ends._replace(capacity=ps.capacity)
         if not self.active:
             return
         tank, dp, c = scene.tank, scene.dp, scene.constants
-        self.ends.length[:] = buffer_length
+        for side in self.sides:
+            self.ends.length[SIDES.index(side)] = buffer_length[side]
         n = ps.n
         x, y, z, kind = ps.f[X, :n], ps.f[Y, :n], ps.f[Z, :n], ps.kind[:n]
         # 3D: only the columns across the tank's width; those beyond it (the edges of the x

@@ -460,7 +460,8 @@ ISPH_INLET_PRESSURE = "extrapolated"
 
 class OpenBoundary(_Model):
     """An open end of the tank (issue 3, seed 002): the tank wall on ``side`` is replaced by a
-    buffer of particles, one kernel support wide, outside the tank face (x0 or x1).
+    buffer of particles outside the tank face (x0 or x1), at least one kernel support wide and
+    wide enough that the wave's orbits do not carry its particles through it (``buffer_width``).
 
     Buffer particles take the velocity of a boundary-data source (see ``sph_core.boundary_data``).
     ``elevation``: ``imposed`` takes the source's elevation (inlet of seed 002); ``extrapolated``
@@ -482,6 +483,11 @@ class OpenBoundary(_Model):
         "wave period [s] where the absorption filter is exact and whose mode profiles the "
         "correction (None: the source's)"))
     gauge_offset: float | None = Field(None, gt=0, description="boundary gauge distance inside the face [m]")
+    buffer_width: float | None = Field(None, gt=0, description=(
+        "buffer width outside the face [m], in whole particle columns, at least one kernel "
+        "support (2h); None: the source wave's surface orbit diameter plus 2h when the source "
+        "is a wave theory with a height and a period, else 2h (docs/physics/open_boundaries.md, "
+        "'Buffer width')"))
     pressure: Literal["hydrostatic", "extrapolated"] | None = Field(
         None, description="buffer pressure: hydrostatic below the buffer's surface, or "
                           "extrapolated from the fluid through mirrored ghost nodes; None: "

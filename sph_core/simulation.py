@@ -41,13 +41,13 @@ from . import wcsph
 from .bodies import BodyLog, BodySet
 from .boundary_data import BoundaryData, BoundaryDataError, BoundarySample
 from .eos import tait_b
-from .geometry import build_layout
+from .geometry import buffer_layers, build_layout
 from .geometry3d import build_layout_3d
 from .kernels import w_of_q, wendland_alpha
 from .neighbours import CellGrid, compute_cells, counting_sort
 from .load_probes import LoadProbes
 from .open_boundary import INLET_IDLE
-from .open_ends import OpenBoundaries
+from .open_ends import OpenBoundaries, buffer_widths
 from .output import RunWriter
 from .particles import (FLUID, INACTIVE, M, P, RHO, VX, VY, VZ, WALL, X, Y, Z, Checkpoint,
                         ParticleSet)
@@ -108,7 +108,10 @@ class Simulation:
                 raise DeviceError(f"device cuda: {reason}")
         self.scene = scene
         c = scene.constants
-        layout = build_layout(scene) if scene.dim == 2 else build_layout_3d(scene)
+        # an open end's buffer: its source wave's orbit wide, at least the walls' layers
+        buffers = {side: buffer_layers(scene, w) for side, w in buffer_widths(scene, sources).items()}
+        layout = (build_layout(scene, buffers) if scene.dim == 2
+                  else build_layout_3d(scene, buffers))
         dp, h = scene.dp, scene.h
         self.h = h
         self.c0 = scene.c0
@@ -140,11 +143,13 @@ class Simulation:
             ps.f[P, ps.n - rho_f.size: ps.n] = p_f
         self.bodies.attach(ps, c.rho0, dp)
         self.n_layers = layout.n_layers
-        self.open.attach(ps, scene, self.b, layout.n_layers * dp)
+        self.open.attach(ps, scene, self.b, {side: k * dp for side, k in buffers.items()})
         t = scene.tank
         wall = layout.n_layers * dp
         yr = {} if flat else dict(y0=t.y0 - wall, y1=t.y1 + wall)
-        self.grid = CellGrid.covering(t.x0 - wall, t.x1 + wall, t.z0 - wall, t.z1, 2.0 * h,
+        wx0 = buffers.get("left", layout.n_layers) * dp
+        wx1 = buffers.get("right", layout.n_layers) * dp
+        self.grid = CellGrid.covering(t.x0 - wx0, t.x1 + wx1, t.z0 - wall, t.z1, 2.0 * h,
                                       reach=cells_per_support, **yr)
         self.cells = self.grid.lists(ps.capacity)
         aw = wendland_alpha(h, scene.dim)

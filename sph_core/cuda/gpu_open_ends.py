@@ -101,12 +101,13 @@ def k_buffers(buf, n, ends, prm, clk, ctl, oe):
     if i < n:
         ps = _view(buf)
         f = oe[F]
-        b, u, w, xi, k, rho, p = buffer_particle(i, ps, clk[K.DTS], f[R], f[ZS0], f[DU0],
-                                                 f[ZS1], f[DU1], ends, prm)
+        b, u, w, xi, zi, k, rho, p = buffer_particle(i, ps, clk[K.DTS], f[R], f[ZS0], f[DU0],
+                                                     f[ZS1], f[DU1], ends, prm)
         if b >= 0:
             ps.vx[i] = u
             ps.vz[i] = w
             ps.x[i] = xi
+            ps.z[i] = zi
             ps.kind[i] = k
             ps.rho[i] = rho
             ps.p[i] = p

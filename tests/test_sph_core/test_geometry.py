@@ -127,3 +127,66 @@ def test_a_whole_number_of_dp_a_dam_break_column_and_a_beach_are_not_warned():
         beach = full_tank(1.99)                 # a beach up to the wall holds the corner
         beach["beds"] = [{"points": [[1.0, 0.0], [1.99, 0.3]]}]
         build_layout(make_scene(beach))
+
+
+def open_flume(**end) -> dict:
+    """A flume 0.6 m long in 0.3 m of water, open at both ends (``end``: the left end's extra
+    settings)."""
+    return {"name": "open", "dp": 0.02, "t_end": 1.0, "still_water_level": 0.3,
+            "tank": {"x0": 0.0, "x1": 0.6, "z0": 0.0, "z1": 0.42},
+            "water_blocks": [{"x0": 0.0, "x1": 0.6, "z0": 0.0, "z1": 0.3}],
+            "open_boundaries": [{"side": "left", **end}, {"side": "right",
+                                                          "elevation": "extrapolated"}]}
+
+
+def test_orbit_diameter_is_linear_theorys():
+    from sph_core.open_ends import orbit_diameter
+    # deep water: the orbit is the wave height; shallow: H / kd, longer than H
+    assert orbit_diameter(0.1, 1.0, 10.0) == pytest.approx(0.1, rel=1e-9)
+    # kd from the diameter satisfies the dispersion relation omega^2 = g k tanh kd
+    t = 0.06 / orbit_diameter(0.06, 2.0, 0.3)
+    assert (2 * np.pi / 2.0) ** 2 == pytest.approx(9.81 * np.arctanh(t) / 0.3 * t, rel=1e-6)
+    assert orbit_diameter(0.01, 20.0, 0.3) > 10 * 0.01
+
+
+def test_buffer_width_is_the_scenes_else_the_source_waves_orbit_else_the_kernel():
+    from sph_core.boundary_data import WaveModelBoundary
+    from sph_core.open_ends import buffer_widths, flume_nodes, orbit_diameter
+    from wave_client.theories import build_theory
+
+    scene = make_scene(open_flume())
+    nodes = flume_nodes(scene)
+    wave = build_theory("linear", height=0.06, period=2.0, depth=0.3)
+    sources = {"left": WaveModelBoundary(wave, nodes["left"], 0.3, 0.0)}
+    w = buffer_widths(scene, sources)
+    assert w["left"] == pytest.approx(orbit_diameter(0.06, 2.0, 0.3) + 2 * scene.h)
+    assert w["right"] == pytest.approx(2 * scene.h)       # no source: pushed data
+    assert buffer_widths(make_scene(open_flume(buffer_width=0.3)), sources)["left"] == 0.3
+    with pytest.raises(ValueError, match="buffer_width"):
+        make_scene(open_flume(buffer_width=0.0))
+
+
+def test_a_wider_open_end_gets_whole_columns_outside_its_face():
+    from sph_core.geometry import buffer_layers, wall_layers
+    from sph_core.geometry3d import build_layout_3d
+
+    scene = make_scene(open_flume())
+    nl = wall_layers(scene)
+    assert buffer_layers(scene, None) == nl
+    assert buffer_layers(scene, 0.01) == nl                 # never below the walls' layers
+    assert buffer_layers(scene, 0.25) == 13                 # 12.5 dp, rounded up
+    plain, wide = build_layout(scene), build_layout(scene, {"left": 13})
+    column = np.sum(np.isclose(plain.wall_x, -0.01))        # the first column outside x0
+    assert wide.wall_x.size - plain.wall_x.size == (13 - nl) * column
+    xs = np.unique(np.round(wide.wall_x[wide.wall_x < 0] / 0.02 - 0.5))
+    np.testing.assert_array_equal(xs, -np.arange(13, 0, -1))   # no gap between the columns
+    np.testing.assert_array_equal(wide.fluid_x, plain.fluid_x)
+    # 3D: the extra columns span the y walls too (the buffer's sides)
+    s3 = make_scene({**open_flume(), "dim": 3, "dp": 0.05, "still_water_level": 0.3,
+                     "tank": {"x0": 0.0, "x1": 0.6, "y0": 0.0, "y1": 0.2, "z0": 0.0, "z1": 0.4},
+                     "water_blocks": [{"x0": 0.0, "x1": 0.6, "y0": 0.0, "y1": 0.2, "z0": 0.0,
+                                       "z1": 0.3}]})
+    p3, w3 = build_layout_3d(s3), build_layout_3d(s3, {"right": wall_layers(s3) + 2})
+    face = np.sum(np.isclose(p3.wall_x, 0.6 + 0.025))
+    assert w3.wall_x.size - p3.wall_x.size == 2 * face
+    assert w3.wall_x.max() == pytest.approx(0.6 + (wall_layers(s3) + 1.5) * 0.05)

@@ -16,7 +16,7 @@ import math
 from pathlib import Path
 from typing import Any
 
-from .coupled_flume import depth_for_case
+from .coupled_flume import buffer_width_for, depth_for_case
 from .demo_flume import HEIGHT, PERIOD, _couple
 from ..local_server import InProcessServer
 
@@ -42,6 +42,7 @@ def basin_scene(dp: float, t_end: float) -> dict[str, Any]:
                                     {"kind": "force", "name": "column_load", "x0": c0 - dp,
                                      "x1": c1 + dp, "y0": yc - 0.5 * BASIN_COLUMN - dp,
                                      "y1": yc + 0.5 * BASIN_COLUMN + dp, "z0": 0.0, "z1": d + 0.2}]
+    bw = buffer_width_for(HEIGHT, PERIOD, d, dp)   # the buffers as wide as the wave's orbit
     return {
         "name": "wavesph-basin-3d", "dim": 3, "dp": dp, "t_end": t_end, "still_water_level": d,
         "tank": {"x0": 0.0, "x1": BASIN_LENGTH, "y0": 0.0, "y1": BASIN_WIDTH, "z0": 0.0, "z1": round(d + 0.2, 12)},
@@ -52,8 +53,10 @@ def basin_scene(dp: float, t_end: float) -> dict[str, Any]:
                       "h_over_dp": H_OVER_DP},
         "output": {"probe_every": PERIOD / 20, "snapshot_every": min(1.0, t_end)},
         "probes": probes,
-        "open_boundaries": [{"side": "left", "elevation": "imposed", "absorb": True},
-                            {"side": "right", "elevation": "extrapolated", "absorb": True}],
+        "open_boundaries": [{"side": "left", "elevation": "imposed", "absorb": True,
+                             "buffer_width": bw},
+                            {"side": "right", "elevation": "extrapolated", "absorb": True,
+                             "buffer_width": bw}],
     }
 
 

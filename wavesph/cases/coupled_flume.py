@@ -39,6 +39,7 @@ from typing import Any
 import numpy as np
 
 from server.schemas import TERMINAL
+from sph_core.open_ends import orbit_diameter
 from wave_client import G
 
 from ..local_server import InProcessServer, wait_for_state
@@ -147,6 +148,13 @@ def _tank_end(c: FlumeCase, x_toe: float, dp: float) -> float:
     return dp * round((x_toe + (c.depth + 0.1) / c.slope) / dp)
 
 
+def buffer_width_for(height: float, period: float, depth: float, dp: float) -> float:
+    """An open end's ``buffer_width`` [m] for a regular wave pushed by a client: the surface
+    orbit's diameter plus the largest kernel support (4 dp at h/dp 2), rounded to whole dp (the
+    rule the server applies itself when its source is a theory)."""
+    return dp * math.ceil(orbit_diameter(height, period, depth, G) / dp + 4.0 - 1e-9)
+
+
 def _sph_scene(c: FlumeCase, dp: float, t_end: float, x_toe: float, gauges: dict[str, float],
                name: str, absorb: bool, constants: dict[str, Any] | None = None
                ) -> dict[str, Any]:
@@ -174,7 +182,10 @@ def _sph_scene(c: FlumeCase, dp: float, t_end: float, x_toe: float, gauges: dict
         "constants": {"c0": 10.0 * math.sqrt(G * d), "wall_slip": "no_slip", **(constants or {})},
         "output": {"probe_every": c.period / 20},
         "probes": [{"kind": "elevation", "name": n, "x": x} for n, x in gauges.items()],
-        "open_boundaries": [{"side": "left", "elevation": "imposed", "absorb": absorb}],
+        # the server gets its boundary data pushed, so the scene sizes the buffer from the
+        # wave it is built for (sph_core.open_ends.buffer_widths)
+        "open_boundaries": [{"side": "left", "elevation": "imposed", "absorb": absorb,
+                             "buffer_width": buffer_width_for(c.height, c.period, d, dp)}],
     }
 
 

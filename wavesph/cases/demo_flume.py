@@ -25,7 +25,7 @@ from typing import Any
 
 import numpy as np
 
-from .coupled_flume import depth_for_case
+from .coupled_flume import buffer_width_for, depth_for_case
 from ..local_server import InProcessServer, wait_for_state
 from ..analysis import group_velocity, rmse_over_height
 
@@ -95,7 +95,8 @@ def demo_scene(dp: float, t_end: float, body: str | None = None) -> dict[str, An
         # VTK snapshots every second (sph/snapshots/, sph/run.pvd), at least the first and last
         "output": {"probe_every": PERIOD / 20, "snapshot_every": min(SNAPSHOT_EVERY, t_end)},
         "probes": [{"kind": "elevation", "name": n, "x": x} for n, x in GAUGES.items()],
-        "open_boundaries": [{"side": "left", "elevation": "imposed", "absorb": True}],
+        "open_boundaries": [{"side": "left", "elevation": "imposed", "absorb": True,
+                             "buffer_width": buffer_width_for(HEIGHT, PERIOD, d, dp)}],
         **({"bodies": [demo_body(body, dp)]} if body else {}),
     }
 

@@ -205,7 +205,7 @@ def zone_scene(req: PlanRequest, dp: float, method: str = "wcsph_kdk_h2_wallav0"
     structure region (a beach of ``beach_slope`` or flat bed ending in an outlet)."""
     from sph_core.scene import make_scene
 
-    from ..cases.coupled_flume import depth_for_case
+    from ..cases.coupled_flume import buffer_width_for, depth_for_case
 
     d = depth_for_case(req.depth, dp)
     flat, structures = zone_parts(req)
@@ -214,6 +214,7 @@ def zone_scene(req: PlanRequest, dp: float, method: str = "wcsph_kdk_h2_wallav0"
     scheme = opts.pop("scheme", None)          # a method's scheme is a scene table of its own
     cst = {"c0": req.c0 or 10.0 * math.sqrt(G * d), **opts}
     extra = {"scheme": scheme} if scheme else {}
+    bw = buffer_width_for(req.height, req.period, d, dp)
     if req.beach_slope:
         x_toe = dp * round(flat / dp)
         run = structures if structures > 0 else (d + 0.1) / req.beach_slope   # a scene's own
@@ -225,28 +226,31 @@ def zone_scene(req: PlanRequest, dp: float, method: str = "wcsph_kdk_h2_wallav0"
                               "z1": d}],
             "beds": [{"points": [[x_toe, 0.0], [x1, req.beach_slope * (x1 - x_toe)]]}],
             "constants": cst, **extra,
-            "open_boundaries": [{"side": "left", "elevation": "imposed", "absorb": True}]})
+            "open_boundaries": [{"side": "left", "elevation": "imposed", "absorb": True,
+                                 "buffer_width": bw}]})
     length = dp * round((flat + structures) / dp)
     return make_scene({
         "name": "plan-zone", "dp": dp, "t_end": req.duration, "still_water_level": d,
         "tank": {"x0": 0.0, "x1": length, "z0": 0.0, "z1": top},
         "water_blocks": [{"x0": 0.0, "x1": length, "z0": 0.0, "z1": d}], "constants": cst, **extra,
-        "open_boundaries": [{"side": "left", "elevation": "imposed", "absorb": True},
-                            {"side": "right", "elevation": "extrapolated", "absorb": True}]})
+        "open_boundaries": [{"side": "left", "elevation": "imposed", "absorb": True,
+                             "buffer_width": bw},
+                            {"side": "right", "elevation": "extrapolated", "absorb": True,
+                             "buffer_width": bw}]})
 
 
 def count_particles(scene: Any) -> int:
-    """Particles of a scene at its start: the lattice (fluid + walls) plus one buffer of
-    ceil(2h/dp) columns over the depth per open end (which replaces that end's wall)."""
-    from sph_core.geometry import build_layout, wall_layers
+    """Particles of a scene at its start: the lattice (fluid + walls) plus one buffer per open
+    end of its columns (``buffer_width``, at least ceil(2h/dp)) over the depth, which replaces
+    that end's wall."""
+    from sph_core.geometry import buffer_layers, build_layout, wall_layers
 
     lay = build_layout(scene)
     n = lay.fluid_x.size + lay.wall_x.size
-    if scene.open_boundaries:
-        nl = wall_layers(scene)
-        wall_col = nl * math.ceil((scene.tank.z1 - scene.tank.z0) / scene.dp)
-        depth_rows = math.ceil((scene.still_water_level - scene.tank.z0) / scene.dp)
-        n += len(scene.open_boundaries) * (nl * depth_rows - wall_col)
+    wall_col = wall_layers(scene) * math.ceil((scene.tank.z1 - scene.tank.z0) / scene.dp)
+    depth_rows = math.ceil((scene.still_water_level - scene.tank.z0) / scene.dp)
+    for o in scene.open_boundaries:
+        n += buffer_layers(scene, o.buffer_width) * depth_rows - wall_col
     return int(n)
 
 
