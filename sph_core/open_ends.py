@@ -77,37 +77,16 @@ def orbit_diameter(height: float, period: float, depth: float, g: float = 9.81) 
     return height / math.tanh(kd)
 
 
-def source_orbit_diameter(source: BoundaryData | None, depth: float, g: float) -> float | None:
-    """``orbit_diameter`` of the wave a source carries (a spectrum's H taken as 2 Hs, about its
-    largest wave in 1,000); None when the source has no wave height and period (pushed data, a
-    solitary wave)."""
-    model = getattr(source, "model", None)
-    period = source_period(source)
-    height = getattr(model, "height", None)
-    if height is None and getattr(model, "hs", None) is not None:
-        height = 2.0 * float(model.hs)
-    if period is None or height is None or not depth > 0:
-        return None
-    return orbit_diameter(float(height), period, depth, g)
-
-
-def buffer_widths(scene: Scene, sources: Mapping[str, BoundaryData] | None = None
-                  ) -> dict[str, float]:
+def buffer_widths(scene: Scene) -> dict[str, float]:
     """Each open end's buffer width [m] (before rounding up to whole columns): the scene's
-    ``buffer_width``, else the source wave's surface orbit diameter plus the kernel support
-    (``source_orbit_diameter``), else the kernel support 2h. A buffer narrower than the orbit is
-    emptied and refilled from the fluid every period, and its particles then stand where fluid
-    crossed the face: at H/dp 8 (case V) the flume lost its reflection goal that way
-    (docs/studies/absorption.md, 'The buffer's width')."""
-    if not scene.open_boundaries:
-        return {}
-    depth = scene.still_water_level - scene.tank.z0
-    out = {}
-    for o in scene.open_boundaries:
-        orbit = source_orbit_diameter((sources or {}).get(o.side), depth, scene.constants.g)
-        out[o.side] = (o.buffer_width if o.buffer_width is not None
-                       else 2.0 * scene.h + (orbit or 0.0))
-    return out
+    ``buffer_width``, else the kernel support 2h. A wave flume wants the wave's orbit diameter
+    plus 2h (``orbit_diameter``; wavesph.cases.coupled_flume.buffer_width_for): a buffer
+    narrower than the orbit is emptied and refilled from the fluid every period, and its
+    particles then stand where fluid crossed the face; at H/dp 8 (case V) the flume lost its
+    reflection goal that way (docs/studies/absorption.md, 'The buffer's width'). The width is
+    the scene's alone, so a standalone run and a coupled one of the same scene step alike."""
+    return {o.side: o.buffer_width if o.buffer_width is not None else 2.0 * scene.h
+            for o in scene.open_boundaries}
 
 
 class OpenBoundaries:

@@ -485,9 +485,9 @@ class OpenBoundary(_Model):
     gauge_offset: float | None = Field(None, gt=0, description="boundary gauge distance inside the face [m]")
     buffer_width: float | None = Field(None, gt=0, description=(
         "buffer width outside the face [m], in whole particle columns, at least one kernel "
-        "support (2h); None: the source wave's surface orbit diameter plus 2h when the source "
-        "is a wave theory with a height and a period, else 2h (docs/physics/open_boundaries.md, "
-        "'Buffer width')"))
+        "support (2h, also the default); a wave flume wants the wave's surface orbit diameter "
+        "H / tanh(kd) plus 2h, so the orbits do not carry the buffer's particles through it "
+        "(docs/physics/open_boundaries.md, 'Buffer width')"))
     pressure: Literal["hydrostatic", "extrapolated"] | None = Field(
         None, description="buffer pressure: hydrostatic below the buffer's surface, or "
                           "extrapolated from the fluid through mirrored ghost nodes; None: "

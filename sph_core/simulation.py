@@ -108,8 +108,8 @@ class Simulation:
                 raise DeviceError(f"device cuda: {reason}")
         self.scene = scene
         c = scene.constants
-        # an open end's buffer: its source wave's orbit wide, at least the walls' layers
-        buffers = {side: buffer_layers(scene, w) for side, w in buffer_widths(scene, sources).items()}
+        # an open end's buffer: the scene's width, at least the walls' layers
+        buffers = {side: buffer_layers(scene, w) for side, w in buffer_widths(scene).items()}
         layout = (build_layout(scene, buffers) if scene.dim == 2
                   else build_layout_3d(scene, buffers))
         dp, h = scene.dp, scene.h

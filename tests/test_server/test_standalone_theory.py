@@ -48,13 +48,17 @@ def test_standalone_theory_run_equals_the_coupled_run(tmp_path):
     assert a[0] == b[0] and len(a) == len(b) == 16
     va = np.array([[float(v) for v in r] for r in a[1:]])
     vb = np.array([[float(v) for v in r] for r in b[1:]])
-    assert np.all(np.isfinite(va)) and np.ptp(va[:, 2]) > 1e-3  # the inlet gauge saw the wave rise
     np.testing.assert_allclose(va, vb, rtol=1e-12, atol=1e-15)
     # the source's theory log holds the model's elevation at the gauges, as the client's does
     ta = rows(runs / alone["id"] / "theory.csv")
     tb = rows(tmp_path / "client.csv")
     model_a = [r for r in ta if not r[0].startswith("#")]
     model_b = [r for r in tb if not r[0].startswith("#")]
+    # the inlet gauge saw the wave rise: the records compared above are not still water (in the
+    # ramp's first 0.3 s it reads 0.87 mm of the model's 3.1 mm; 1.2 mm while the buffer's
+    # particles kept their heights)
+    eta_model = [float(r[model_a[0].index("left_boundary_eta_model")]) for r in model_a[1:]]
+    assert np.all(np.isfinite(va)) and np.ptp(va[:, 2]) > 0.2 * np.ptp(eta_model)
     col = model_a[0].index("g1_eta_model")   # named after the server's gauge, as the client's
     np.testing.assert_allclose([float(r[col]) for r in model_a[1:]],
                                [float(r[col]) for r in model_b[1:]], rtol=1e-12, atol=1e-15)

@@ -149,21 +149,20 @@ def test_orbit_diameter_is_linear_theorys():
     assert orbit_diameter(0.01, 20.0, 0.3) > 10 * 0.01
 
 
-def test_buffer_width_is_the_scenes_else_the_source_waves_orbit_else_the_kernel():
-    from sph_core.boundary_data import WaveModelBoundary
-    from sph_core.open_ends import buffer_widths, flume_nodes, orbit_diameter
-    from wave_client.theories import build_theory
+def test_buffer_width_is_the_scenes_else_the_kernel_support():
+    from sph_core.open_ends import buffer_widths
+    from wavesph.cases.wave_flume import buffer_width_for, wave_flume_scene
 
-    scene = make_scene(open_flume())
-    nodes = flume_nodes(scene)
-    wave = build_theory("linear", height=0.06, period=2.0, depth=0.3)
-    sources = {"left": WaveModelBoundary(wave, nodes["left"], 0.3, 0.0)}
-    w = buffer_widths(scene, sources)
-    assert w["left"] == pytest.approx(orbit_diameter(0.06, 2.0, 0.3) + 2 * scene.h)
-    assert w["right"] == pytest.approx(2 * scene.h)       # no source: pushed data
-    assert buffer_widths(make_scene(open_flume(buffer_width=0.3)), sources)["left"] == 0.3
+    scene = make_scene(open_flume(buffer_width=0.3))
+    assert buffer_widths(scene) == {"left": 0.3, "right": pytest.approx(2 * scene.h)}
     with pytest.raises(ValueError, match="buffer_width"):
         make_scene(open_flume(buffer_width=0.0))
+    # a wave flume's builders size it from the wave: the orbit plus 4 dp, in whole dp
+    w = buffer_width_for(0.06, 2.0, 0.3, 0.0075)
+    assert w == pytest.approx(0.0075 * 20)            # case V at H/dp 8: 0.115 m + 0.03 m
+    flume = wave_flume_scene(depth=0.3, wavelength=3.3, height=0.06, dp=0.015, t_end=1.0,
+                             period=2.0)
+    assert buffer_widths(flume) == {"left": pytest.approx(0.18), "right": pytest.approx(0.18)}
 
 
 def test_a_wider_open_end_gets_whole_columns_outside_its_face():

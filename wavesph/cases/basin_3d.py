@@ -16,7 +16,8 @@ import math
 from pathlib import Path
 from typing import Any
 
-from .coupled_flume import buffer_width_for, depth_for_case
+from .coupled_flume import depth_for_case
+from .wave_flume import buffer_width_for
 from .demo_flume import HEIGHT, PERIOD, _couple
 from ..local_server import InProcessServer
 

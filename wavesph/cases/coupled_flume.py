@@ -39,9 +39,9 @@ from typing import Any
 import numpy as np
 
 from server.schemas import TERMINAL
-from sph_core.open_ends import orbit_diameter
 from wave_client import G
 
+from .wave_flume import buffer_width_for
 from ..local_server import InProcessServer, wait_for_state
 
 H_MIN_FRACTION = 1.0 / 3.0   # the reference Boussinesq beach ends at depth d/3 (then a sponge)
@@ -146,13 +146,6 @@ def depth_for_case(depth: float, dp: float) -> float:
 def _tank_end(c: FlumeCase, x_toe: float, dp: float) -> float:
     """x [m] of the closed end: the beach rises 0.1 m above still water (room for run-up)."""
     return dp * round((x_toe + (c.depth + 0.1) / c.slope) / dp)
-
-
-def buffer_width_for(height: float, period: float, depth: float, dp: float) -> float:
-    """An open end's ``buffer_width`` [m] for a regular wave pushed by a client: the surface
-    orbit's diameter plus the largest kernel support (4 dp at h/dp 2), rounded to whole dp (the
-    rule the server applies itself when its source is a theory)."""
-    return dp * math.ceil(orbit_diameter(height, period, depth, G) / dp + 4.0 - 1e-9)
 
 
 def _sph_scene(c: FlumeCase, dp: float, t_end: float, x_toe: float, gauges: dict[str, float],

@@ -25,7 +25,8 @@ from typing import Any
 
 import numpy as np
 
-from .coupled_flume import buffer_width_for, depth_for_case
+from .coupled_flume import depth_for_case
+from .wave_flume import buffer_width_for
 from ..local_server import InProcessServer, wait_for_state
 from ..analysis import group_velocity, rmse_over_height
 

@@ -96,7 +96,8 @@ def amplitude_profile(model: Any, *, ramp: float, height: float, period: float, 
                              t_end=t0 + periods * period, length=flume_wavelengths * length,
                              absorb=(True, outlet_absorb),
                              right_elevation="extrapolated", probe_every=period / 40,
-                             name="wave_decay", left_pressure=inlet_pressure, **constants)
+                             name="wave_decay", left_pressure=inlet_pressure, period=period,
+                             **constants)
     probes = [ElevationProbe(kind="elevation", name=f"g{i}", x=float(x)) for i, x in enumerate(xs)]
     scene = scene.model_copy(update={"probes": probes})
     edges = np.arange(0.0, scene.tank.x1 + 1e-9, NOISE_BIN_M)

@@ -21,7 +21,7 @@ from typing import Any, Callable
 import numpy as np
 
 from sph_core.boundary_data import WaveModelBoundary
-from sph_core.open_ends import flume_nodes
+from sph_core.open_ends import flume_nodes, orbit_diameter
 from sph_core.simulation import Simulation
 from sph_core.scene import Scene, make_scene
 
@@ -37,19 +37,28 @@ REFLECTION_GAUGES = ["refl_-4", "refl_-3", "refl_a", "refl_-1", "mid", "refl_+1"
                      "refl_b", "refl_+3", "refl_+4"]
 
 
+def buffer_width_for(height: float, period: float, depth: float, dp: float,
+                     g: float = 9.81) -> float:
+    """An open end's ``buffer_width`` [m] for a regular wave (a spectrum: its largest, ~2 Hs at
+    Tp): the surface orbit's diameter plus the largest kernel support (4 dp at h/dp 2), in whole
+    dp (sph_core.open_ends.buffer_widths)."""
+    return dp * math.ceil(orbit_diameter(height, period, depth, g) / dp + 4.0 - 1e-9)
+
+
 def wave_flume_scene(*, depth: float, wavelength: float, height: float, dp: float, t_end: float,
                      length: float | None = None, absorb: tuple[bool, bool] = (True, True),
                      right_elevation: str = "extrapolated", probe_every: float = 0.02,
                      c0: float | None = None, g: float = 9.81, name: str = "wave_flume",
                      left_pressure: str | None = None, scheme: dict | None = None,
-                     **constants: Any) -> Scene:
+                     period: float | None = None, **constants: Any) -> Scene:
     """A flat-bed flume [0, length] x [0, top] (floor z = 0, still water at z = depth) with open
     ends and elevation gauges mid-flume and L/16 apart within L/4 of it.
 
     length defaults to one wavelength; the tank top leaves 2H + 4dp above still water. c0
     defaults to 10 sqrt(g d): the shallow-water celerity bounds the orbital speeds, and the
     hydrostatic density variation g d / c0^2 stays at 1 %. ``scheme``: the scene's [scheme]
-    table (default wcsph)."""
+    table (default wcsph). ``period`` [s]: the buffers as wide as the wave's orbit plus 2h
+    (``buffer_width_for``); None: the scene's default, 2h."""
     # whole number of particle spacings: the right buffer continues the fluid lattice
     length = dp * round((wavelength if length is None else length) / dp)
     top = depth + 2.0 * height + 4.0 * dp
@@ -57,6 +66,7 @@ def wave_flume_scene(*, depth: float, wavelength: float, height: float, dp: floa
     probes = [{"kind": "elevation", "name": nm, "x": mid + off * wavelength}
               for nm, off in GAUGE_OFFSETS.items() if 0.0 < mid + off * wavelength < length]
     cst = {"c0": c0 if c0 is not None else 10.0 * math.sqrt(g * depth), "g": g, **constants}
+    width = None if period is None else buffer_width_for(height, period, depth, dp, g)
     return make_scene({
         "name": name, "dp": dp, "t_end": t_end, "still_water_level": depth,
         "tank": {"x0": 0.0, "x1": length, "z0": 0.0, "z1": top},
@@ -65,8 +75,9 @@ def wave_flume_scene(*, depth: float, wavelength: float, height: float, dp: floa
         "probes": probes, "scheme": scheme or {},
         "open_boundaries": [
             {"side": "left", "elevation": "imposed", "absorb": absorb[0],
-             "pressure": left_pressure},
-            {"side": "right", "elevation": right_elevation, "absorb": absorb[1]}],
+             "pressure": left_pressure, "buffer_width": width},
+            {"side": "right", "elevation": right_elevation, "absorb": absorb[1],
+             "buffer_width": width}],
     })
 
 
@@ -176,7 +187,8 @@ def flume_case(model: Any, *, height: float, period: float, depth: float, wavele
     scene = wave_flume_scene(depth=depth, wavelength=wavelength, height=height, dp=dp,
                              t_end=t_end, length=length, absorb=absorb,
                              right_elevation="imposed" if standing else "extrapolated",
-                             probe_every=period / 40, name=name, **constants)
+                             probe_every=period / 40, name=name, period=period,
+                             **constants)
     x_left = -0.5 * scene.tank.x1 if standing else 0.0
     speed_max = {"left": 0.0, "right": 0.0, "mid": 0.0}
 

@@ -205,7 +205,8 @@ def zone_scene(req: PlanRequest, dp: float, method: str = "wcsph_kdk_h2_wallav0"
     structure region (a beach of ``beach_slope`` or flat bed ending in an outlet)."""
     from sph_core.scene import make_scene
 
-    from ..cases.coupled_flume import buffer_width_for, depth_for_case
+    from ..cases.coupled_flume import depth_for_case
+    from ..cases.wave_flume import buffer_width_for
 
     d = depth_for_case(req.depth, dp)
     flat, structures = zone_parts(req)
