@@ -80,7 +80,7 @@ def orbit_diameter(height: float, period: float, depth: float, g: float = 9.81) 
 def buffer_widths(scene: Scene) -> dict[str, float]:
     """Each open end's buffer width [m] (before rounding up to whole columns): the scene's
     ``buffer_width``, else the kernel support 2h. A wave flume wants the wave's orbit diameter
-    plus 2h (``orbit_diameter``; wavesph.cases.coupled_flume.buffer_width_for): a buffer
+    plus 2h (``orbit_diameter``; wavesph.cases.wave_flume.buffer_width_for): a buffer
     narrower than the orbit is emptied and refilled from the fluid every period, and its
     particles then stand where fluid crossed the face; at H/dp 8 (case V) the flume lost its
     reflection goal that way (docs/studies/absorption.md, 'The buffer's width'). The width is
