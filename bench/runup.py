@@ -16,7 +16,8 @@ are) and ``--toe-over-d`` can shorten the SPH zone to a few depths before the to
 approach costs no particles. The wedge of water over the beach is filled to the still shoreline. A
 `runup` probe (near_bed 2 dp) records the shoreline; R is its highest z - still water over the
 run, R0 the same before the wave's front (eta > H/100) reaches the beach's toe: what the
-layout itself gives at rest. The run ends 1.5 L/c after the linear shallow-water travel time
+layout itself gives at rest. The scene's delta-SPH coefficient is 0.2, not the default 0.1, under
+which the beach's shallows break up before the wave arrives (override with --constants). The run ends 1.5 L/c after the linear shallow-water travel time
 to the still shoreline (by then the run-up maximum has passed).
 
 The law holds for non-breaking waves (Synolakis: H/d < 0.818 (cot beta)^(-10/9), 0.030 here;
@@ -28,6 +29,14 @@ One JSON object per H/d: H_over_d, R_over_d, R_over_d_law, R_over_d_breaking_fit
 R0_over_d, stopped (null, or why the run stopped early: R is then over the records before it),
 far_field, toe_over_d (the inlet-to-toe distance / d), R_loose_over_d (the same probe counting any particle with one fluid neighbour at any
 height: what the wet-film criteria leave out), H_toe_over_H (the highest SPH elevation at the toe up to the run-up peak, over H), dp, d_over_dp, H_over_dp, particles, steps, t_end, wall_s.
+
+Beside the law, the same wave on the same beach in the nonlinear shallow-water equations
+(wavesph.cases.shallow_runup, seconds): R_over_d_nswe (the law's own model, so within ~2 % of
+it where the law holds), excess_ratio (for each section, named by its still depth / d from the
+toe "1" to the still shoreline "0": the largest volume of water shoreward of it above what lay
+there at rest, SPH over the NSWE; it says where along the beach the SPH swash falls behind),
+and nswe_film_at_R_over_dp (the NSWE's water depth, at its own run-up instant, where the bed
+stands at the SPH's R, in dp: how thin the swash is where the SPH's stops).
 """
 
 from __future__ import annotations
@@ -51,8 +60,14 @@ from sph_core.scene import make_scene  # noqa: E402
 from sph_core.simulation import Simulation, UnstableError  # noqa: E402
 from wave_client.boussinesq import solitary_approach  # noqa: E402
 from wave_client.theories import G, SolitaryWave  # noqa: E402
+from wavesph.cases.shallow_runup import solitary_runup  # noqa: E402
 
 COT_BETA = 19.85
+# density diffusion: water a few particles deep (the beach's shallows) breaks up at rest at the
+# default 0.1 (d/dp 40: within 0.5 s); 0.2 holds it still (docs/studies/runup.md)
+DELTA = 0.2
+# sections of the beach named by their still depth / d: the toe (1) to the still shoreline (0)
+SECTIONS = (1.0, 0.5, 0.25, 0.125, 0.0625, 0.0)
 
 
 def law(h_over_d: float) -> float:
@@ -90,7 +105,7 @@ def runup_scene(h_over_d: float, depth: float, dp: float, wall_slip: str = "no_s
         "water_blocks": [{"x0": 0.0, "x1": x_shore, "z0": 0.0, "z1": depth}],
         "beds": [{"points": [[x_toe, 0.0], [x1, (x1 - x_toe) / COT_BETA]]}],
         "open_boundaries": [{"side": "left", "elevation": "imposed"}],
-        "constants": {"wall_slip": wall_slip, **(constants or {})},
+        "constants": {"wall_slip": wall_slip, "delta": DELTA, **(constants or {})},
         "output": {"probe_every": 0.02},
         # "loose": any fluid particle with one neighbour, at any height (spray included)
         "probes": [{"kind": "runup", "name": "shore", "near_bed": 2 * dp},
@@ -113,11 +128,27 @@ def run_case(h_over_d: float, depth: float, dp_over_d: float, wall_slip: str = "
     model = (wave if far_field == "theory" else
              solitary_approach(wave.height, depth, wave.t0, scene.t_end))
     src = WaveModelBoundary(model, flume_nodes(scene)["left"], depth, 0.0)
+    # the water shoreward of each section (named by its still depth / d) above what was there
+    # at rest, after every record: the SPH's side of the shallow-water comparison
+    x_sec = {s: x_toe + (1.0 - s) * depth * COT_BETA for s in SECTIONS}
+
+    def shoreward_volumes(s: Simulation) -> dict[float, float]:
+        st = s.fluid_state()
+        vol = st["m"] / st["rho"]
+        return {k: float(vol[st["x"] > xs].sum()) for k, xs in x_sec.items()}
+
     tic = time.perf_counter()
     sim = Simulation(scene, sources={"left": src})
+    at_rest = shoreward_volumes(sim)
+    excess = dict.fromkeys(SECTIONS, 0.0)
+
+    def record_excess(s: Simulation) -> None:
+        for k, v in shoreward_volumes(s).items():
+            excess[k] = max(excess[k], v - at_rest[k])
+
     stopped = None
     try:
-        sim.advance_to(scene.t_end)
+        sim.advance_to(scene.t_end, progress=record_excess)
     except UnstableError as exc:  # the records up to the stop still say how far it ran up
         stopped = str(exc)
     wall = time.perf_counter() - tic
@@ -133,10 +164,14 @@ def run_case(h_over_d: float, depth: float, dp_over_d: float, wall_slip: str = "
     toe = np.array([np.nan if r_["toe_eta"] is None else r_["toe_eta"] for r_ in h])
     h_toe = float(np.nanmax(toe[t <= t[int(np.nanargmax(rise))]]))
     rl = law(h_over_d)
+    nswe = solitary_runup(h_over_d * depth, depth, COT_BETA, sections=SECTIONS)
     return {"bench": "runup", "H_over_d": h_over_d, "R_over_d": round(r / depth, 4),
             "R_over_d_law": round(rl, 4), "R_over_d_breaking_fit": round(breaking_fit(h_over_d), 4),
             "error": round((r / depth - rl) / rl, 3), "R0_over_d": round(r0 / depth, 4),
             "R_loose_over_d": round(r_loose / depth, 4),
+            "R_over_d_nswe": round(nswe.runup / depth, 4),
+            "excess_ratio": {f"{k:g}": round(excess[k] / nswe.excess[k], 3) for k in SECTIONS},
+            "nswe_film_at_R_over_dp": round(nswe.film_at(r) / dp, 3),
             "H_toe_over_H": round(h_toe / (h_over_d * depth), 3),
             "t_R": round(float(t[int(np.nanargmax(rise))]), 3),
             "depth": depth, "dp": round(dp, 6), "d_over_dp": round(depth / dp, 2),
