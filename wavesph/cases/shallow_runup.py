@@ -24,6 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from wave_client import G
+
 DRY = 1e-7          # [m] below this depth a cell carries no velocity
 WET = 1e-5          # [m] the shoreline: the last cell deeper than this
 
@@ -41,10 +42,6 @@ class SwashReference:
     x: np.ndarray                    # cell centres, the toe at x = 0 [m]
     bed: np.ndarray                  # bed elevation, still water at 0 [m]
     h_at_runup: np.ndarray           # water depth at the instant of R [m]
-
-    def section_x(self, section: float) -> float:
-        """x [m] of the section whose still depth is ``section`` d."""
-        return (1.0 - section) * self.depth * self.cot_beta
 
     def film_at(self, z: float) -> float:
         """Water depth [m] at the instant of R where the bed stands z [m] above still water."""
@@ -99,8 +96,8 @@ def solitary_runup(height: float, depth: float, cot_beta: float = 19.85, *,
                    sections: tuple[float, ...] = (1.0, 0.5, 0.25, 0.125, 0.0625, 0.0),
                    courant: float = 0.4) -> SwashReference:
     """Run the NSWE until the shoreline has fallen back a quarter of its run-up (or the wave's
-    passage time twice over). ``cells_per_depth``: d / dx (100 gives R within ~1 % of the
-    converged value at H/d 0.05; 50 within ~3 %)."""
+    passage time twice over). ``cells_per_depth``: d / dx (at H/d 0.05, 100 and 50 cells per d
+    give R/d 0.303 and 0.293)."""
     if not (height > 0 and depth > 0 and cot_beta > 0):
         raise ValueError("height, depth and cot_beta must be positive")
     if cells_per_depth < 10:

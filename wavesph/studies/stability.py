@@ -14,6 +14,11 @@ reason, never as NaN in the outputs.
 Scenarios (T_s: the run's simulated seconds; quick / full):
   still_water        a 1 m tank of still water d = 0.3 m for 40 / 200 sqrt(d/g): level drift,
                      surface noise (std of eta at mid-tank, second half), largest speed.
+  shallow_water      still water only 5 dp deep in a 1 m tank, under the c0 of the 0.3 m tank (as over
+                     a beach, whose c0 comes from its deepest water), dp 0.02 / 0.01, for 3 / 5 s:
+                     largest speed at the end. Under kdk at the default delta 0.1 it breaks up
+                     (0.32 sqrt(g d) at 3 s, dp 0.02); delta 0.2, or symplectic_pc at 0.1, holds it
+                     (docs/studies/runup.md).
   no_diffusion       the same with delta-SPH off (delta = 0) for 3 / 10 s: pressure noise, the
                      std over particles of (p - rho0 g (d - z)) / (rho0 g d) at the end.
   cfl_1.5            the dam break with cfl = 1.5, past the scene's limit 0.5: the scene validates
@@ -67,7 +72,7 @@ def unchecked(scene: Any, **constants: Any) -> Any:
 
 def stability_points(quick: bool = False, methods: list[str] | None = None) -> list[Point]:
     methods = methods or (["wcsph_kdk", "wcsph_symplectic"] if quick else list(METHODS))
-    scen = ["still_water", "no_diffusion", "cfl_1.5", "low_c0", "tensile", "violent_impact",
+    scen = ["still_water", "shallow_water", "no_diffusion", "cfl_1.5", "low_c0", "tensile", "violent_impact",
             "steep_wave"] + [f"window_{n}" for n in WINDOW_STEPS] + ["still_water_3d",
                                                                     "violent_impact_3d"]
     return [Point(f"stability_{s}", m, 0.0, {"quick": quick}) for s in scen for m in methods]
@@ -84,10 +89,10 @@ def _advance(sim: Any, t_end: float) -> tuple[str, float | None, str]:
     return "completed", None, ""
 
 
-def _still_tank(dp: float, t_end: float, scheme: dict | None = None, **constants: Any) -> Any:
+def _still_tank(dp: float, t_end: float, scheme: dict | None = None, d: float = 0.3,
+                **constants: Any) -> Any:
     from sph_core.scene import make_scene
 
-    d = 0.3
     return make_scene({
         "name": "still_water", "dp": dp, "t_end": t_end, "still_water_level": d,
         "tank": {"x0": 0.0, "x1": 1.0, "z0": 0.0, "z1": d + 0.1},
@@ -111,6 +116,20 @@ def _still_water(consts: dict, quick: bool) -> dict[str, Any]:
                 "surface_noise_over_dp": (float(np.std(half)) / dp if half.size else None, 0.1),
                 "max_speed_over_sqrt_gd": (float(v.max()) / math.sqrt(G * d), 0.02)}
     return _verdict(sim, status, t_fail, reason, t_end, measures)
+
+
+def _shallow_water(consts: dict, quick: bool) -> dict[str, Any]:
+    from sph_core.simulation import Simulation
+
+    dp = 0.02 if quick else 0.01
+    d, t_end = 5 * dp, 3.0 if quick else 5.0
+    # the c0 of the 0.3 m tank: a beach's shallows step under the c0 of its deepest water
+    c0 = consts.get("c0_factor", 10.0) * math.sqrt(2.0 * G * 0.3)
+    sim = Simulation(_still_tank(dp, t_end, d=d, **{"c0": c0, **consts}))
+    status, t_fail, reason = _advance(sim, t_end)
+    v = np.hypot(*[sim.fluid_state()[k] for k in ("vx", "vz")])
+    return _verdict(sim, status, t_fail, reason, t_end,
+                    {"max_speed_over_sqrt_gd": (float(v.max()) / math.sqrt(G * d), 0.02)})
 
 
 def _no_diffusion(consts: dict, quick: bool) -> dict[str, Any]:
@@ -306,7 +325,8 @@ def _violent_3d(consts: dict, quick: bool) -> dict[str, Any]:
 
 
 SCENARIOS: dict[str, Callable[[dict, bool], dict[str, Any]]] = {
-    "still_water": _still_water, "no_diffusion": _no_diffusion, "cfl_1.5": _cfl,
+    "still_water": _still_water, "shallow_water": _shallow_water, "no_diffusion": _no_diffusion,
+    "cfl_1.5": _cfl,
     "low_c0": _low_c0, "tensile": _tensile, "violent_impact": _violent, "steep_wave": _steep,
     **{f"window_{n}": _window(n) for n in WINDOW_STEPS},
     "still_water_3d": _still_water_3d, "violent_impact_3d": _violent_3d}
