@@ -60,7 +60,7 @@ from sph_core.scene import make_scene  # noqa: E402
 from sph_core.simulation import Simulation, UnstableError  # noqa: E402
 from wave_client.boussinesq import solitary_approach  # noqa: E402
 from wave_client.theories import G, SolitaryWave  # noqa: E402
-from wavesph.cases.shallow_runup import solitary_runup  # noqa: E402
+from wavesph.cases.shallow_runup import solitary_runup, synolakis_law  # noqa: E402
 
 COT_BETA = 19.85
 # density diffusion: water a few particles deep (the beach's shallows) breaks up at rest at the
@@ -71,8 +71,8 @@ SECTIONS = (1.0, 0.5, 0.25, 0.125, 0.0625, 0.0)
 
 
 def law(h_over_d: float) -> float:
-    """Synolakis (1987), non-breaking run-up R/d."""
-    return 2.831 * math.sqrt(COT_BETA) * h_over_d**1.25
+    """Synolakis (1987), non-breaking run-up R/d on this beach."""
+    return synolakis_law(h_over_d, COT_BETA)
 
 
 def breaking_fit(h_over_d: float) -> float:

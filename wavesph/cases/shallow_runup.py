@@ -24,6 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from wave_client import G
+from wave_client.theories import SolitaryWave
 
 DRY = 1e-7          # [m] below this depth a cell carries no velocity
 WET = 1e-5          # [m] the shoreline: the last cell deeper than this
@@ -47,6 +48,11 @@ class SwashReference:
         """Water depth [m] at the instant of R where the bed stands z [m] above still water."""
         i = int(np.argmin(np.abs(self.bed - z)))
         return float(self.h_at_runup[i])
+
+
+def synolakis_law(h_over_d: float, cot_beta: float) -> float:
+    """Synolakis (1987): the non-breaking run-up R/d of a solitary wave on a plane beach."""
+    return 2.831 * math.sqrt(cot_beta) * h_over_d**1.25
 
 
 def _minmod(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -105,10 +111,10 @@ def solitary_runup(height: float, depth: float, cot_beta: float = 19.85, *,
     if any(not 0.0 <= s <= 1.0 for s in sections):
         raise ValueError(f"sections: still depths as fractions of d in [0, 1], got {sections}")
     H, d = height, depth
-    k = math.sqrt(3.0 * H / (4.0 * d**3))
+    wave = SolitaryWave(H, depth=d)
+    k, c = wave.k, wave.c
     half = math.acosh(math.sqrt(20.0)) / k              # Synolakis' L
-    c = math.sqrt(G * (d + H))
-    law = 2.831 * math.sqrt(cot_beta) * (H / d) ** 1.25 * d
+    law = synolakis_law(H / d, cot_beta) * d
     dx = d / cells_per_depth
     x0 = -half - 5.0 / k                                 # sech^2(5) = 2e-4: the tail is in
     # dry beach up to three times the law's run-up, at most 2 d above still water (a breaking
@@ -133,8 +139,9 @@ def solitary_runup(height: float, depth: float, cot_beta: float = 19.85, *,
         h = np.maximum(0.5 * (h + h1 + dt * dh1), 0.0)
         q = np.where(h > DRY, 0.5 * (q + q1 + dt * dq1), 0.0)
         t += dt
+        above = h - still
         for s, m in masks.items():
-            excess[s] = max(excess[s], float((h - still)[m].sum() * dx))
+            excess[s] = max(excess[s], float(above[m].sum() * dx))
         wet = np.nonzero(h > WET)[0]
         if wet[-1] >= x.size - 5:
             raise RuntimeError(f"solitary_runup: the shoreline reached the grid's end, "

@@ -72,9 +72,9 @@ def unchecked(scene: Any, **constants: Any) -> Any:
 
 def stability_points(quick: bool = False, methods: list[str] | None = None) -> list[Point]:
     methods = methods or (["wcsph_kdk", "wcsph_symplectic"] if quick else list(METHODS))
-    scen = ["still_water", "shallow_water", "no_diffusion", "cfl_1.5", "low_c0", "tensile", "violent_impact",
-            "steep_wave"] + [f"window_{n}" for n in WINDOW_STEPS] + ["still_water_3d",
-                                                                    "violent_impact_3d"]
+    scen = (["still_water", "shallow_water", "no_diffusion", "cfl_1.5", "low_c0", "tensile",
+             "violent_impact", "steep_wave"] + [f"window_{n}" for n in WINDOW_STEPS]
+            + ["still_water_3d", "violent_impact_3d"])
     return [Point(f"stability_{s}", m, 0.0, {"quick": quick}) for s in scen for m in methods]
 
 
