@@ -22,13 +22,16 @@ rmse_over_H: elevation at the flat-bed gauge inside the SPH zone (0.8 m past the
 the reference, over t >= compare_from (ramp + front travel + 1 period) to t_end (4 periods).
 What bounds it (measured at dp 0.01, 4.76 % absorption-only): the free second harmonic the SPH
 inlet radiates (its buffer particles carry the orbit's w but hold their height; 3.16 % with them
-moved as the flow, not on main), the beach (SPH's breaking beach reflects 2.8 %, the reference's
-0.6 %), the SPH wave's own loss over those 0.8 m (bench/wave_decay.py, no coupling) and the
+moved as the flow, not on main), the beach (SPH's breaking beach reflects 7.7 %, as Battjes'
+0.1 xi^2 for this slope, the reference's 0.6 %: `beach_reflection`), the SPH wave's own loss over those 0.8 m (bench/wave_decay.py, no coupling) and the
 Boussinesq model's own bound second harmonic (3.6 mm against Stokes' 3.1 mm here);
 docs/studies/absorption.md, "The inlet's free second harmonic".
 Speed figures want a quiet machine and OpenMP's default (active) wait policy: on a shared,
 loaded machine set OMP_WAIT_POLICY=passive, which costs the small SPH zone ~27 % of its
 throughput (its parallel regions are short; a sleeping worker takes ~0.1 ms to wake).
+Beside rmse_over_H, each coupled run prints the first harmonic split at the flat and toe gauges:
+beach_reflection (SPH), beach_reflection_reference, battjes_reflection (0.1 xi^2) and
+incident_ratio (SPH's incident wave over the reference's).
 Prints one JSON object per line: one per run, then the summary with `speedup` = SPH-only wall
 time / coupled wall time (two-way if it finished, else absorption-only).
 """
@@ -37,6 +40,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import sys
 import tempfile
 from pathlib import Path
@@ -45,6 +49,9 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
+from wave_client import G  # noqa: E402
+from wave_client.theories.linear import wavenumber  # noqa: E402
+from wavesph.analysis import reflection_coefficient  # noqa: E402
 from wavesph.cases.coupled_flume import (FlumeCase, correlation, reference_run,  # noqa: E402
                                          rmse_over_h, run_coupled, run_sph_only)
 
@@ -59,10 +66,29 @@ def _accuracy(c: FlumeCase, res: dict, gauge: str = "flat") -> dict:
         return {"rmse_over_H": None, "correlation": None}
     sel = t >= c.compare_from - 1e-9
     # the mean level against the reference's and the wave's size (std ratio) over the same span
-    return {"rmse_over_H": round(rmse, 4),
-            "correlation": round(correlation(t, eta, ref, c.compare_from), 4),
-            "mean_level_m": round(float(np.mean(eta[sel]) - np.mean(ref[sel])), 5),
-            "amplitude_ratio": round(float(np.std(eta[sel]) / np.std(ref[sel])), 4)}
+    out = {"rmse_over_H": round(rmse, 4),
+           "correlation": round(correlation(t, eta, ref, c.compare_from), 4),
+           "mean_level_m": round(float(np.mean(eta[sel]) - np.mean(ref[sel])), 5),
+           "amplitude_ratio": round(float(np.std(eta[sel]) / np.std(ref[sel])), 4)}
+    window = {n: e[sel] for n, e in res["eta"].items()}
+    return {**out, **_beach_reflection(c, t[sel], window, reference_run(c, t[sel]))}
+
+
+def _beach_reflection(c: FlumeCase, t: np.ndarray, eta: dict, ref: dict) -> dict:
+    """The first harmonic split into the incident wave and the beach's reflection at the flat
+    and toe gauges (0.4 m apart, same depth), for SPH and the reference: the compared gauge
+    stands in their partial standing wave, so a beach that reflects more moves its phase and
+    size though the incident wave is the same. ``battjes_reflection``: Battjes (1974) 0.1 xi^2
+    for the 1:10 slope (xi = tan beta / sqrt(H / L0))."""
+    xs = np.array([c.gauges["flat"], c.gauges["toe"]])
+    k = float(wavenumber(c.omega, c.depth))   # Airy: the SPH wave's
+    kr, a_i, _ = reflection_coefficient(t, np.array([eta["flat"], eta["toe"]]), xs, c.period, k)
+    kr_ref, a_i_ref, _ = reflection_coefficient(t, np.array([ref["flat"], ref["toe"]]), xs,
+                                                c.period, k)
+    xi = c.slope / math.sqrt(c.height / (G * c.period ** 2 / (2.0 * math.pi)))
+    return {"beach_reflection": round(kr, 4), "beach_reflection_reference": round(kr_ref, 4),
+            "battjes_reflection": round(0.1 * xi * xi, 4),
+            "incident_ratio": round(a_i / a_i_ref, 4)}
 
 
 def main(argv: list[str] | None = None) -> int:

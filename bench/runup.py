@@ -16,8 +16,7 @@ are) and ``--toe-over-d`` can shorten the SPH zone to a few depths before the to
 approach costs no particles. The wedge of water over the beach is filled to the still shoreline. A
 `runup` probe (near_bed 2 dp) records the shoreline; R is its highest z - still water over the
 run, R0 the same before the wave's front (eta > H/100) reaches the beach's toe: what the
-layout itself gives at rest. The scene's delta-SPH coefficient is 0.2, not the default 0.1, under
-which the beach's shallows break up before the wave arrives (override with --constants). The run ends 1.5 L/c after the linear shallow-water travel time
+layout itself gives at rest. The scene's constants are the defaults (override with --constants). The run ends 1.5 L/c after the linear shallow-water travel time
 to the still shoreline (by then the run-up maximum has passed).
 
 The law holds for non-breaking waves (Synolakis: H/d < 0.818 (cot beta)^(-10/9), 0.030 here;
@@ -63,9 +62,6 @@ from wave_client.theories import G, SolitaryWave  # noqa: E402
 from wavesph.cases.shallow_runup import solitary_runup, synolakis_law  # noqa: E402
 
 COT_BETA = 19.85
-# density diffusion: water a few particles deep (the beach's shallows) breaks up at rest at the
-# default 0.1 (d/dp 40: within 0.5 s); 0.2 holds it still (docs/studies/runup.md)
-DELTA = 0.2
 # sections of the beach named by their still depth / d: the toe (1) to the still shoreline (0)
 SECTIONS = (1.0, 0.5, 0.25, 0.125, 0.0625, 0.0)
 
@@ -105,7 +101,7 @@ def runup_scene(h_over_d: float, depth: float, dp: float, wall_slip: str = "no_s
         "water_blocks": [{"x0": 0.0, "x1": x_shore, "z0": 0.0, "z1": depth}],
         "beds": [{"points": [[x_toe, 0.0], [x1, (x1 - x_toe) / COT_BETA]]}],
         "open_boundaries": [{"side": "left", "elevation": "imposed"}],
-        "constants": {"wall_slip": wall_slip, "delta": DELTA, **(constants or {})},
+        "constants": {"wall_slip": wall_slip, **(constants or {})},
         "output": {"probe_every": 0.02},
         # "loose": any fluid particle with one neighbour, at any height (spray included)
         "probes": [{"kind": "runup", "name": "shore", "near_bed": 2 * dp},

@@ -208,6 +208,16 @@ def _guard(u, v, w, r, axi, ayi, azi, lo, hi):
     return 0, 1 if (r < lo or r > hi) else 0, v2, a2
 
 
+@njit(cache=True, inline="always")
+def kdk_pressure(rho_half, drho, dt, prm):
+    """The pressure the leapfrog's force pass reads: the half-kicked density rho^{n+1/2} carried a
+    full step on, not half. That density lags the velocity by half a step (its last rate came from
+    v^{n-1/2}); read only half a step on, sound grows by (k c dt)^2/4 a step, an anti-diffusion
+    c0^2 dt/4 that delta 0.1 does not outweigh in water a few particles deep
+    (bench/leapfrog_acoustics.py, docs/physics/wcsph.md "Time step and integrators")."""
+    return pressure(rho_half + dt * drho, prm.rho0, prm.b, prm.gamma)
+
+
 @njit(parallel=True, cache=True)
 def kdk_kick_drift(ps, n, dt, prm):
     """First half-kick and drift of the leapfrog; returns the number of fluid particles outside the tank."""
@@ -221,7 +231,7 @@ def kdk_kick_drift(ps, n, dt, prm):
             f[VZ, i] += hdt * f[AZ, i]
             r = f[RHO, i] + hdt * f[DRHO, i]
             f[RHO, i] = r
-            f[P, i] = pressure(r + hdt * f[DRHO, i], prm.rho0, prm.b, prm.gamma)
+            f[P, i] = kdk_pressure(r, f[DRHO, i], dt, prm)
             xi = f[X, i] + dt * f[VX, i]
             zi = f[Z, i] + dt * f[VZ, i]
             f[X, i] = xi

@@ -13,9 +13,8 @@ from __future__ import annotations
 
 from numba import njit
 
-from ..eos import pressure
 from ..neighbours import cell_at
-from ..wcsph import _guard, _outside
+from ..wcsph import _guard, _outside, kdk_pressure
 
 
 @njit(cache=True, inline="always")
@@ -35,7 +34,7 @@ def kick_drift_particle(i, ps, dt, prm):
     ps.vz[i] += hdt * ps.az[i]
     r = ps.rho[i] + hdt * ps.drho[i]
     ps.rho[i] = r
-    ps.p[i] = pressure(r + hdt * ps.drho[i], prm.rho0, prm.b, prm.gamma)
+    ps.p[i] = kdk_pressure(r, ps.drho[i], dt, prm)
     xi = ps.x[i] + dt * ps.vx[i]
     zi = ps.z[i] + dt * ps.vz[i]
     ps.x[i] = xi

@@ -16,9 +16,9 @@ Scenarios (T_s: the run's simulated seconds; quick / full):
                      surface noise (std of eta at mid-tank, second half), largest speed.
   shallow_water      still water only 5 dp deep in a 1 m tank, under the c0 of the 0.3 m tank (as over
                      a beach, whose c0 comes from its deepest water), dp 0.02 / 0.01, for 3 / 5 s:
-                     largest speed at the end. Under kdk at the default delta 0.1 it breaks up
-                     (0.32 sqrt(g d) at 3 s, dp 0.02); delta 0.2, or symplectic_pc at 0.1, holds it
-                     (docs/studies/runup.md).
+                     largest speed at the end. It broke up (0.32 sqrt(g d) at 3 s, dp 0.02) when
+                     kdk read its pressure half a step too early (wcsph.kdk_pressure,
+                     docs/physics/wcsph.md).
   no_diffusion       the same with delta-SPH off (delta = 0) for 3 / 10 s: pressure noise, the
                      std over particles of (p - rho0 g (d - z)) / (rho0 g d) at the end.
   cfl_1.5            the dam break with cfl = 1.5, past the scene's limit 0.5: the scene validates
