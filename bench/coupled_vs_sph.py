@@ -23,7 +23,8 @@ the reference, over t >= compare_from (ramp + front travel + 1 period) to t_end 
 What bounds it (measured at dp 0.01, 4.76 % absorption-only): the free second harmonic the SPH
 inlet radiates (its buffer particles carry the orbit's w but hold their height; 3.16 % with them
 moved as the flow, not on main), the beach (SPH's breaking beach reflects 7.7 %, as Battjes'
-0.1 xi^2 for this slope, the reference's 0.6 %: `beach_reflection`), the SPH wave's own loss over those 0.8 m (bench/wave_decay.py, no coupling) and the
+0.1 xi^2 for this slope, the reference's 0.6 %: `beach_reflection`), the SPH wave's own loss
+over those 0.8 m (bench/wave_decay.py, no coupling) and the
 Boussinesq model's own bound second harmonic (3.6 mm against Stokes' 3.1 mm here);
 docs/studies/absorption.md, "The inlet's free second harmonic".
 Speed figures want a quiet machine and OpenMP's default (active) wait policy: on a shared,
@@ -60,7 +61,8 @@ def _accuracy(c: FlumeCase, res: dict, gauge: str = "flat") -> dict:
     if "t" not in res or res["state"] != "finished":
         return {"rmse_over_H": None, "correlation": None}
     t, eta = res["t"], res["eta"][gauge]
-    ref = reference_run(c, t)[gauge]
+    refs = reference_run(c, t)          # every SPH-zone gauge: one Boussinesq run
+    ref = refs[gauge]
     rmse = rmse_over_h(t, eta, ref, c)
     if rmse is None:
         return {"rmse_over_H": None, "correlation": None}
@@ -70,8 +72,8 @@ def _accuracy(c: FlumeCase, res: dict, gauge: str = "flat") -> dict:
            "correlation": round(correlation(t, eta, ref, c.compare_from), 4),
            "mean_level_m": round(float(np.mean(eta[sel]) - np.mean(ref[sel])), 5),
            "amplitude_ratio": round(float(np.std(eta[sel]) / np.std(ref[sel])), 4)}
-    window = {n: e[sel] for n, e in res["eta"].items()}
-    return {**out, **_beach_reflection(c, t[sel], window, reference_run(c, t[sel]))}
+    return {**out, **_beach_reflection(c, t[sel], {n: e[sel] for n, e in res["eta"].items()},
+                                       {n: r[sel] for n, r in refs.items()})}
 
 
 def _beach_reflection(c: FlumeCase, t: np.ndarray, eta: dict, ref: dict) -> dict:

@@ -16,8 +16,9 @@ are) and ``--toe-over-d`` can shorten the SPH zone to a few depths before the to
 approach costs no particles. The wedge of water over the beach is filled to the still shoreline. A
 `runup` probe (near_bed 2 dp) records the shoreline; R is its highest z - still water over the
 run, R0 the same before the wave's front (eta > H/100) reaches the beach's toe: what the
-layout itself gives at rest. The scene's constants are the defaults (override with --constants). The run ends 1.5 L/c after the linear shallow-water travel time
-to the still shoreline (by then the run-up maximum has passed).
+layout itself gives at rest. The scene's constants are the defaults (override with --constants).
+The run ends 1.5 L/c after the linear shallow-water travel time to the still shoreline (by then
+the run-up maximum has passed).
 
 The law holds for non-breaking waves (Synolakis: H/d < 0.818 (cot beta)^(-10/9), 0.030 here;
 breaking on run-down from about 0.044); H/d = 0.3 breaks on run-up, where Synolakis' data
