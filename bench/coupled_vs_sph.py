@@ -57,7 +57,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from wave_client import G  # noqa: E402
 from wave_client.theories.linear import wavenumber  # noqa: E402
-from wavesph.analysis import rmse_over_height, separate_harmonics  # noqa: E402
+from wavesph.analysis import (reflected_wave, rmse_over_height,  # noqa: E402
+                              separate_harmonics)
 from wavesph.cases.coupled_flume import (FlumeCase, correlation, reference_run,  # noqa: E402
                                          rmse_over_h, run_coupled, run_sph_only)
 
@@ -93,20 +94,18 @@ def _beach_reflection(c: FlumeCase, t: np.ndarray, eta: dict, ref: dict) -> dict
     does not make."""
     xs = np.array([c.gauges["flat"], c.gauges["toe"]])
     k = float(wavenumber(c.omega, c.depth))   # Airy: the SPH wave's
-    s = separate_harmonics(t, np.array([eta["flat"], eta["toe"]]), xs, c.period, [k])[0]
-    s_ref = separate_harmonics(t, np.array([ref["flat"], ref["toe"]]), xs, c.period, [k])[0]
-
-    def incident(e: np.ndarray, sep) -> np.ndarray:   # the record less its reflected wave
-        return e - sep.a_reflected * np.cos(c.omega * t + k * xs[0] + sep.phase_reflected)
-
+    pair, pair_ref = (np.array([e["flat"], e["toe"]]) for e in (eta, ref))
+    s = separate_harmonics(t, pair, xs, c.period, [k])[0]
+    s_ref = separate_harmonics(t, pair_ref, xs, c.period, [k])[0]
+    incident, incident_ref = (e["flat"] - reflected_wave(t, p, xs, c.period, k, xs[0])
+                              for e, p in ((eta, pair), (ref, pair_ref)))
     xi = c.slope / math.sqrt(c.height / (G * c.period ** 2 / (2.0 * math.pi)))
     return {"beach_reflection": round(s.kr, 4), "beach_reflection_reference": round(s_ref.kr, 4),
             "battjes_reflection": round(0.1 * xi * xi, 4),
             "incident_ratio": round(s.a_incident / s_ref.a_incident, 4),
             "incident_phase_rad": round(float(np.angle(np.exp(
                 1j * (s.phase_incident - s_ref.phase_incident)))), 4),
-            "rmse_over_H_incident": round(rmse_over_height(
-                incident(eta["flat"], s), incident(ref["flat"], s_ref), c.height), 4)}
+            "rmse_over_H_incident": round(rmse_over_height(incident, incident_ref, c.height), 4)}
 
 
 def _against_sph_only(c: FlumeCase, res: dict, sph: dict) -> float | None:

@@ -24,7 +24,8 @@ same way with the wavenumber the caller gives for it: n k for the bound harmonic
 nonlinear wave (they travel at the fundamental's phase speed), the linear-dispersion k(n omega)
 for free waves (e.g. spurious harmonics emitted by a boundary). Mansard & Funke (1980) fit the
 same least squares with a residual ("noise") term: uncorrelated noise adds only to the residual
-returned here.
+returned here. ``reflected_wave`` gives the fitted reflected first harmonic as a record at one
+position, to take it out of a measured one.
 """
 
 from __future__ import annotations
@@ -147,6 +148,17 @@ def reflection_coefficient(t: np.ndarray, etas: np.ndarray, xs: np.ndarray, peri
     amplitudes are those at the centre of the gauge array."""
     s = separate_harmonics(t, etas, xs, period, [k], decay=decay)[0]
     return s.kr, s.a_incident, s.a_reflected
+
+
+def reflected_wave(t: np.ndarray, etas: np.ndarray, xs: np.ndarray, period: float, k: float,
+                   x: float) -> np.ndarray:
+    """The reflected first harmonic at position ``x`` [m] over ``t``, from the two-gauge (or
+    more) fit of ``separate_harmonics`` (no decay): subtracted from a record at x it leaves the
+    incident wave and the harmonics, e.g. to score a flume against a reference whose end
+    reflects differently."""
+    s = separate_harmonics(t, etas, xs, period, [k])[0]
+    omega = 2.0 * math.pi / period
+    return s.a_reflected * np.cos(omega * np.asarray(t, dtype=float) + k * x + s.phase_reflected)
 
 
 # ---------------------------------------------------------------------------- post-processing

@@ -8,7 +8,8 @@ import math
 import numpy as np
 import pytest
 
-from wavesph.analysis import reflection_coefficient, rmse_over_height, separate_harmonics
+from wavesph.analysis import (reflected_wave, reflection_coefficient, rmse_over_height,
+                              separate_harmonics)
 from sph_core import open_boundary as ob
 from sph_core.particles import FLUID, P, X, Z
 from sph_core.scene import make_scene
@@ -168,3 +169,20 @@ def test_rmse_over_height_and_dry_records():
     assert rmse_over_height(th + 0.01, th, 0.5) == pytest.approx(0.02)
     with pytest.raises(ValueError, match="dry"):
         rmse_over_height(np.where(th > 0.9, np.nan, th), th, 0.5)
+
+
+def test_reflected_wave_leaves_the_incident_wave_and_its_harmonics():
+    """A partial standing wave with a bound second harmonic at two gauges: the record at the
+    first less reflected_wave there is the incident wave with its harmonic."""
+    period, k, a = 1.4, 3.2, 0.02
+    omega = 2 * np.pi / period
+    t = np.arange(0.0, 4 * period, period / 50) + 20.0
+    xs = np.array([24.0, 24.4])
+
+    def incident(x):
+        return a * np.cos(omega * t - k * x + 0.3) + 0.15 * a * np.cos(2 * (omega * t - k * x + 0.3))
+
+    etas = np.array([incident(x) + 0.08 * a * np.cos(omega * t + k * x + 1.0) for x in xs])
+    left = etas[0] - reflected_wave(t, etas, xs, period, k, xs[0])
+    np.testing.assert_allclose(left, incident(xs[0]), atol=1e-9 * a)
+    assert rmse_over_height(etas[0], incident(xs[0]), 2 * a) > 0.02   # what was taken out
