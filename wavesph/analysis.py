@@ -24,7 +24,7 @@ same way with the wavenumber the caller gives for it: n k for the bound harmonic
 nonlinear wave (they travel at the fundamental's phase speed), the linear-dispersion k(n omega)
 for free waves (e.g. spurious harmonics emitted by a boundary). Mansard & Funke (1980) fit the
 same least squares with a residual ("noise") term: uncorrelated noise adds only to the residual
-returned here. ``reflected_wave`` gives the fitted reflected first harmonic as a record at one
+returned here. ``reflected_wave`` turns a separation's reflected first harmonic into a record at one
 position, to take it out of a measured one.
 """
 
@@ -150,13 +150,11 @@ def reflection_coefficient(t: np.ndarray, etas: np.ndarray, xs: np.ndarray, peri
     return s.kr, s.a_incident, s.a_reflected
 
 
-def reflected_wave(t: np.ndarray, etas: np.ndarray, xs: np.ndarray, period: float, k: float,
-                   x: float) -> np.ndarray:
-    """The reflected first harmonic at position ``x`` [m] over ``t``, from the two-gauge (or
-    more) fit of ``separate_harmonics`` (no decay): subtracted from a record at x it leaves the
-    incident wave and the harmonics, e.g. to score a flume against a reference whose end
-    reflects differently."""
-    s = separate_harmonics(t, etas, xs, period, [k])[0]
+def reflected_wave(s: Separation, t: np.ndarray, period: float, k: float, x: float) -> np.ndarray:
+    """The reflected wave of a first-harmonic ``Separation`` (``separate_harmonics`` without
+    decay, with wavenumber ``k``) at position ``x`` [m] over ``t``: subtracted from a record at x
+    it leaves the incident wave and the harmonics, e.g. to score a flume against a reference
+    whose end reflects differently."""
     omega = 2.0 * math.pi / period
     return s.a_reflected * np.cos(omega * np.asarray(t, dtype=float) + k * x + s.phase_reflected)
 
