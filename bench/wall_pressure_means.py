@@ -79,8 +79,7 @@ def main() -> None:
     bins = {}
     sensors = []
     for k in range(4):
-        p = np.array([np.nan if r[f"wall_p{k}"] is None else r[f"wall_p{k}"] for r in sim.history],
-                     dtype=float) / rgh
+        p = _series(sim.history, f"wall_p{k}") / rgh
         sensors.append(p)
         m, me = (t >= 3) & (t <= 5), (exp[:, 0] >= 3) & (exp[:, 0] <= 5)
         s, e = float(np.nan_to_num(p[m]).mean()), float(exp[me, k + 1].mean())
