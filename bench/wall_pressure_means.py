@@ -78,10 +78,10 @@ def main() -> None:
            "scheme": scene.scheme.kind, "gate_speed": a.gate_speed}
     bins = {}
     sensors = []
-    for k in range(4):
+    m, me = (t >= 3) & (t <= 5), (exp[:, 0] >= 3) & (exp[:, 0] <= 5)   # the scored window
+    for k in range(len(SENSOR_Z)):
         p = _series(sim.history, f"wall_p{k}") / rgh
         sensors.append(p)
-        m, me = (t >= 3) & (t <= 5), (exp[:, 0] >= 3) & (exp[:, 0] <= 5)
         s, e = float(np.nan_to_num(p[m]).mean()), float(exp[me, k + 1].mean())
         out[f"s{k + 1}"] = {"sph": round(s, 3), "exp": round(e, 3), "err": round(s / e - 1, 3),
                             "dry": round(float(np.isnan(p[m]).mean()), 3)}
@@ -91,7 +91,6 @@ def main() -> None:
     out["impact_T"] = {"sph": _first_above(t, np.nan_to_num(sensors[0]), IMPACT_LEVEL),
                        "exp": _first_above(exp[:, 0], exp[:, 1], IMPACT_LEVEL)}
     out["levels"] = _levels(t, sim.history)
-    m = (t >= 3) & (t <= 5)
     out["profile"] = {str(z): round(float(np.nan_to_num(_series(sim.history, f"wall_p{k}")[m]).mean()
                                           / rgh), 3)
                       for k, z in enumerate(PROFILE_Z, start=len(SENSOR_Z))}
