@@ -1,6 +1,6 @@
 """How much does the SPH flume damp a progressive wave over distance, at a given resolution?
 
-    python bench/wave_decay.py [--H 0.04 --T 1.4 --d 0.24] [--dp 0.02 0.01 0.005] [--periods 4]
+    python bench/wave_decay.py [--H 0.04 --T 1.4 --d 0.24] [--dp 0.02 0.01 0.005] [--periods 4 (--long: 12)]
         [--settle-periods 0] [--inlet-pressure hydrostatic|extrapolated] [--no-outlet-absorb]
         [--h-over-dp 2.0] [--alpha 0.01] [--slip no_slip|free_slip] [--c0-factor 10] [--delta 0.1]
         [--cfl 0.25] [--integrator kdk|symplectic_pc] [--nu 1e-6] [--alpha-wall 1.0]
@@ -10,10 +10,13 @@
         [--long] [--noise]
         [--scheme wcsph|riemann|isph] [--reconstruction muscl|none]
 
---long: a flume 3 wavelengths long, 36 gauges over 2.25 wavelengths, the window after the
-outlet's reflection has come back to the inlet: resolves the decay to ~0.1 %/m (dp 0.02: fitted
+--long: a flume 3 wavelengths long, 36 gauges over 2.25 wavelengths, 12 periods from the time
+the outlet's reflection has come back to the inlet: resolves the decay to ~0.1 %/m (dp 0.02: fitted
 2.56, separated 2.58 %/m; a fit over the default 0.75 L span moves by ~1 %/m with the outlet's
-reflection pattern; docs/studies/absorption.md), ~5x the particle-steps of the default flume.
+reflection pattern; docs/studies/absorption.md). 12 periods, not 4: at H/dp 4 the loss climbs
+from 0.3 to 1.0 %/m over the first 4 periods of that window and holds there
+(modulated_decay_per_period; docs/studies/wave_decay_study.md, "The long flume's loss settles
+in time"). ~9x the particle-steps of the default flume.
 
 A flume one wavelength long with open ends driven by second-order Stokes theory (the wave of the
 coupled flume, wavesph/cases/coupled_flume.py, by default), gauges from 2h past the inlet to 3/4 of the
@@ -26,6 +29,11 @@ theory, first harmonic), decay_per_m (least squares of the log), loss_per_wavele
 (1 - exp(-decay L)), amplitude_at_0_8m (that fit 0.8 m past the inlet: the coupled flume's
 gauge), wall_s, particles, steps, particle_steps_per_s; then, given several dp, one line with the
 convergence order of the decay between successive dp, log(decay_1/decay_2)/log(dp_1/dp_2).
+modulated_decay_per_m, modulated_loss_per_wavelength, reflection_ripple, beat_modulation: the
+decay fitted with the outlet's reflection ripple (period L/2) and the free second harmonic's beat
+(period 2 pi / (k(2 omega) - 2k), ~3 m here; null where the gauges span less) beside it (wavesph.cases.wave_decay.modulated_decay:
+the plain fit hangs on where its span cuts the beat); modulated_decay_per_period, that fit over
+each period of the window in turn (a loss that changes with the run's time).
 separated_decay_per_m, separated_k_over_k_theory (SPH's wavenumber: phase-speed error),
 separated_reflection: an incident and a reflected wave with one decay rate and wavenumber
 fitted to the complex amplitudes (wavesph.cases.wave_decay.separated_decay).
@@ -58,13 +66,20 @@ from wavesph.cases.schemes import (add_constant_arguments, add_scheme_arguments,
 from wave_client.theories import build_theory  # noqa: E402
 
 
+def _finite(v: float) -> float | None:
+    """``v`` to 4 decimals, None for nan (JSON has no nan)."""
+    return None if math.isnan(v) else round(v, 4)
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--H", type=float, default=0.04, help="wave height [m]")
     ap.add_argument("--T", type=float, default=1.4, help="period [s]")
     ap.add_argument("--d", type=float, default=0.24, help="still-water depth [m]")
     ap.add_argument("--dp", type=float, nargs="+", default=[0.02], help="particle spacing(s) [m]")
-    ap.add_argument("--periods", type=float, default=4.0, help="periods analysed")
+    ap.add_argument("--periods", type=float, default=None,
+                    help="periods analysed (default 4; --long 12: its loss settles over the "
+                         "first 4)")
     ap.add_argument("--settle-periods", type=float, default=0.0,
                     help="extra periods between the front's passage and the analysed window")
     ap.add_argument("--flume-wavelengths", type=float, default=1.0,
@@ -72,9 +87,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--gauge-wavelengths", type=float, default=0.75,
                     help="gauges from 2h past the inlet to this many wavelengths")
     ap.add_argument("--long", action="store_true",
-                    help="the long flume: 3 wavelengths, 36 gauges over 2.25, window after the "
-                         "outlet's reflection has come back to the inlet (its pattern, period "
-                         "L/2, averages out of the fitted decay)")
+                    help="the long flume: 3 wavelengths, 36 gauges over 2.25, a window of 12 "
+                         "periods after the outlet's reflection has come back to the inlet (its "
+                         "pattern, period L/2, averages out of the fitted decay)")
     ap.add_argument("--noise", action="store_true",
                     help="sample the particle-noise energy along x and in time (diagnostic)")
     ap.add_argument("--n-gauges", type=int, default=12, help="number of elevation gauges")
@@ -92,6 +107,8 @@ def main(argv: list[str] | None = None) -> int:
     scheme = scheme_from_args(a)
     if a.long:
         a.flume_wavelengths, a.gauge_wavelengths, a.n_gauges = 3.0, 2.25, 36
+    if a.periods is None:
+        a.periods = 12.0 if a.long else 4.0
     c0 = a.c0_factor * math.sqrt(9.81 * a.d)
     decays = []
     for dp in a.dp:
@@ -117,6 +134,13 @@ def main(argv: list[str] | None = None) -> int:
                           "x": prof.x.tolist(),
                           "amplitude_ratio": [round(float(r), 4) for r in prof.ratio],
                           "decay_per_m": round(prof.decay_per_m, 4),
+                          "modulated_decay_per_m": round(prof.modulated_decay_per_m, 4),
+                          "modulated_loss_per_wavelength": round(
+                              1.0 - math.exp(-prof.modulated_decay_per_m * length), 4),
+                          "reflection_ripple": _finite(prof.reflection_ripple),
+                          "beat_modulation": _finite(prof.beat_modulation),
+                          "modulated_decay_per_period": [round(float(v), 4)
+                                                         for v in prof.decay_per_period],
                           "loss_per_wavelength": round(1.0 - math.exp(-prof.decay_per_m * length), 4),
                           "separated_decay_per_m": round(sep_decay, 4),
                           "separated_k_over_k_theory": round(sep_k / prof.k, 4),

@@ -20,6 +20,7 @@ from typing import Any
 import numpy as np
 from scipy.optimize import minimize
 
+from sph_core.absorption import linear_wavenumber
 from sph_core.scene import ElevationProbe
 
 from .particle_noise import binned_noise, noise_energy
@@ -61,6 +62,15 @@ class AmplitudeProfile:
     noise_fraction_t: np.ndarray | None = None
     # per end (left, right): particles in / out / created / removed over the run
     counts: dict | None = None
+    # modulated_decay's fit: decay [1/m] with the outlet's reflection ripple (period L/2) and
+    # the free second harmonic's beat (period 2 pi / (k(2 omega) - 2k)) fitted beside it, and
+    # the two modulations' amplitudes (in ln ratio)
+    modulated_decay_per_m: float = 0.0
+    reflection_ripple: float = 0.0
+    beat_modulation: float = 0.0
+    # the same fit over each whole period of the window in turn: a decay that changes with
+    # the run's time shows here
+    decay_per_period: np.ndarray | None = None
 
     def ratio_at(self, x: float) -> float:
         """The fitted ratio at ``x`` [m] (the outlet's small reflection ripples the profile)."""
@@ -118,7 +128,7 @@ def amplitude_profile(model: Any, *, ramp: float, height: float, period: float, 
                       for a, p in zip(amp, probes)])
     slope, icpt = np.polyfit(xs, np.log(ratio), 1)
 
-    def half_ratio(part: np.ndarray) -> np.ndarray:
+    def window_ratio(part: np.ndarray) -> np.ndarray:
         return np.array([abs(harmonic_amplitude(res.t[part], res.eta[p.name][part], omega))
                          / abs(harmonic_amplitude(res.t[part], res.theory[p.name][part], omega))
                          for p in probes])
@@ -141,10 +151,42 @@ def amplitude_profile(model: Any, *, ramp: float, height: float, period: float, 
         nfr = nb[win].mean(axis=0) / e_bin
         span = edges[1:] <= xs[-1] + 1e-9
         nft = nb[:, span].sum(axis=1) / (e_bin * np.count_nonzero(span))
+    k = 2.0 * math.pi / length
+    kb = beat_wavenumber(k, period, depth)
+    mod = modulated_decay(xs, ratio, k, kb)
+    per = int(round(period / (res.t[1] - res.t[0])))
+    by_period = np.array([modulated_decay(xs, window_ratio(sel[j:j + per]), k, kb)[0]
+                          for j in range(0, sel.size - per + 1, per)])
     return AmplitudeProfile(xs, ratio, float(-slope), float(icpt), res.wall_s, res.particles,
-                            res.steps, amp, 2.0 * math.pi / length, half_ratio(sel[:nh]),
-                            half_ratio(sel[nh:]), mean_err, drift, ratio2, nx, nfr, nt, nft,
-                            res.counts)
+                            res.steps, amp, k, window_ratio(sel[:nh]),
+                            window_ratio(sel[nh:]), mean_err, drift, ratio2, nx, nfr, nt, nft,
+                            res.counts, *mod, by_period)
+
+
+def beat_wavenumber(k: float, period: float, depth: float) -> float:
+    """Wavenumber [1/m] of the beat between a free second harmonic (linear dispersion at
+    2 omega) and the bound one (2k): the first harmonic's third-order modulation along x."""
+    return linear_wavenumber(4.0 * math.pi / period, depth) - 2.0 * k
+
+
+def modulated_decay(x: np.ndarray, ratio: np.ndarray, k: float,
+                    k_beat: float) -> tuple[float, float, float]:
+    """(decay [1/m], reflection ripple, beat modulation) of the amplitude ratio at ``x`` by
+    linear least squares, ln ratio = c - decay x + ripple cos(2k x + .) + beat cos(k_beat x + .).
+    A plain log-linear fit over a span that is not whole periods of both modulations reads them
+    partly as decay: on the long flume a 0.5 % beat of period ~3 m moves the fit over half the
+    gauges between 0.2 and 0.8 %/m (docs/studies/wave_decay_study.md). A modulation whose
+    period the gauges' span does not cover is left out (it and the slope are one there) and
+    its amplitude is nan."""
+    span = float(x.max() - x.min())
+    cols = [np.ones_like(x), -x]
+    fitted = [kk for kk in (2.0 * k, k_beat) if 2.0 * math.pi / kk <= span]
+    for kk in fitted:
+        cols += [np.cos(kk * x), np.sin(kk * x)]
+    coef, *_ = np.linalg.lstsq(np.stack(cols, axis=1), np.log(ratio), rcond=None)
+    amps = iter(math.hypot(coef[i], coef[i + 1]) for i in range(2, len(coef), 2))
+    return (float(coef[1]), *(float(next(amps)) if kk in fitted else math.nan
+                              for kk in (2.0 * k, k_beat)))
 
 
 def separated_decay(x: np.ndarray, amp: np.ndarray, k: float) -> tuple[float, float, float]:
