@@ -179,14 +179,13 @@ def modulated_decay(x: np.ndarray, ratio: np.ndarray, k: float,
     period the gauges' span does not cover is left out (it and the slope are one there) and
     its amplitude is nan."""
     span = float(x.max() - x.min())
+    waves = [kk for kk in (2.0 * k, k_beat) if 2.0 * math.pi / kk <= span]
     cols = [np.ones_like(x), -x]
-    fitted = [kk for kk in (2.0 * k, k_beat) if 2.0 * math.pi / kk <= span]
-    for kk in fitted:
+    for kk in waves:
         cols += [np.cos(kk * x), np.sin(kk * x)]
     coef, *_ = np.linalg.lstsq(np.stack(cols, axis=1), np.log(ratio), rcond=None)
-    amps = iter(math.hypot(coef[i], coef[i + 1]) for i in range(2, len(coef), 2))
-    return (float(coef[1]), *(float(next(amps)) if kk in fitted else math.nan
-                              for kk in (2.0 * k, k_beat)))
+    amps = {kk: math.hypot(coef[2 + 2 * i], coef[3 + 2 * i]) for i, kk in enumerate(waves)}
+    return float(coef[1]), amps.get(2.0 * k, math.nan), amps.get(k_beat, math.nan)
 
 
 def separated_decay(x: np.ndarray, amp: np.ndarray, k: float) -> tuple[float, float, float]:
