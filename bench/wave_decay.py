@@ -13,10 +13,12 @@
 --long: a flume 3 wavelengths long, 36 gauges over 2.25 wavelengths, 12 periods from the time
 the outlet's reflection has come back to the inlet: resolves the decay to ~0.1 %/m (dp 0.02: fitted
 2.56, separated 2.58 %/m; a fit over the default 0.75 L span moves by ~1 %/m with the outlet's
-reflection pattern; docs/studies/absorption.md). 12 periods, not 4: at H/dp 4 the loss climbs
-from 0.3 to 1.0 %/m over the first 4 periods of that window and holds there
-(modulated_decay_per_period; docs/studies/wave_decay_study.md, "The long flume's loss settles
-in time"). ~9x the particle-steps of the default flume.
+reflection pattern; docs/studies/absorption.md). 12 periods, not 4: the inlet's amplitude falls
+2.5 % as the outlet's reflection returns, and until that envelope has run past the gauges the
+fit at one time reads less loss (at H/dp 4: 0.3 %/m in the window's first period, 1.0 from the
+fourth on, 0.92 along the wave groups; modulated_decay_per_period; docs/studies/
+wave_decay_study.md, "The long flume's 4-period window read the inlet's envelope"). ~9x the
+particle-steps of the default flume.
 
 A flume one wavelength long with open ends driven by second-order Stokes theory (the wave of the
 coupled flume, wavesph/cases/coupled_flume.py, by default), gauges from 2h past the inlet to 3/4 of the
@@ -78,8 +80,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--d", type=float, default=0.24, help="still-water depth [m]")
     ap.add_argument("--dp", type=float, nargs="+", default=[0.02], help="particle spacing(s) [m]")
     ap.add_argument("--periods", type=float, default=None,
-                    help="periods analysed (default 4; --long 12: its loss settles over the "
-                         "first 4)")
+                    help="periods analysed (default 4; --long 12: the inlet's envelope passes "
+                         "the gauges over the first 4)")
     ap.add_argument("--settle-periods", type=float, default=0.0,
                     help="extra periods between the front's passage and the analysed window")
     ap.add_argument("--flume-wavelengths", type=float, default=1.0,
