@@ -35,7 +35,11 @@ modulated_decay_per_m, modulated_loss_per_wavelength, reflection_ripple, beat_mo
 decay fitted with the outlet's reflection ripple (period L/2) and the free second harmonic's beat
 (period 2 pi / (k(2 omega) - 2k), ~3 m here; null where the gauges span less) beside it (wavesph.cases.wave_decay.modulated_decay:
 the plain fit hangs on where its span cuts the beat); modulated_decay_per_period, that fit over
-each period of the window in turn (a loss that changes with the run's time).
+each period of the window in turn (a loss that changes with the run's time);
+group_decay_per_period, group_decay_per_m, group_loss_per_wavelength: the same fit following each
+period down the flume, each gauge x / c_g later (wavesph.cases.wave_decay.group_decays; the
+periods whose last gauge the record reaches): an inlet amplitude that changes over time does
+not read as decay there. The figure to quote.
 separated_decay_per_m, separated_k_over_k_theory (SPH's wavenumber: phase-speed error),
 separated_reflection: an incident and a reflected wave with one decay rate and wavenumber
 fitted to the complex amplitudes (wavesph.cases.wave_decay.separated_decay).
@@ -71,6 +75,14 @@ from wave_client.theories import build_theory  # noqa: E402
 def _finite(v: float) -> float | None:
     """``v`` to 4 decimals, None for nan (JSON has no nan)."""
     return None if math.isnan(v) else round(v, 4)
+
+
+def _along_groups(decays, length: float) -> dict:
+    """The fit along the wave groups: per period, their mean and its loss per wavelength."""
+    mean = float(decays.mean()) if decays.size else math.nan
+    return {"group_decay_per_period": [round(float(v), 4) for v in decays],
+            "group_decay_per_m": _finite(mean),
+            "group_loss_per_wavelength": _finite(1.0 - math.exp(-mean * length))}
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -143,6 +155,7 @@ def main(argv: list[str] | None = None) -> int:
                           "beat_modulation": _finite(prof.beat_modulation),
                           "modulated_decay_per_period": [round(float(v), 4)
                                                          for v in prof.decay_per_period],
+                          **_along_groups(prof.group_decay_per_period, length),
                           "loss_per_wavelength": round(1.0 - math.exp(-prof.decay_per_m * length), 4),
                           "separated_decay_per_m": round(sep_decay, 4),
                           "separated_k_over_k_theory": round(sep_k / prof.k, 4),

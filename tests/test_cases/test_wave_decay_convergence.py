@@ -16,8 +16,9 @@ import numpy as np
 import pytest
 
 from wavesph.cases.standing_wave import standing_wave_decay
+from wavesph.analysis import harmonic_amplitude
 from wavesph.cases.wave_decay import (beat_wavenumber, convergence_orders, convergence_record,
-                                      modulated_decay)
+                                      group_decays, modulated_decay)
 from sph_core.scene import Constants
 
 DPS = [0.025, 0.02, 0.01]   # tank 1.0 m long: whole numbers of spacings (no gap at the wall)
@@ -68,3 +69,24 @@ def test_modulated_decay_reads_the_decay_under_a_beat_and_a_ripple():
     assert abs(-np.polyfit(x[half], np.log(ratio[half]), 1)[0] - 0.007) > 0.0035
     # a span shorter than the beat fits the ripple only
     assert math.isnan(modulated_decay(x[half], ratio[half], k, kb)[2])
+
+
+def test_group_decays_do_not_read_the_inlets_envelope_as_decay():
+    # the long flume's case: the wave loses 0.9 %/m while the inlet's amplitude falls 2.5 % over
+    # t 8.5-12.7 s; read at one time from 12.7 s the far gauges still see the older waves
+    period, cg, k, x = 1.4, 1.193, 2 * math.pi / 1.971, np.linspace(0.014, 4.43, 36)
+    t = np.arange(0.0, 12.7 + 12 * period, period / 40)
+    omega, decay, t0 = 2 * math.pi / period, 0.009, 12.7
+    tau = t[None, :] - x[:, None] / cg
+    envelope = 1.0 - 0.025 * np.clip((tau - 8.5) / 4.2, 0.0, 1.0)
+    theory = np.cos(omega * t[None, :] - k * x[:, None])
+    eta = envelope * np.exp(-decay * x[:, None]) * theory
+    kb = beat_wavenumber(k, period, 0.24)
+    along = group_decays(t, eta, theory, x, t0=t0, period=period, cg=cg, k=k, k_beat=kb)
+    assert along.size == 9   # 12 periods of record, 3.7 s of them the last gauge's lag
+    assert np.allclose(along, decay, atol=2e-4)
+    win = slice(int(np.searchsorted(t, t0 - 1e-9)), int(np.searchsorted(t, t0 - 1e-9)) + 40)
+    fixed = np.array([abs(harmonic_amplitude(t[win], e[win], omega))
+                      / abs(harmonic_amplitude(t[win], th[win], omega))
+                      for e, th in zip(eta, theory)])
+    assert modulated_decay(x, fixed, k, kb)[0] < decay - 0.003
