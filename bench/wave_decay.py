@@ -63,6 +63,8 @@ import os
 import sys
 from pathlib import Path
 
+import numpy as np
+
 os.environ.setdefault("OMP_WAIT_POLICY", "passive")  # before numba: shared, loaded cores
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
@@ -77,7 +79,7 @@ def _finite(v: float) -> float | None:
     return None if math.isnan(v) else round(v, 4)
 
 
-def _along_groups(decays, length: float) -> dict:
+def _along_groups(decays: np.ndarray, length: float) -> dict:
     """The fit along the wave groups: per period, their mean and its loss per wavelength."""
     mean = float(decays.mean()) if decays.size else math.nan
     return {"group_decay_per_period": [round(float(v), 4) for v in decays],

@@ -131,10 +131,12 @@ def amplitude_profile(model: Any, *, ramp: float, height: float, period: float, 
                       for a, p in zip(amp, probes)])
     slope, icpt = np.polyfit(xs, np.log(ratio), 1)
 
-    def window_ratio(part: np.ndarray) -> np.ndarray:
-        return np.array([abs(harmonic_amplitude(res.t[part], res.eta[p.name][part], omega))
-                         / abs(harmonic_amplitude(res.t[part], res.theory[p.name][part], omega))
-                         for p in probes])
+    etas = np.array([res.eta[p.name] for p in probes])
+    theories = np.array([res.theory[p.name] for p in probes])
+
+    def window_ratio(part: np.ndarray) -> np.ndarray:   # part: contiguous indices
+        return harmonic_ratios(res.t, etas, theories, omega, np.full(len(probes), part[0]),
+                               part.size)
 
     nh = sel.size // 2
     mean_err = np.array([np.mean(res.eta[p.name][sel]) - np.mean(res.theory[p.name][sel])
@@ -160,9 +162,7 @@ def amplitude_profile(model: Any, *, ramp: float, height: float, period: float, 
     per = int(round(period / (res.t[1] - res.t[0])))
     by_period = np.array([modulated_decay(xs, window_ratio(sel[j:j + per]), k, kb)[0]
                           for j in range(0, sel.size - per + 1, per)])
-    along = group_decays(res.t, np.array([res.eta[p.name] for p in probes]),
-                         np.array([res.theory[p.name] for p in probes]), xs, t0=t0,
-                         period=period, cg=cg, k=k, k_beat=kb)
+    along = group_decays(res.t, etas, theories, xs, t0=t0, period=period, cg=cg, k=k, k_beat=kb)
     return AmplitudeProfile(xs, ratio, float(-slope), float(icpt), res.wall_s, res.particles,
                             res.steps, amp, k, window_ratio(sel[:nh]),
                             window_ratio(sel[nh:]), mean_err, drift, ratio2, nx, nfr, nt, nft,
@@ -184,12 +184,19 @@ def group_decays(t: np.ndarray, eta: np.ndarray, theory: np.ndarray, x: np.ndarr
     omega = 2.0 * math.pi / period
     out = []
     while start + lag.max() + per <= t.size:
-        ratio = np.array([abs(harmonic_amplitude(t[a:a + per], e[a:a + per], omega))
-                          / abs(harmonic_amplitude(t[a:a + per], th[a:a + per], omega))
-                          for a, e, th in zip(start + lag, eta, theory)])
-        out.append(modulated_decay(x, ratio, k, k_beat)[0])
+        out.append(modulated_decay(x, harmonic_ratios(t, eta, theory, omega, start + lag, per),
+                                   k, k_beat)[0])
         start += per
     return np.array(out)
+
+
+def harmonic_ratios(t: np.ndarray, eta: np.ndarray, theory: np.ndarray, omega: float,
+                    starts: np.ndarray, n: int) -> np.ndarray:
+    """|first harmonic| of ``eta[i]`` over that of ``theory[i]`` (rows: gauges, at uniform
+    ``t``), each over its own ``n`` samples from ``starts[i]``."""
+    return np.array([abs(harmonic_amplitude(t[a:a + n], e[a:a + n], omega))
+                     / abs(harmonic_amplitude(t[a:a + n], th[a:a + n], omega))
+                     for a, e, th in zip(starts, eta, theory)])
 
 
 def beat_wavenumber(k: float, period: float, depth: float) -> float:
