@@ -7,7 +7,7 @@
         [--shifting none|fickian|dplus] [--shift-a 2.0]
         [--shift-fs-div 1.8] [--shift-open-end full|none] [--flume-wavelengths 1]
         [--gauge-wavelengths 0.75] [--n-gauges 12]
-        [--long] [--noise]
+        [--long] [--noise] [--records DIR]
         [--scheme wcsph|riemann|isph] [--reconstruction muscl|none]
 
 --long: a flume 3 wavelengths long, 36 gauges over 2.25 wavelengths, 12 periods from the time
@@ -40,6 +40,8 @@ group_decay_per_period, group_decay_per_m, group_loss_per_wavelength: the same f
 period down the flume, each gauge x / c_g later (wavesph.cases.wave_decay.group_decays; the
 periods whose last gauge the record reaches): an inlet amplitude that changes over time does
 not read as decay there. The figure to quote.
+--records DIR keeps the gauge records (an npz per dp) to fit again without re-running, e.g.
+group_decays(**npz) with an earlier t0 (a long run's groups before the window start).
 separated_decay_per_m, separated_k_over_k_theory (SPH's wavenumber: phase-speed error),
 separated_reflection: an incident and a reflected wave with one decay rate and wavenumber
 fitted to the complex amplitudes (wavesph.cases.wave_decay.separated_decay).
@@ -109,6 +111,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--noise", action="store_true",
                     help="sample the particle-noise energy along x and in time (diagnostic)")
     ap.add_argument("--n-gauges", type=int, default=12, help="number of elevation gauges")
+    ap.add_argument("--records", type=Path, default=None, metavar="DIR",
+                    help="keep each dp's gauge records in DIR/wave_decay_dp<dp>.npz (t, x, eta, "
+                         "theory, t0, period, cg, k, k_beat: group_decays' arguments)")
     add_constant_arguments(ap, open_ends=True)
     ap.add_argument("--c0-factor", type=float, default=10.0, help="c0 = factor * sqrt(g d)")
     ap.add_argument("--no-outlet-absorb", action="store_true",
@@ -138,6 +143,9 @@ def main(argv: list[str] | None = None) -> int:
                                  c0=c0, scheme=scheme, device=a.device, **cst)
         length = float(model.length)
         decays.append(prof.decay_per_m)
+        if a.records is not None:
+            a.records.mkdir(parents=True, exist_ok=True)
+            np.savez(a.records / f"wave_decay_dp{dp:g}.npz", **prof.records)
         sep_decay, sep_k, sep_kr = separated_decay(prof.x, prof.amp, prof.k)
         print(json.dumps({"H": a.H, "T": a.T, "d": a.d, "dp": dp, "H_over_dp": round(a.H / dp, 3),
                           "device": a.device or "cpu",

@@ -74,6 +74,9 @@ class AmplitudeProfile:
     # the fit along the wave groups (group_decays): each period of the window followed down the
     # flume, each gauge x / c_g later; an envelope the inlet sends does not read as decay
     group_decay_per_period: np.ndarray | None = None
+    # the gauge records, for a re-analysis without re-running (bench/wave_decay.py --records):
+    # t [s], eta and theory [m] (rows: gauges at x), t0 the window's start [s], cg [m/s]
+    records: dict[str, Any] | None = None
 
     def ratio_at(self, x: float) -> float:
         """The fitted ratio at ``x`` [m] (the outlet's small reflection ripples the profile)."""
@@ -166,7 +169,9 @@ def amplitude_profile(model: Any, *, ramp: float, height: float, period: float, 
     return AmplitudeProfile(xs, ratio, float(-slope), float(icpt), res.wall_s, res.particles,
                             res.steps, amp, k, window_ratio(sel[:nh]),
                             window_ratio(sel[nh:]), mean_err, drift, ratio2, nx, nfr, nt, nft,
-                            res.counts, *mod, by_period, along)
+                            res.counts, *mod, by_period, along,
+                            {"t": res.t, "x": xs, "eta": etas, "theory": theories, "t0": t0,
+                             "period": period, "cg": cg, "k": k, "k_beat": kb})
 
 
 def group_decays(t: np.ndarray, eta: np.ndarray, theory: np.ndarray, x: np.ndarray, *,
@@ -177,6 +182,7 @@ def group_decays(t: np.ndarray, eta: np.ndarray, theory: np.ndarray, x: np.ndarr
     amplitude the inlet changes over time reads as decay along x (the far gauges still see the
     older waves): the long flume's inlet falls 2.5 % as the outlet's reflection returns, and the
     fixed-time fit reads 0.3 %/m where the wave loses 0.9 (docs/studies/wave_decay_study.md)."""
+    t0, period, cg, k, k_beat = map(float, (t0, period, cg, k, k_beat))  # an npz's 0-d arrays
     dt = float(t[1] - t[0])
     per = int(round(period / dt))
     lag = np.rint(x / cg / dt).astype(int)
