@@ -11,7 +11,7 @@
 # Every phase runs under `timeout`, capped by what is left of TOTAL_S, so the script ends in time.
 # Overrides (a rerun, or a dry run here): GPU_DPS, CPU_DP, CPU_STEPS, THREADS (empty: no CPU runs), TEST_S,
 # FLUMES (non-empty: the H/dp 8 wave flumes on the GPU, two lanes side by side; II: case II
-# alone), HOST_THREADS (16: pytest and the GPU runs' host side), TOTAL_S, PYTHON, SKIP_WHEELS,
+# alone), RUNUP (non-empty: the solitary run-up at d/dp 80 and the breaking one at 40), HOST_THREADS (16: pytest and the GPU runs' host side), TOTAL_S, PYTHON, SKIP_WHEELS,
 # SKIP_TESTS, NUMBA_ENABLE_CUDASIM.
 set -u
 cd "$(dirname "$0")/.."
@@ -123,5 +123,19 @@ elif [ -n "${FLUMES:-}" ]; then
            "$FA --case V --dp 0.0075 --periods 4 --steady" \
            "$FA --case I --dp 0.0184210526 --periods 4 --steady" &
     wait
+fi
+if [ -n "${RUNUP:-}" ]; then
+    # issue 26 item 1 at the resolutions the CPU cannot reach: the non-breaking solitary run-up
+    # at d/dp 80 (H/dp 4; d/dp 40 on the CPU: 30k particles, 92k steps, 1,784 s on 2 threads),
+    # Boussinesq far field 2 d before the toe, then the breaking wave at d/dp 40 (theory inlet).
+    # Estimate (not run): ~0.1M particles and ~185k steps, at the long flume's ~1.1 ms a step
+    # (62k particles, H200) ~4 min; each run capped by what is left of TOTAL_S
+    say "GPU run-up: H/d 0.05 at d/dp 80, then H/d 0.3 at d/dp 40"
+    for args in "--h-over-d 0.05 --dp-over-d 0.0125 --far-field boussinesq --toe-over-d 2" \
+                "--h-over-d 0.3 --dp-over-d 0.025"; do
+        NUMBA_NUM_THREADS=$HT timeout "$(left 600)" $PY bench/runup.py --device cuda $args \
+            2>>"$LOG" | tee -a "$JSONL" "$LOG"
+        say "run-up $args: exit ${PIPESTATUS[0]}"
+    done
 fi
 say "done: $(wc -l < "$JSONL") JSON lines in $JSONL"

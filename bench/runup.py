@@ -4,6 +4,7 @@ Synolakis' (1987) run-up law R/d = 2.831 sqrt(cot beta) (H/d)^(5/4)?
     NUMBA_NUM_THREADS=1 python bench/runup.py [--h-over-d 0.05,0.3] [--dp-over-d 0.1] [--depth 0.2]
                                               [--wall-slip free_slip] [--constants JSON]
                                               [--far-field boussinesq] [--toe-over-d 2]
+                                              [--device cuda]
 
 The canonical case (Synolakis 1987, J. Fluid Mech. 185): still water d on a flat bed, then a
 plane beach of slope 1/19.85 whose toe is L = arccosh(sqrt(20)) / k downstream of the inlet
@@ -28,7 +29,7 @@ against the non-breaking law in every case.
 One JSON object per H/d: H_over_d, R_over_d, R_over_d_law, R_over_d_breaking_fit, error,
 R0_over_d, stopped (null, or why the run stopped early: R is then over the records before it),
 far_field, toe_over_d (the inlet-to-toe distance / d), R_loose_over_d (the same probe counting any particle with one fluid neighbour at any
-height: what the wet-film criteria leave out), H_toe_over_H (the highest SPH elevation at the toe up to the run-up peak, over H), dp, d_over_dp, H_over_dp, particles, steps, t_end, wall_s.
+height: what the wet-film criteria leave out), H_toe_over_H (the highest SPH elevation at the toe up to the run-up peak, over H), dp, d_over_dp, H_over_dp, particles, steps, t_end, wall_s, device.
 
 Beside the law, the same wave on the same beach in the nonlinear shallow-water equations
 (wavesph.cases.shallow_runup, seconds): R_over_d_nswe (the law's own model, so within ~2 % of
@@ -114,10 +115,11 @@ def runup_scene(h_over_d: float, depth: float, dp: float, wall_slip: str = "no_s
 
 def run_case(h_over_d: float, depth: float, dp_over_d: float, wall_slip: str = "no_slip",
              constants: dict | None = None, far_field: str = "theory",
-             toe_over_d: float | None = None) -> dict:
+             toe_over_d: float | None = None, device: str | None = None) -> dict:
     """One run-up. far_field "theory": the solitary theory drives the SPH inlet; "boussinesq":
     the Boussinesq model carries the wave to it (solitary_approach; one-way: the beach's
-    reflection leaves SPH through the inlet's imposed elevation, as with the theory)."""
+    reflection leaves SPH through the inlet's imposed elevation, as with the theory).
+    ``device``: where the SPH steps run (None: the scene's, cpu; "cuda": an NVIDIA GPU)."""
     dp = dp_over_d * depth
     data, wave, x_toe = runup_scene(h_over_d, depth, dp, wall_slip, constants,
                                     None if toe_over_d is None else toe_over_d * depth)
@@ -135,7 +137,7 @@ def run_case(h_over_d: float, depth: float, dp_over_d: float, wall_slip: str = "
         return {k: float(vol[st["x"] > xs].sum()) for k, xs in x_sec.items()}
 
     tic = time.perf_counter()
-    sim = Simulation(scene, sources={"left": src})
+    sim = Simulation(scene, sources={"left": src}, device=device)
     at_rest = shoreward_volumes(sim)
     excess = dict.fromkeys(SECTIONS, 0.0)
 
@@ -176,6 +178,7 @@ def run_case(h_over_d: float, depth: float, dp_over_d: float, wall_slip: str = "
             "far_field": far_field, "toe_over_d": round(x_toe / depth, 3),
             **({"constants": constants} if constants else {}), "particles": sim.n_particles,
             "steps": sim.steps, "t_end": scene.t_end, "stopped": stopped, "wall_s": round(wall, 1),
+            "device": device or "cpu",
             "threads": int(os.environ.get("NUMBA_NUM_THREADS", "0") or 0)}
 
 
@@ -195,10 +198,12 @@ def main() -> None:
     ap.add_argument("--toe-over-d", type=float, default=None,
                     help="inlet-to-toe distance / d (default Synolakis' half-width L; a short "
                          "SPH zone with --far-field boussinesq)")
+    ap.add_argument("--device", choices=("cpu", "cuda"), default=None,
+                    help="where the SPH steps run (default: the scene's, cpu)")
     a = ap.parse_args()
     for hd in (float(v) for v in a.h_over_d.split(",")):
         print(json.dumps(run_case(hd, a.depth, a.dp_over_d, a.wall_slip, a.constants,
-                                  a.far_field, a.toe_over_d)), flush=True)
+                                  a.far_field, a.toe_over_d, a.device)), flush=True)
 
 
 if __name__ == "__main__":
