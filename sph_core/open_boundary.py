@@ -241,11 +241,16 @@ def buffer_update(ps, n, dt, r, zs0, du0, zs1, du1, ends, prm):
     ay = ps.ay
     az = ps.az
     kind = ps.kind
+    acc = prm.buffer_acceleration
     for i in prange(n):
         b, u, w, xi, zi, k, rho, pi = buffer_particle(i, ps, dt, r, zs0, du0, zs1, du1, ends,
                                                       prm)
         if b < 0:
             continue
+        # the imposed velocity's change along the particle's path, absorption correction
+        # included (ISPH's buffer rows: the pressure that gives the buffer its motion)
+        ax[i] = (u - vx[i]) / dt if acc else 0.0
+        az[i] = (w - vz[i]) / dt if acc else 0.0
         vx[i] = u
         vz[i] = w
         x[i] = xi
@@ -254,8 +259,6 @@ def buffer_update(ps, n, dt, r, zs0, du0, zs1, du1, ends, prm):
         rho_[i] = rho
         p[i] = pi
         drho[i] = 0.0
-        ax[i] = 0.0
-        az[i] = 0.0
         if prm.three is not None:   # long-crested: the boundary data has no y component
             vy[i] = 0.0
             ay[i] = 0.0
@@ -301,9 +304,11 @@ def transition_of(i, ps, ends, r, zs0, du0, zs1, du1):
 
 
 @njit(cache=True)
-def buffer_transitions(ps, n, ends, r, zs0, du0, zs1, du1):
+def buffer_transitions(ps, n, ends, r, zs0, du0, zs1, du1, prm):
     """Convert particles crossing a face, spawn and remove buffer particles (serial: appends in
-    slot order; the GPU's prefix sum over the clones gives the same slots).
+    slot order; the GPU's prefix sum over the clones gives the same slots). With
+    ``prm.buffer_acceleration`` a particle entering a buffer takes its imposed velocity (its
+    next acceleration is then the imposed flow's, not its step from the fluid's velocity).
 
     Returns the new slot count, or -1 if the capacity is exhausted."""
     f = ps.f
@@ -340,6 +345,12 @@ def buffer_transitions(ps, n, ends, r, zs0, du0, zs1, du1):
             continue
         if act == T_TO_BUFFER:
             counters[b, C_OUT] += 1
+            if prm.buffer_acceleration:
+                kind[i] = knew
+                _, u, w, _, _, _, _, _ = buffer_particle(i, ps, 0.0, r, zs0, du0, zs1, du1,
+                                                         ends, prm)
+                ps.vx[i] = u
+                ps.vz[i] = w
         elif act == T_FAR_OUT:
             counters[b, C_REMOVED] += 1
         else:
@@ -370,7 +381,7 @@ def update_buffers(ps, n, t1, dt, ends, prm):
     ends.zs[0] = zs0
     ends.zs[1] = zs1
     buffer_update(ps, n, dt, r, zs0, du0, zs1, du1, ends, prm)
-    return buffer_transitions(ps, n, ends, r, zs0, du0, zs1, du1)
+    return buffer_transitions(ps, n, ends, r, zs0, du0, zs1, du1, prm)
 
 
 @njit(cache=True, inline="always")

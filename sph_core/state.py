@@ -141,6 +141,10 @@ class Params(NamedTuple):
     wall_gb: float = 0.0
     # shifting next to an open end's buffer (shifting.SHIFT_OPEN_END): 0 full, 1 none
     shift_open: int = 0
+    # ISPH (isph.stepper): each buffer particle keeps its imposed acceleration in ax, az (the
+    # change of its imposed velocity over the step, open_boundary.buffer_update) for its
+    # pressure row, and a particle entering a buffer takes its imposed velocity at once
+    buffer_acceleration: bool = False
     # three dimensions: gravity's y component and the y range of the box of fx0..fz1
     gy: float = 0.0
     fy0: float = -1e300

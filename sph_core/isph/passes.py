@@ -91,10 +91,14 @@ def wall_state(ps, n, cells, prm, dt, stop, wsum, dwall):
 @njit(parallel=True, cache=True, fastmath=FASTMATH)
 def buffer_rows(ps, n, cells, prm, wsum, dwall):
     """wsum[b], dwall[b] of every active buffer particle b of an open end: the Adami sums over
-    its fluid neighbours, p_b - sum_f w_bf p_f = sum_f w_bf rho_f g . r_bf, a row of the PPE
+    its fluid neighbours, p_b - sum_f w_bf p_f = sum_f w_bf rho_f (g - a_b) . r_bf, a row of the PPE
     (with wsum > 0) solved with the fluid rows: the buffer's pressure follows the fluid's within
     the step, as a wall's does. (Taken from the last step's fluid, the open-end hook's ghost
-    extrapolation, it lagged the solve by a step, and the still open flume broke down.)"""
+    extrapolation, it lagged the solve by a step, and the still open flume broke down.) a_b is
+    the buffer's imposed acceleration (ax, az: Params.buffer_acceleration): with g alone the
+    buffer's pressure had no wave in it beyond the hydrostatic, the fluid beside the face did not
+    follow the buffer near the bed, and the wave flume broke down there 2 s sooner
+    (docs/studies/schemes.md, "The buffer's pressure with its acceleration")."""
     kind = ps.kind
     inv_h = 1.0 / prm.h
     s2 = 4.0 * prm.h * prm.h
@@ -103,7 +107,8 @@ def buffer_rows(ps, n, cells, prm, wsum, dwall):
             wsum[i] = 0.0
             dwall[i] = 0.0
             s = gather(i, ps.x[i], ps.y[i], ps.z[i], ps.cell[i], ps, cells, s2, fluid_only,
-                       wall_pair, (inv_h, prm.alpha_w, prm.gx, prm.gz, wsum), WALL_ROW_SUMS_ZERO)
+                       wall_pair, (inv_h, prm.alpha_w, prm.gx - ps.ax[i], prm.gz - ps.az[i],
+                                   wsum), WALL_ROW_SUMS_ZERO)
             wsum[i] = s.sw
             if s.sw > 0.0:
                 dwall[i] = s.sp / s.sw

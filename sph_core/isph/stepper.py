@@ -94,13 +94,14 @@ class IsphStepper:
         """Params of ISPH: no artificial viscosity (the bodies' load pass reads alpha), the flow
         speed's Courant number, Fickian shifting only (its figures in docs/studies/schemes.md were
         measured without the carry), no wall-face no-penetration shares (the PPE has its own
-        no-penetration pressure, isph_wall_stop)."""
+        no-penetration pressure, isph_wall_stop), the buffers' imposed acceleration kept for
+        their pressure rows (passes.buffer_rows)."""
         c = scene.constants
         shifting = c.shifting == "fickian" or self.isph_shifting
         prm = Params(**base, alpha=0.0, cfl=scene.scheme.isph_cfl,
                      shift_a=c.shift_a if shifting else 0.0, shift_dplus=False,
                      shift_carry=False, wall_ga=0.0, wall_g0=0.0, wall_gb=0.0, riemann=False,
-                     limiter=NO_RECONSTRUCTION)
+                     limiter=NO_RECONSTRUCTION, buffer_acceleration=True)
         self.prm = prm
         self.shifting = self.isph_shifting and prm.shift_a > 0.0
         # a typical fluid diagonal sum_j B_ij ~ (2 / rho0) sum_j V_j F_ij = 7 / (rho0 h^2): the
