@@ -346,7 +346,7 @@ def buffer_transitions(ps, n, ends, r, zs0, du0, zs1, du1, prm):
         if act == T_TO_BUFFER:
             counters[b, C_OUT] += 1
             if prm.buffer_acceleration:
-                kind[i] = knew
+                kind[i] = knew   # now, not below: buffer_particle reads it (dt 0: no move)
                 _, u, w, _, _, _, _, _ = buffer_particle(i, ps, 0.0, r, zs0, du0, zs1, du1,
                                                          ends, prm)
                 ps.vx[i] = u
