@@ -130,16 +130,15 @@ def amplitude_profile(model: Any, *, ramp: float, height: float, period: float, 
     sel = sel[: int(round(periods * period / (res.t[1] - res.t[0])))]
     omega = 2.0 * math.pi / period
     amp = np.array([harmonic_amplitude(res.t[sel], res.eta[p.name][sel], omega) for p in probes])
-    ratio = np.array([abs(a) / abs(harmonic_amplitude(res.t[sel], res.theory[p.name][sel], omega))
-                      for a, p in zip(amp, probes)])
-    slope, icpt = np.polyfit(xs, np.log(ratio), 1)
-
     etas = np.array([res.eta[p.name] for p in probes])
     theories = np.array([res.theory[p.name] for p in probes])
 
     def window_ratio(part: np.ndarray) -> np.ndarray:   # part: contiguous indices
         return harmonic_ratios(res.t, etas, theories, omega, np.full(len(probes), part[0]),
                                part.size)
+
+    ratio = window_ratio(sel)
+    slope, icpt = np.polyfit(xs, np.log(ratio), 1)
 
     nh = sel.size // 2
     mean_err = np.array([np.mean(res.eta[p.name][sel]) - np.mean(res.theory[p.name][sel])
