@@ -8,7 +8,8 @@
         [--shift-fs-div 1.8] [--shift-open-end full|none] [--flume-wavelengths 1]
         [--gauge-wavelengths 0.75] [--n-gauges 12]
         [--long] [--noise] [--records DIR]
-        [--scheme wcsph|riemann|isph] [--reconstruction muscl|none]
+        [--scheme wcsph|riemann|isph] [--reconstruction muscl|none] [--ppe-solver bicgstab|amg]
+        [--isph-density-relaxation 0.01] [--isph-wall-stop 1] [--isph-relaxation-zone 0]
 
 --long: a flume 3 wavelengths long, 36 gauges over 2.25 wavelengths, 12 periods from the time
 the outlet's reflection has come back to the inlet: resolves the decay to ~0.1 %/m (dp 0.02: fitted
@@ -19,6 +20,11 @@ fit at one time reads less loss (at H/dp 4: 0.3 %/m in the window's first period
 fourth on, 0.92 along the wave groups; modulated_decay_per_period; docs/studies/
 wave_decay_study.md, "The long flume's 4-period window read the inlet's envelope"). ~9x the
 particle-steps of the default flume.
+
+ISPH carries this wave through its open ends with relaxation zones and its wave settings,
+`--scheme isph --h-over-dp 1.2 --isph-density-relaxation 0.05 --isph-wall-stop 100
+--isph-relaxation-zone 0.4` (docs/physics/isph.md; the first gauge then sits at the zone's end);
+with the scheme's defaults its flume breaks down at ~5 s, before the window.
 
 A flume one wavelength long with open ends driven by second-order Stokes theory (the wave of the
 coupled flume, wavesph/cases/coupled_flume.py, by default), gauges from 2h past the inlet to 3/4 of the

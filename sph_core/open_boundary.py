@@ -264,6 +264,40 @@ def buffer_update(ps, n, dt, r, zs0, du0, zs1, du1, ends, prm):
             ay[i] = 0.0
 
 
+
+@njit(parallel=True, cache=True)
+def relax_to_source(ps, n, t1, dt, ends, length, tau):
+    """ISPH's relaxation zones (Scheme.isph_relaxation_zone): every fluid particle within
+    ``length`` of an open end's face has its velocity pulled towards the end's source velocity
+    (u, w)(z, t1) (the buffer's imposed profile without the absorption correction; above the
+    surface z_s the value at z_s) by a = 1 - exp(-dt q^2 / tau), q = 1 - s / length, s the
+    distance from the face: the pull is strongest at the face and vanishes with its slope at
+    the zone's end. Wave codes generate and absorb with such zones (Altomare et al. 2018 in
+    DualSPHysics). Why ISPH needs one: at outflow through the inlet the fluid's surface beside
+    the face fell below the buffer's and then rose at twice its speed, and the flume broke down
+    there within ~3 periods (docs/studies/schemes.md, "The wave flume's open ends with
+    relaxation zones")."""
+    if not ends.active:
+        return
+    r = window_weight(t1, ends.win_t)
+    vx = ps.vx
+    vz = ps.vz
+    kind = ps.kind
+    for i in prange(n):
+        if kind[i] != FLUID:
+            continue
+        for b in range(2):
+            if not ends.on[b]:
+                continue
+            s = (ps.x[i] - ends.x_face[b]) * (-ends.nx[b])
+            if s < 0.0 or s >= length:
+                continue
+            zi = min(ps.z[i], ends.zs[b])
+            q = 1.0 - s / length
+            a = 1.0 - math.exp(-dt * q * q / tau)
+            vx[i] += a * (profile_value(ends.zn[b], ends.win_u[b], r, zi) - vx[i])
+            vz[i] += a * (profile_value(ends.zn[b], ends.win_w[b], r, zi) - vz[i])
+
 # what a slot does at the face crossings (transition_of)
 T_NONE, T_TO_BUFFER, T_TO_FLUID, T_IDLE_OUT, T_FAR_OUT = range(5)
 

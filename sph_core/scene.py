@@ -323,6 +323,13 @@ class Scheme(_Model):
         "particle along the wall normal); 1: within one step"))
     isph_shifting: bool = Field(True, description=(
         "ISPH: Fickian particle shifting (Lind et al. 2012) with Constants.shift_a after each step"))
+    isph_relaxation_zone: float = Field(0.0, ge=0, description=(
+        "ISPH: length [m] of a relaxation zone inside each open end's face, where the fluid's "
+        "velocity is pulled towards the end's source velocity at the rate q^2 / "
+        "isph_relaxation_time, q = 1 - s / length, s the distance from the face; 0: none (the "
+        "wave flume's inlet then breaks down within a few periods: docs/studies/schemes.md)"))
+    isph_relaxation_time: float = Field(0.2, gt=0, description=(
+        "ISPH: time scale [s] of the relaxation zone's pull at the face"))
 
 
 class PointProbe(_Model):

@@ -11,7 +11,8 @@ import numpy as np
 
 from ..bodies import KICK, KICK_DRIFT, bodies_advance, bodies_v2max, body_loads, place_bodies
 from ..neighbours import sort_by_cell
-from ..open_boundary import extrapolate_buffers, measure_boundaries, update_buffers
+from ..open_boundary import (extrapolate_buffers, measure_boundaries, relax_to_source,
+                             update_buffers)
 from ..particles import FLUID, N_SORTED_KDK, WALL
 from ..riemann import NO_RECONSTRUCTION
 from ..scene import Scene
@@ -59,6 +60,8 @@ class IsphStepper:
         self.v_ref = float(sc.isph_vref_factor * math.sqrt(2.0 * c.g * scene.water_height))
         self.wall_stop = float(sc.isph_wall_stop)
         self.relax = float(sc.isph_density_relaxation)
+        self.zone = float(sc.isph_relaxation_zone)
+        self.zone_tau = float(sc.isph_relaxation_time)
         self.rho0 = c.rho0
         self.g = c.g
         self.vol = scene.dp * scene.dp
@@ -201,6 +204,8 @@ class IsphStepper:
             n = update_buffers(ps, n, t + dt, dt, ends, prm)
             if n < 0:
                 return -1, int(n_bad), int(n_out), float(v2), float(a2)
+            if self.zone > 0.0:
+                relax_to_source(ps, n, t + dt, dt, ends, self.zone, self.zone_tau)
         n = sort_by_cell(ps, ps2, N_SORTED_KDK, n, cells)
         if self.shifting:
             shift_particles(ps2, n, cells, prm, dt)

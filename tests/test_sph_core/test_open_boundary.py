@@ -170,6 +170,39 @@ def test_isph_buffers_carry_their_imposed_acceleration():
         assert np.all(np.abs(az) < 1e-9)
 
 
+
+def test_isph_relaxation_zone_pulls_the_fluid_towards_the_source():
+    """Scheme.isph_relaxation_zone (open_boundary.relax_to_source): a fluid particle at rest at
+    distance s < L from a face moves towards the end's source velocity by a = 1 - exp(-dt q^2 /
+    tau), q = 1 - s / L; beyond L nothing changes. Here u = U sin(omega t) through both ends, the
+    source's u at the window's end (0.25 s) is U; the scene's own run with the zone keeps it."""
+    zone, tau, dt = 0.1, 0.2, 0.003
+    ends = [{"side": "left", "elevation": "imposed", "absorb": False},
+            {"side": "right", "elevation": "extrapolated", "absorb": False}]
+    sc = flume_scene(scheme="isph", open_boundaries=ends)
+    sc = sc.model_copy(update={"scheme": sc.scheme.model_copy(update={
+        "isph_relaxation_zone": zone, "isph_relaxation_time": tau})})
+    src = {s: Oscillating(n) for s, n in flume_nodes(sc).items()}
+    fl = Simulation(sc, sources=src, window=0.05)
+    fl.advance_to(0.25)
+    ps = fl.particles
+    n = ps.n
+    fluid = ps.kind[:n] == FLUID
+    ps.view.vx[:n][fluid] = 0.0
+    ps.view.vz[:n][fluid] = 0.0
+    ob.relax_to_source(ps.view, n, 0.25, dt, fl.open.ends, zone, tau)
+    x = ps.f[X, :n][fluid]
+    s = np.minimum(x, sc.tank.x1 - x)
+    q = np.where(s < 0.0, 0.0, np.clip(1.0 - s / zone, 0.0, None))   # s < 0: in a buffer's face
+    expected = (1.0 - np.exp(-dt * q * q / tau)) * src["left"].sample(0.25).u[0]
+    assert np.allclose(ps.view.vx[:n][fluid], expected, rtol=1e-9, atol=1e-12)
+    assert np.all(ps.view.vz[:n][fluid] == 0.0)
+    inside = (s >= 0.0) & (s < zone)
+    assert inside.sum() > 20 and (~inside).sum() > 20
+    assert np.all(ps.view.vx[:n][fluid][~inside] == 0.0)
+    assert expected.max() > 0.01 * 0.2   # the pull at the face: ~1.5 % of U a step
+
+
 class Straining:
     """No flow at the faces, w = w0 + A (z - z0) at every node."""
 

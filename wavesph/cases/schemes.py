@@ -21,12 +21,19 @@ RIEMANN_VARIANTS: dict[str, dict[str, Any]] = {
 
 
 def add_scheme_arguments(ap: argparse.ArgumentParser) -> None:
-    """--scheme, --reconstruction, --ppe-solver."""
+    """--scheme, --reconstruction, and the isph options --ppe-solver, --isph-density-relaxation,
+    --isph-wall-stop, --isph-relaxation-zone."""
     ap.add_argument("--scheme", choices=["wcsph", "riemann", "isph"], default="wcsph",
                     help="[scheme] kind (sph_core.scene.Scheme)")
     ap.add_argument("--reconstruction", choices=["muscl", "none"], help="riemann: reconstruction")
     ap.add_argument("--ppe-solver", choices=["bicgstab", "amg"],
-                    help="isph: pressure Poisson solver (scene default: amg)")
+                    help="isph: pressure Poisson solver (scene default: bicgstab)")
+    ap.add_argument("--isph-density-relaxation", type=float,
+                    help="isph: density-invariance weight (scene default 0.01)")
+    ap.add_argument("--isph-wall-stop", type=float,
+                    help="isph: steps over which fluid approaching a wall is stopped (default 1)")
+    ap.add_argument("--isph-relaxation-zone", type=float,
+                    help="isph: relaxation zone inside each open end [m] (default 0: none)")
 
 
 def scheme_from_args(a: argparse.Namespace) -> dict[str, Any]:
@@ -35,8 +42,11 @@ def scheme_from_args(a: argparse.Namespace) -> dict[str, Any]:
     if a.scheme == "riemann":
         if a.reconstruction is not None:
             out["reconstruction"] = a.reconstruction
-    if a.scheme == "isph" and a.ppe_solver is not None:
-        out["ppe_solver"] = a.ppe_solver
+    if a.scheme == "isph":
+        for key in ("ppe_solver", "isph_density_relaxation", "isph_wall_stop",
+                    "isph_relaxation_zone"):
+            if getattr(a, key) is not None:
+                out[key] = getattr(a, key)
     return out
 
 

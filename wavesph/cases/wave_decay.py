@@ -102,11 +102,10 @@ def amplitude_profile(model: Any, *, ramp: float, height: float, period: float, 
     if not 0.0 < gauge_wavelengths < flume_wavelengths:
         raise ValueError(f"gauge_wavelengths ({gauge_wavelengths}) must lie inside the flume "
                          f"({flume_wavelengths} wavelengths)")
-    xs = np.round(np.linspace(2.0 * math.sqrt(2.0) * dp, gauge_wavelengths * length, n_gauges),
-                  4)
+    last = round(gauge_wavelengths * length, 4)
     # the ramped front and one period past the last gauge
     cg = group_velocity(length, period, depth)
-    travel = 2.0 * flume_wavelengths * length if wait_reflection else xs[-1]
+    travel = 2.0 * flume_wavelengths * length if wait_reflection else last
     t0 = ramp + travel / cg + (1.0 + settle_periods) * period
     scene = wave_flume_scene(depth=depth, wavelength=length, height=height, dp=dp,
                              t_end=t0 + periods * period, length=flume_wavelengths * length,
@@ -114,6 +113,15 @@ def amplitude_profile(model: Any, *, ramp: float, height: float, period: float, 
                              right_elevation="extrapolated", probe_every=period / 40,
                              name="wave_decay", left_pressure=inlet_pressure, period=period,
                              **constants)
+    # the first gauge 2h past the inlet, or past an ISPH relaxation zone (inside it the velocity
+    # is pulled towards the theory's: not the SPH wave's own)
+    first = 2.0 * math.sqrt(2.0) * dp
+    if scene.scheme.kind == "isph":
+        first = max(first, scene.scheme.isph_relaxation_zone)
+    if first >= last:
+        raise ValueError(f"the gauges' span ends at {last} m, inside the first gauge's {first} m "
+                         "(an ISPH relaxation zone longer than the span)")
+    xs = np.round(np.linspace(first, last, n_gauges), 4)
     probes = [ElevationProbe(kind="elevation", name=f"g{i}", x=float(x)) for i, x in enumerate(xs)]
     scene = scene.model_copy(update={"probes": probes})
     edges = np.arange(0.0, scene.tank.x1 + 1e-9, NOISE_BIN_M)
