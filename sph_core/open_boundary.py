@@ -4,6 +4,8 @@ The step (step.run) calls three hooks, each a no-op when ``ends.active`` is Fals
     update_buffers      after the drift: impose and move buffers, then the crossings (appends)
     extrapolate_buffers after the sort: ghost-node pressure of extrapolating ends
     measure_boundaries  after the forces: the boundary gauges (eta_meas)
+and ISPH's stepper a fourth after update_buffers where its scheme asks for relaxation zones:
+    relax_to_source     the fluid's velocity pulled towards the source's near each face
 The Python side (settings, sources, windows, validation) is open_ends.OpenBoundaries.
 
 A flume has at most two open ends, index b = 0 (left, particle kinds INLET / INLET_IDLE) and
@@ -264,7 +266,6 @@ def buffer_update(ps, n, dt, r, zs0, du0, zs1, du1, ends, prm):
             ay[i] = 0.0
 
 
-
 @njit(parallel=True, cache=True)
 def relax_to_source(ps, n, t1, dt, ends, length, tau):
     """ISPH's relaxation zones (Scheme.isph_relaxation_zone): every fluid particle within
@@ -297,6 +298,7 @@ def relax_to_source(ps, n, t1, dt, ends, length, tau):
             a = 1.0 - math.exp(-dt * q * q / tau)
             vx[i] += a * (profile_value(ends.zn[b], ends.win_u[b], r, zi) - vx[i])
             vz[i] += a * (profile_value(ends.zn[b], ends.win_w[b], r, zi) - vz[i])
+
 
 # what a slot does at the face crossings (transition_of)
 T_NONE, T_TO_BUFFER, T_TO_FLUID, T_IDLE_OUT, T_FAR_OUT = range(5)
