@@ -170,12 +170,11 @@ def test_isph_buffers_carry_their_imposed_acceleration():
         assert np.all(np.abs(az) < 1e-9)
 
 
-
 def test_isph_relaxation_zone_pulls_the_fluid_towards_the_source():
     """Scheme.isph_relaxation_zone (open_boundary.relax_to_source): a fluid particle at rest at
     distance s < L from a face moves towards the end's source velocity by a = 1 - exp(-dt q^2 /
     tau), q = 1 - s / L; beyond L nothing changes. Here u = U sin(omega t) through both ends, the
-    source's u at the window's end (0.25 s) is U; the scene's own run with the zone keeps it."""
+    source's u at the window's end (0.25 s) is U; the run up to then has the zone on."""
     zone, tau, dt = 0.1, 0.2, 0.003
     ends = [{"side": "left", "elevation": "imposed", "absorb": False},
             {"side": "right", "elevation": "extrapolated", "absorb": False}]

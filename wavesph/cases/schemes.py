@@ -31,9 +31,11 @@ def add_scheme_arguments(ap: argparse.ArgumentParser) -> None:
     ap.add_argument("--isph-density-relaxation", type=float,
                     help="isph: density-invariance weight (scene default 0.01)")
     ap.add_argument("--isph-wall-stop", type=float,
-                    help="isph: steps over which fluid approaching a wall is stopped (default 1)")
+                    help="isph: steps over which fluid approaching a wall is stopped "
+                         "(scene default 1)")
     ap.add_argument("--isph-relaxation-zone", type=float,
-                    help="isph: relaxation zone inside each open end [m] (default 0: none)")
+                    help="isph: relaxation zone inside each open end [m] (scene default 0: "
+                         "none)")
 
 
 def scheme_from_args(a: argparse.Namespace) -> dict[str, Any]:
