@@ -2,6 +2,7 @@
 
     python bench/coupled_vs_sph.py [--dp 0.01] [--wavelengths 12] [--sph-only-seconds 3]
                                    [--modes two_way,absorption_only] [--out DIR]   (~30 min)
+                                   [--scheme isph --isph-... (wavesph.cases.schemes)]
 
 The flume of wavesph/cases/coupled_flume.py: regular waves (H = 0.04 m, T = 1.4 s, d = 0.24 m) from a
 Boussinesq source --wavelengths wavelengths (12: 23.6 m) up-flume of an SPH zone (open inlet,
@@ -26,6 +27,9 @@ and that reflection builds up across the scored window (the error's non-periodic
 incident wave is the reference's within 0.2 % and 0.02 rad. Smaller parts: the mean level the
 closed beach holds after the ramped front, the Boussinesq model's own bound second harmonic
 (3.6 mm against Stokes' 3.1 mm here); docs/studies/absorption.md, "The coupled flume's window".
+--scheme and its options set both SPH scenes' [scheme] (each line carries it): ISPH does not
+run this flume yet, its 1:10 beach loses still water within seconds (docs/studies/schemes.md,
+"The coupled flume's beach under ISPH"); the line then says state "unstable".
 Speed figures want a quiet machine and OpenMP's default (active) wait policy: on a shared,
 loaded machine set OMP_WAIT_POLICY=passive, which costs the small SPH zone ~27 % of its
 throughput (its parallel regions are short; a sleeping worker takes ~0.1 ms to wake).
@@ -59,6 +63,7 @@ from wave_client import G  # noqa: E402
 from wave_client.theories.linear import wavenumber  # noqa: E402
 from wavesph.analysis import (reflected_wave, rmse_over_height,  # noqa: E402
                               separate_harmonics)
+from wavesph.cases.schemes import add_scheme_arguments, scheme_from_args  # noqa: E402
 from wavesph.cases.coupled_flume import (FlumeCase, correlation, reference_run,  # noqa: E402
                                          rmse_over_h, run_coupled, run_sph_only)
 
@@ -135,13 +140,15 @@ def main(argv: list[str] | None = None) -> int:
                          "absorption-only; wavesph.cases.coupled_flume.run_coupled)")
     ap.add_argument("--h-over-dp", type=float, help="SPH smoothing length / dp (scene default)")
     ap.add_argument("--alpha-wall", type=float, help="SPH wall viscosity factor (scene default)")
+    add_scheme_arguments(ap)
     ap.add_argument("--out", type=Path, default=None, help="run directories (default: a temp dir)")
     args = ap.parse_args(argv)
+    scheme = scheme_from_args(args)
     out = args.out or Path(tempfile.mkdtemp(prefix="coupled_vs_sph-"))
     constants = {k: v for k, v in (("h_over_dp", args.h_over_dp),
                                    ("alpha_wall_factor", args.alpha_wall)) if v is not None}
     c = FlumeCase(wavelengths=args.wavelengths).at(args.dp)
-    common = {"dp": args.dp, "H": c.height, "T": c.period, "depth": c.depth, "H_over_dp":
+    common = {"dp": args.dp, "scheme": scheme, "H": c.height, "T": c.period, "depth": c.depth, "H_over_dp":
               round(c.height / args.dp, 3), "wavelengths": c.wavelengths,
               "wavelength_m": round(c.wavelength, 4), "t_end": round(c.t_end, 3),
               "compare_from": round(c.compare_from, 3), "gauge_x_from_inlet": c.gauge,
@@ -149,7 +156,7 @@ def main(argv: list[str] | None = None) -> int:
     coupled, records = {}, {}
     for mode in args.modes.split(","):
         res = run_coupled(c, args.dp, out / f"coupled_{mode}", two_way=mode == "two_way",
-                          absorb=args.absorb, constants=constants)
+                          absorb=args.absorb, constants=constants, scheme=scheme)
         records[mode] = res
         line = {"run": "coupled", "mode": res["mode"], "absorb": res["absorb"], **common,
                 "state": res["state"],
@@ -161,7 +168,8 @@ def main(argv: list[str] | None = None) -> int:
     if args.no_sph_only:
         return 0
     full = args.sph_only_seconds <= 0 or args.sph_only_seconds >= c.t_end
-    res = run_sph_only(c, args.dp, out / "sph_only", t_end=None if full else args.sph_only_seconds)
+    res = run_sph_only(c, args.dp, out / "sph_only", t_end=None if full else args.sph_only_seconds,
+                       scheme=scheme)
     build, run_wall = res["build_s"], res["wall_s"] - res["build_s"]
     wall = res["wall_s"] if full else build + run_wall * c.t_end / res["t_end"]
     sph = {"run": "sph_only", **common, "state": res["state"], "particles": res["particles"],

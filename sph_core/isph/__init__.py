@@ -11,7 +11,8 @@ on the sorted state at t^n (docs/studies/schemes.md "## ISPH" has the measuremen
 
 1. free surface (Dirichlet p = 0): the position divergence sum_j V_j F_ij r_ij^2 <= 1.5
    (``free_surface_threshold``; 2 inside the fluid in 2D, Lind et al. 2012; seed 004's density
-   criterion is retired: docs/decisions/free_surface.md);
+   criterion is retired: docs/decisions/free_surface.md), or fewer than 3 fluid and buffer
+   neighbours (a film or drop walled in by walls: without a p = 0 link its rows are singular);
 2. predictor (eq. 7): u*_i = u^n_i + dt (g + nu lap u_i), the Lo & Shao (2002) laminar term of
    wcsph.fluid_pass; walls: Adami et al. (2012) no-slip velocity;
 3. pressure Poisson equation (eq. 9-12), one sparse system over the interior fluid particles

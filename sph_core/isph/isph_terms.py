@@ -15,7 +15,7 @@ from typing import NamedTuple
 from numba import njit
 
 from ..kernels import f_of_q, w_of_q
-from ..particles import FLUID, INLET, WALL
+from ..particles import FLUID, INLET, OUTLET, WALL
 from ..terms import WallSums, adami_sum, kernel_f, viscous_momentum
 
 MAX_ROW = 64   # non-zeros per PPE row, generous: a full 2D support at h/dp 2 has ~50 neighbours
@@ -23,11 +23,15 @@ MAX_ROW = 64   # non-zeros per PPE row, generous: a full 2D support at h/dp 2 ha
 
 @njit(cache=True, inline="always")
 def surface_pair(i, j, dx, dy, dz, r2, ps, ctx, a):
-    """(kernel density sum_j m_j W_ij, position divergence sum_j V_j F_ij r_ij^2) of a fluid
-    particle. ctx = (inv_h, alpha_w, alpha_f, rho0)."""
+    """(kernel density sum_j m_j W_ij, position divergence sum_j V_j F_ij r_ij^2, count of
+    fluid and active buffer neighbours besides itself) of a fluid particle.
+    ctx = (inv_h, alpha_w, alpha_f, rho0)."""
     q = math.sqrt(r2) * ctx[0]
     mj = ps.m[j]
-    return a[0] + mj * w_of_q(q, ctx[1]), a[1] + mj / ctx[3] * f_of_q(q, ctx[2]) * r2
+    kj = ps.kind[j]
+    carried = 1 if r2 > 0.0 and (kj == FLUID or kj == INLET or kj == OUTLET) else 0
+    return (a[0] + mj * w_of_q(q, ctx[1]), a[1] + mj / ctx[3] * f_of_q(q, ctx[2]) * r2,
+            a[2] + carried)
 
 
 class WallRowSums(NamedTuple):

@@ -18,11 +18,20 @@ from .isph_terms import (WALL_ROW_SUMS_ZERO, surface_pair, symmetric_pressure_pa
                     wall_pair, wall_stop_pair)
 
 
+# a film or drop against a wall: walls fill its divergence's support, so it can read as
+# interior, and a cluster of interior particles whose only other neighbours are walls has no
+# p = 0 link in the PPE (wall rows copy the fluid's pressure): the system is singular and
+# BiCGSTAB returned NaN for every particle (a film running up a 1:10 staircase beach, dp 0.02).
+# A lattice particle in a tank's corner has 7 fluid neighbours in 2D at h/dp 1.2.
+MIN_INTERIOR_NEIGHBOURS = 3
+
+
 @njit(parallel=True, cache=True, fastmath=FASTMATH)
 def free_surface_flags(ps, n, cells, prm, threshold, flag, rho_k):
-    """flag[i] = 1 for a free-surface fluid particle (position divergence <= ``threshold``),
-    0 for an interior one, -1 for the rest; rho_k[i] = sum_j m_j W_ij (fluid, wall, buffer,
-    self included) of every fluid particle."""
+    """flag[i] = 1 for a free-surface fluid particle (position divergence <= ``threshold``, or
+    fewer than MIN_INTERIOR_NEIGHBOURS fluid and buffer neighbours), 0 for an interior one, -1
+    for the rest; rho_k[i] = sum_j m_j W_ij (fluid, wall, buffer, self included) of every fluid
+    particle."""
     kind = ps.kind
     h = prm.h
     s2 = 4.0 * h * h
@@ -31,10 +40,10 @@ def free_surface_flags(ps, n, cells, prm, threshold, flag, rho_k):
         flag[i] = -1
         if kind[i] == FLUID:
             # walked around the point (slot -1): the self term m_i W(0) counts in rho_k
-            sr, sdiv = gather(-1, ps.x[i], ps.y[i], ps.z[i], ps.cell[i], ps, cells, s2, interacting,
-                              surface_pair, ctx, (0.0, 0.0))
+            sr, sdiv, carried = gather(-1, ps.x[i], ps.y[i], ps.z[i], ps.cell[i], ps, cells, s2,
+                                       interacting, surface_pair, ctx, (0.0, 0.0, 0))
             rho_k[i] = sr
-            flag[i] = 1 if sdiv <= threshold else 0
+            flag[i] = 1 if sdiv <= threshold or carried < MIN_INTERIOR_NEIGHBOURS else 0
 
 
 @njit(parallel=True, cache=True, fastmath=FASTMATH)

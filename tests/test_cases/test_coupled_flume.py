@@ -78,6 +78,21 @@ def test_sph_zone_starts_while_its_water_is_still():
     assert sph_zone_scene(c, 0.02)["t_start"] == pytest.approx(c.t_sph_start)
 
 
+
+def test_sph_scenes_take_a_scheme_table():
+    """bench/coupled_vs_sph.py --scheme ...: both SPH scenes carry the [scheme] table they are
+    given and the server accepts it; without one they keep the scene's default (WCSPH)."""
+    dp = 0.02
+    c = FlumeCase().at(dp)
+    table = {"kind": "isph", "isph_relaxation_zone": 0.4, "isph_wall_stop": 100.0}
+    zone = RunRequest.model_validate({"scene": sph_zone_scene(c, dp, scheme=table)}).scene
+    full = RunRequest.model_validate({"scene": sph_only_scene(c, dp, scheme=table)}).scene
+    for scene in (zone, full):
+        assert scene.scheme.kind == "isph" and scene.scheme.isph_relaxation_zone == 0.4
+        assert scene.scheme.isph_wall_stop == 100.0
+    assert "scheme" not in sph_zone_scene(c, dp)
+    assert RunRequest.model_validate({"scene": sph_zone_scene(c, dp)}).scene.scheme.kind == "wcsph"
+
 def test_scenes_are_one_flume():
     """The coupled model, the reference and the SPH scenes describe the same flume: the SPH
     inlet at the model's coupling point, equal depth, z_ref = the model's reference level,

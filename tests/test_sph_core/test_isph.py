@@ -17,7 +17,7 @@ import scipy.sparse.linalg as spla
 
 from wavesph.cases.dambreak import dambreak_scene, front_errors, martin_moyce_table
 from sph_core import isph
-from sph_core.particles import P, WALL, Z
+from sph_core.particles import FLUID, P, WALL, Z
 from sph_core.scene import SceneError, make_scene
 from sph_core.simulation import Simulation
 
@@ -66,6 +66,33 @@ def test_wall_particles_without_fluid_neighbours_get_zero_pressure():
     assert np.all(st.wsum[:n][dry] == 0.0)
     assert np.all(parts.field(P)[:n][dry] == 0.0)
 
+
+
+def test_fluid_walled_in_by_walls_alone_is_free_surface():
+    """A fluid particle whose only neighbours are walls (a film or drop pressed into a bed's
+    corner) reads interior by its position divergence; its PPE row then has no p = 0 link (the
+    wall rows copy its pressure) and the singular system gave p ~ -4e18 Pa for a particle
+    moving into the corner (on a 1:10 beach, NaN for every particle). It must be free surface,
+    p = 0, stopped by the walls."""
+    dp = 0.02
+    sim = Simulation(make_scene({
+        "name": "pocket", "dp": dp, "t_end": 0.1,
+        "tank": {"x0": 0.0, "x1": 0.3, "z0": 0.0, "z1": 0.3},
+        "water_blocks": [{"x0": 0.0, "x1": 0.3, "z0": 0.0, "z1": 0.1}],
+        # two solid blocks leave one lattice site free: the tank's bottom-left corner
+        "structures": [{"x0": dp, "x1": 0.3, "z0": 0.0, "z1": 0.2},
+                       {"x0": 0.0, "x1": dp, "z0": dp, "z1": 0.2}],
+        "scheme": {"kind": "isph"}, "constants": {"h_over_dp": 1.2}}))
+    st, ps, prm = sim.stepper, sim.particles.view, sim.prm
+    n = sim.particles.n
+    (i,) = np.flatnonzero(ps.kind[:n] == FLUID)
+    isph.free_surface_flags(ps, n, sim.cells, prm, st.fs_threshold, st.flag, st.rho_k)
+    assert st.flag[i] == 1
+    ps.vx[i], ps.vz[i] = 0.3, -0.5   # moving into the corner
+    sim.advance_steps(1)
+    s = sim.fluid_state()
+    assert s["p"][0] == 0.0
+    assert abs(s["vz"][0]) < 0.05 and abs(s["vx"][0]) < 0.5
 
 @pytest.mark.parametrize("solver", isph.PPE_SOLVERS)
 def test_ppe_solvers_agree_and_give_the_hydrostatic_slope(solver):

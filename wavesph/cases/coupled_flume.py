@@ -149,8 +149,8 @@ def _tank_end(c: FlumeCase, x_toe: float, dp: float) -> float:
 
 
 def _sph_scene(c: FlumeCase, dp: float, t_end: float, x_toe: float, gauges: dict[str, float],
-               name: str, absorb: bool, constants: dict[str, Any] | None = None
-               ) -> dict[str, Any]:
+               name: str, absorb: bool, constants: dict[str, Any] | None = None,
+               scheme: dict[str, Any] | None = None) -> dict[str, Any]:
     d = c.depth
     x1 = _tank_end(c, x_toe, dp)
     return {
@@ -173,6 +173,7 @@ def _sph_scene(c: FlumeCase, dp: float, t_end: float, x_toe: float, gauges: dict
         # top at t = 15.6 s; no-slip ran through. Measured at the flat gauge (dp = 0.01,
         # absorption-only): RMSE/H 4.95 % no-slip, 6.0 % free slip.
         "constants": {"c0": 10.0 * math.sqrt(G * d), "wall_slip": "no_slip", **(constants or {})},
+        **({"scheme": scheme} if scheme else {}),
         "output": {"probe_every": c.period / 20},
         "probes": [{"kind": "elevation", "name": n, "x": x} for n, x in gauges.items()],
         # the server gets its boundary data pushed, so the scene sizes the buffer from the
@@ -183,22 +184,25 @@ def _sph_scene(c: FlumeCase, dp: float, t_end: float, x_toe: float, gauges: dict
 
 
 def sph_zone_scene(c: FlumeCase, dp: float, absorb: bool = False,
-                   constants: dict[str, Any] | None = None) -> dict[str, Any]:
+                   constants: dict[str, Any] | None = None,
+                   scheme: dict[str, Any] | None = None) -> dict[str, Any]:
     """The SPH zone of the coupled flume (server scene): inlet at SPH x = 0 (model x_c),
-    clock from ``c.t_sph_start``; ``constants`` override the scene's (e.g. h_over_dp)."""
+    clock from ``c.t_sph_start``; ``constants`` and ``scheme`` (the [scheme] table,
+    wavesph.cases.schemes) override the scene's (e.g. h_over_dp, kind = "isph")."""
     c = c.at(dp)
     scene = _sph_scene(c, dp, c.t_end, c.x_flat, c.gauges, "coupled-flume-sph-zone", absorb,
-                       constants)
+                       constants, scheme)
     return {**scene, "t_start": round(c.t_sph_start, 6)}
 
 
-def sph_only_scene(c: FlumeCase, dp: float, t_end: float | None = None) -> dict[str, Any]:
+def sph_only_scene(c: FlumeCase, dp: float, t_end: float | None = None,
+                   scheme: dict[str, Any] | None = None) -> dict[str, Any]:
     """The whole flume in SPH: inlet at the source position (SPH x = model x)."""
     c = c.at(dp)
     x0 = dp * round(c.x_couple / dp)  # the SPH zone's inlet on the particle lattice
     gauges = {n: x0 + x for n, x in c.gauges.items()}
     return _sph_scene(c, dp, c.t_end if t_end is None else t_end, x0 + c.x_flat, gauges,
-                      "sph-only-flume", absorb=False)
+                      "sph-only-flume", absorb=False, scheme=scheme)
 
 
 def wave_scene(c: FlumeCase, two_way: bool = True, reference: bool = False) -> dict[str, Any]:
@@ -305,13 +309,15 @@ def _gauges_csv(path: Path) -> tuple[np.ndarray, dict[str, np.ndarray]]:
 
 def run_coupled(c: FlumeCase, dp: float, out: Path, two_way: bool = True,
                 transport: str = "ws", absorb: str | None = None,
-                constants: dict[str, Any] | None = None) -> dict[str, Any]:
+                constants: dict[str, Any] | None = None,
+                scheme: dict[str, Any] | None = None) -> dict[str, Any]:
     """The coupled flume over a real socket: in-process server, the client as `wavesph couple
     --model boussinesq --config <out>/wave_scene.toml [--absorb]` runs it. Figures and series.
 
     absorb: who absorbs the beach's reflection at the SPH inlet; exactly one absorber, or the
     gain doubles (docs/developer/architecture.md). Default: "incident" for two-way (measured best,
-    docs/studies/absorption.md), "client" otherwise. ``constants`` override the SPH scene's.
+    docs/studies/absorption.md), "client" otherwise. ``constants`` and ``scheme``
+    override the SPH scene's.
       "none": two-way only: the model's characteristic boundary takes SPH's reflected wave
         L = (eta - u_ref / r) / 2 and hands it back in the inlet data, so the inlet passes it.
       "client": `wavesph couple --absorb`; mismatch = the inlet gauge's reading minus the
@@ -347,7 +353,8 @@ def run_coupled(c: FlumeCase, dp: float, out: Path, two_way: bool = True,
     tic = time.perf_counter()
     with InProcessServer(out) as srv, httpx.Client(base_url=f"http://127.0.0.1:{srv.port}",
                                                    timeout=60) as http:
-        r = http.post("/runs", json={"scene": sph_zone_scene(c, dp, absorb == "sph", constants),
+        r = http.post("/runs", json={"scene": sph_zone_scene(c, dp, absorb == "sph", constants,
+                                                                 scheme),
                                      "mode": "coupled",
                                      "coupling": {"window_max": c.window, "z_ref": z_ref}})
         r.raise_for_status()
@@ -382,13 +389,14 @@ def run_coupled(c: FlumeCase, dp: float, out: Path, two_way: bool = True,
     return result
 
 
-def run_sph_only(c: FlumeCase, dp: float, out: Path, t_end: float | None = None) -> dict[str, Any]:
+def run_sph_only(c: FlumeCase, dp: float, out: Path, t_end: float | None = None,
+                 scheme: dict[str, Any] | None = None) -> dict[str, Any]:
     """The whole flume in SPH (server standalone run, Stokes-2 inlet) to ``t_end`` (default the
     case's). wall_s: POST to finished; build_s: POST to the first window."""
     import httpx
 
     c = c.at(dp)
-    scene = sph_only_scene(c, dp, t_end)
+    scene = sph_only_scene(c, dp, t_end, scheme)
     source = {"theory": "stokes", "H": c.height, "T": c.period, "order": 2,
               "ramp_periods": c.ramp_periods, "window": c.window}
     out.mkdir(parents=True, exist_ok=True)
