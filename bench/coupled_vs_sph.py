@@ -63,9 +63,9 @@ from wave_client import G  # noqa: E402
 from wave_client.theories.linear import wavenumber  # noqa: E402
 from wavesph.analysis import (reflected_wave, rmse_over_height,  # noqa: E402
                               separate_harmonics)
-from wavesph.cases.schemes import add_scheme_arguments, scheme_from_args  # noqa: E402
 from wavesph.cases.coupled_flume import (FlumeCase, correlation, reference_run,  # noqa: E402
                                          rmse_over_h, run_coupled, run_sph_only)
+from wavesph.cases.schemes import add_scheme_arguments, scheme_from_args  # noqa: E402
 
 
 def _accuracy(c: FlumeCase, res: dict, gauge: str = "flat") -> dict:
@@ -148,8 +148,8 @@ def main(argv: list[str] | None = None) -> int:
     constants = {k: v for k, v in (("h_over_dp", args.h_over_dp),
                                    ("alpha_wall_factor", args.alpha_wall)) if v is not None}
     c = FlumeCase(wavelengths=args.wavelengths).at(args.dp)
-    common = {"dp": args.dp, "scheme": scheme, "H": c.height, "T": c.period, "depth": c.depth, "H_over_dp":
-              round(c.height / args.dp, 3), "wavelengths": c.wavelengths,
+    common = {"dp": args.dp, "scheme": scheme, "H": c.height, "T": c.period, "depth": c.depth,
+              "H_over_dp": round(c.height / args.dp, 3), "wavelengths": c.wavelengths,
               "wavelength_m": round(c.wavelength, 4), "t_end": round(c.t_end, 3),
               "compare_from": round(c.compare_from, 3), "gauge_x_from_inlet": c.gauge,
               "t_sph_start": round(c.t_sph_start, 3)}

@@ -15,7 +15,8 @@ from typing import NamedTuple
 from numba import njit
 
 from ..kernels import f_of_q, w_of_q
-from ..particles import FLUID, INLET, OUTLET, WALL
+from ..pairs import fluidlike
+from ..particles import FLUID, INLET, WALL
 from ..terms import WallSums, adami_sum, kernel_f, viscous_momentum
 
 MAX_ROW = 64   # non-zeros per PPE row, generous: a full 2D support at h/dp 2 has ~50 neighbours
@@ -28,8 +29,7 @@ def surface_pair(i, j, dx, dy, dz, r2, ps, ctx, a):
     ctx = (inv_h, alpha_w, alpha_f, rho0)."""
     q = math.sqrt(r2) * ctx[0]
     mj = ps.m[j]
-    kj = ps.kind[j]
-    carried = 1 if r2 > 0.0 and (kj == FLUID or kj == INLET or kj == OUTLET) else 0
+    carried = 1 if r2 > 0.0 and fluidlike(ps.kind[j]) else 0
     return (a[0] + mj * w_of_q(q, ctx[1]), a[1] + mj / ctx[3] * f_of_q(q, ctx[2]) * r2,
             a[2] + carried)
 

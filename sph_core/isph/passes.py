@@ -21,7 +21,7 @@ from .isph_terms import (WALL_ROW_SUMS_ZERO, surface_pair, symmetric_pressure_pa
 # a film or drop against a wall: walls fill its divergence's support, so it can read as
 # interior, and a cluster of interior particles whose only other neighbours are walls has no
 # p = 0 link in the PPE (wall rows copy the fluid's pressure): the system is singular and
-# BiCGSTAB returned NaN for every particle (a film running up a 1:10 staircase beach, dp 0.02).
+# BiCGSTAB returned NaN for every particle (a particle pushed into a 1:10 staircase beach).
 # A lattice particle in a tank's corner has 7 fluid neighbours in 2D at h/dp 1.2.
 MIN_INTERIOR_NEIGHBOURS = 3
 
