@@ -78,7 +78,6 @@ def test_sph_zone_starts_while_its_water_is_still():
     assert sph_zone_scene(c, 0.02)["t_start"] == pytest.approx(c.t_sph_start)
 
 
-
 def test_sph_scenes_take_a_scheme_table():
     """bench/coupled_vs_sph.py --scheme ...: both SPH scenes carry the [scheme] table they are
     given and the server accepts it; without one they keep the scene's default (WCSPH)."""
@@ -92,6 +91,7 @@ def test_sph_scenes_take_a_scheme_table():
         assert scene.scheme.isph_wall_stop == 100.0
     assert "scheme" not in sph_zone_scene(c, dp)
     assert RunRequest.model_validate({"scene": sph_zone_scene(c, dp)}).scene.scheme.kind == "wcsph"
+
 
 def test_scenes_are_one_flume():
     """The coupled model, the reference and the SPH scenes describe the same flume: the SPH

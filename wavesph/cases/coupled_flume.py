@@ -316,8 +316,8 @@ def run_coupled(c: FlumeCase, dp: float, out: Path, two_way: bool = True,
 
     absorb: who absorbs the beach's reflection at the SPH inlet; exactly one absorber, or the
     gain doubles (docs/developer/architecture.md). Default: "incident" for two-way (measured best,
-    docs/studies/absorption.md), "client" otherwise. ``constants`` and ``scheme``
-    override the SPH scene's.
+    docs/studies/absorption.md), "client" otherwise. ``constants`` and ``scheme`` override the
+    SPH scene's.
       "none": two-way only: the model's characteristic boundary takes SPH's reflected wave
         L = (eta - u_ref / r) / 2 and hands it back in the inlet data, so the inlet passes it.
       "client": `wavesph couple --absorb`; mismatch = the inlet gauge's reading minus the
@@ -353,8 +353,8 @@ def run_coupled(c: FlumeCase, dp: float, out: Path, two_way: bool = True,
     tic = time.perf_counter()
     with InProcessServer(out) as srv, httpx.Client(base_url=f"http://127.0.0.1:{srv.port}",
                                                    timeout=60) as http:
-        r = http.post("/runs", json={"scene": sph_zone_scene(c, dp, absorb == "sph", constants,
-                                                                 scheme),
+        zone = sph_zone_scene(c, dp, absorb == "sph", constants=constants, scheme=scheme)
+        r = http.post("/runs", json={"scene": zone,
                                      "mode": "coupled",
                                      "coupling": {"window_max": c.window, "z_ref": z_ref}})
         r.raise_for_status()
