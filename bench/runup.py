@@ -4,7 +4,7 @@ Synolakis' (1987) run-up law R/d = 2.831 sqrt(cot beta) (H/d)^(5/4)?
     NUMBA_NUM_THREADS=1 python bench/runup.py [--h-over-d 0.05,0.3] [--dp-over-d 0.1] [--depth 0.2]
                                               [--wall-slip free_slip] [--constants JSON]
                                               [--far-field boussinesq] [--toe-over-d 2]
-                                              [--device cuda]
+                                              [--bed-layout along_slope] [--device cuda]
 
 The canonical case (Synolakis 1987, J. Fluid Mech. 185): still water d on a flat bed, then a
 plane beach of slope 1/19.85 whose toe is L = arccosh(sqrt(20)) / k downstream of the inlet
@@ -19,7 +19,9 @@ approach costs no particles. The wedge of water over the beach is filled to the 
 run, R0 the same before the wave's front (eta > H/100) reaches the beach's toe: what the
 layout itself gives at rest. The scene's constants are the defaults (override with --constants).
 The run ends 1.5 L/c after the linear shallow-water travel time to the still shoreline (by then
-the run-up maximum has passed).
+the run-up maximum has passed). ``--bed-layout along_slope``: the beach's dummy particles in rows
+parallel to the slope (a smooth bed) instead of the tank lattice's staircase (scene ``[[beds]]``
+``layout``).
 
 The law holds for non-breaking waves (Synolakis: H/d < 0.818 (cot beta)^(-10/9), 0.030 here;
 breaking on run-down from about 0.044); H/d = 0.3 breaks on run-up, where Synolakis' data
@@ -28,7 +30,7 @@ against the non-breaking law in every case.
 
 One JSON object per H/d: H_over_d, R_over_d, R_over_d_law, R_over_d_breaking_fit, error,
 R0_over_d, stopped (null, or why the run stopped early: R is then over the records before it),
-far_field, toe_over_d (the inlet-to-toe distance / d), R_loose_over_d (the same probe counting any particle with one fluid neighbour at any
+far_field, bed_layout, toe_over_d (the inlet-to-toe distance / d), R_loose_over_d (the same probe counting any particle with one fluid neighbour at any
 height: what the wet-film criteria leave out), H_toe_over_H (the highest SPH elevation at the toe up to the run-up peak, over H), dp, d_over_dp, H_over_dp, particles, steps, t_end, wall_s, device.
 
 Beside the law, the same wave on the same beach in the nonlinear shallow-water equations
@@ -79,8 +81,8 @@ def breaking_fit(h_over_d: float) -> float:
 
 
 def runup_scene(h_over_d: float, depth: float, dp: float, wall_slip: str = "no_slip",
-                constants: dict | None = None,
-                toe_distance: float | None = None) -> tuple[dict, SolitaryWave, float]:
+                constants: dict | None = None, toe_distance: float | None = None,
+                bed_layout: str = "lattice") -> tuple[dict, SolitaryWave, float]:
     """(scene dict, the inlet's theory, x of the beach's toe [m]). The toe lies ``toe_distance``
     [m] downstream of the inlet (default: Synolakis' half-width L)."""
     H = h_over_d * depth
@@ -101,7 +103,7 @@ def runup_scene(h_over_d: float, depth: float, dp: float, wall_slip: str = "no_s
         "still_water_level": depth,
         "tank": {"x0": 0.0, "x1": x1, "z0": 0.0, "z1": z_top},
         "water_blocks": [{"x0": 0.0, "x1": x_shore, "z0": 0.0, "z1": depth}],
-        "beds": [{"points": [[x_toe, 0.0], [x1, (x1 - x_toe) / COT_BETA]]}],
+        "beds": [{"points": [[x_toe, 0.0], [x1, (x1 - x_toe) / COT_BETA]], "layout": bed_layout}],
         "open_boundaries": [{"side": "left", "elevation": "imposed"}],
         "constants": {"wall_slip": wall_slip, **(constants or {})},
         "output": {"probe_every": 0.02},
@@ -115,14 +117,15 @@ def runup_scene(h_over_d: float, depth: float, dp: float, wall_slip: str = "no_s
 
 def run_case(h_over_d: float, depth: float, dp_over_d: float, wall_slip: str = "no_slip",
              constants: dict | None = None, far_field: str = "theory",
-             toe_over_d: float | None = None, device: str | None = None) -> dict:
+             toe_over_d: float | None = None, device: str | None = None,
+             bed_layout: str = "lattice") -> dict:
     """One run-up. far_field "theory": the solitary theory drives the SPH inlet; "boussinesq":
     the Boussinesq model carries the wave to it (solitary_approach; one-way: the beach's
     reflection leaves SPH through the inlet's imposed elevation, as with the theory).
     ``device``: where the SPH steps run (None: the scene's, cpu; "cuda": an NVIDIA GPU)."""
     dp = dp_over_d * depth
     data, wave, x_toe = runup_scene(h_over_d, depth, dp, wall_slip, constants,
-                                    None if toe_over_d is None else toe_over_d * depth)
+                                    None if toe_over_d is None else toe_over_d * depth, bed_layout)
     scene = make_scene(data)
     model = (wave if far_field == "theory" else
              solitary_approach(wave.height, depth, wave.t0, scene.t_end))
@@ -175,7 +178,7 @@ def run_case(h_over_d: float, depth: float, dp_over_d: float, wall_slip: str = "
             "t_R": round(float(t[int(np.nanargmax(rise))]), 3),
             "depth": depth, "dp": round(dp, 6), "d_over_dp": round(depth / dp, 2),
             "H_over_dp": round(h_over_d * depth / dp, 2), "wall_slip": wall_slip,
-            "far_field": far_field, "toe_over_d": round(x_toe / depth, 3),
+            "far_field": far_field, "bed_layout": bed_layout, "toe_over_d": round(x_toe / depth, 3),
             **({"constants": constants} if constants else {}), "particles": sim.n_particles,
             "steps": sim.steps, "t_end": scene.t_end, "stopped": stopped, "wall_s": round(wall, 1),
             "device": device or "cpu",
@@ -198,12 +201,16 @@ def main() -> None:
     ap.add_argument("--toe-over-d", type=float, default=None,
                     help="inlet-to-toe distance / d (default Synolakis' half-width L; a short "
                          "SPH zone with --far-field boussinesq)")
+    ap.add_argument("--bed-layout", choices=("lattice", "along_slope"), default="lattice",
+                    help="the beach's dummy particles: the tank lattice's staircase, or rows "
+                         "parallel to the slope (a smooth bed)")
     ap.add_argument("--device", choices=("cpu", "cuda"), default=None,
                     help="where the SPH steps run (default: the scene's, cpu)")
     a = ap.parse_args()
     for hd in (float(v) for v in a.h_over_d.split(",")):
         print(json.dumps(run_case(hd, a.depth, a.dp_over_d, a.wall_slip, a.constants,
-                                  a.far_field, a.toe_over_d, a.device)), flush=True)
+                                  a.far_field, a.toe_over_d, a.device, a.bed_layout)),
+              flush=True)
 
 
 if __name__ == "__main__":

@@ -85,6 +85,41 @@ def _polyline_distance(bed: Bed, x: np.ndarray, z: np.ndarray) -> tuple[np.ndarr
     return dist, below
 
 
+def _along_slope(bed: Bed, dp: float, n_layers: int, x0: float, x1: float, z0: float,
+                 lattice_x: np.ndarray, lattice_z: np.ndarray, other_x: np.ndarray,
+                 other_z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Wall particles of an ``along_slope`` bed: ``n_layers`` rows parallel to each segment,
+    (k + 1/2) dp below it and spaced its length over a whole number of spacings closest to dp,
+    inside x0 < x < x1 and above the tank's floor z0 (whose rows hold the rest). Where segments
+    or the tank's walls (``other``) meet, a row point closer than 0.7 dp to one kept before is
+    dropped (concave joints); the staircase's ``lattice`` points farther than 0.8 dp from every
+    row point fill the wedges the rows leave at convex joints."""
+    from scipy.spatial import cKDTree
+    pts = np.asarray(bed.points, dtype=float)
+    kx, kz = [other_x], [other_z]
+    for (ax, az), (bx, bz) in zip(pts[:-1], pts[1:]):
+        length = math.hypot(bx - ax, bz - az)
+        tx, tz = (bx - ax) / length, (bz - az) / length        # along the segment
+        m = max(1, round(length / dp))
+        s = (np.arange(m) + 0.5) * length / m
+        k = (np.arange(n_layers) + 0.5) * dp
+        gs, gk = np.meshgrid(s, k, indexing="ij")
+        x = (ax + gs * tx + gk * tz).ravel()            # (tz, -tx): the normal into the bed
+        z = (az + gs * tz - gk * tx).ravel()
+        keep = (x > x0) & (x < x1) & (z > z0)
+        x, z = x[keep], z[keep]
+        near = cKDTree(np.column_stack([np.concatenate(kx), np.concatenate(kz)])).query(
+            np.column_stack([x, z]), distance_upper_bound=0.7 * dp)[0]
+        kx.append(x[np.isinf(near)])
+        kz.append(z[np.isinf(near)])
+    rx, rz = np.concatenate(kx[1:]), np.concatenate(kz[1:])
+    if rx.size:
+        far = np.isinf(cKDTree(np.column_stack([rx, rz])).query(
+            np.column_stack([lattice_x, lattice_z]), distance_upper_bound=0.8 * dp)[0])
+        rx, rz = np.concatenate([rx, lattice_x[far]]), np.concatenate([rz, lattice_z[far]])
+    return rx, rz
+
+
 def _rect_shell(scene: Scene, r: Rect, thickness: float) -> tuple[np.ndarray, np.ndarray]:
     x, z = _lattice(scene, r.x0, r.x1, r.z0, r.z1)
     d = np.minimum.reduce([x - r.x0, r.x1 - x, z - r.z0, r.z1 - z])
@@ -125,6 +160,10 @@ def build_layout(scene: Scene, buffers: Mapping[str, int] | None = None) -> Layo
                           max(pts[:, 1].min() - th, t.z0), min(pts[:, 1].max(), t.z1), dx)
         d, below = _polyline_distance(bed, bx, bz)
         keep = below & (d < th)
+        if bed.layout == "along_slope":
+            bx, bz = _along_slope(bed, dp, nl, t.x0, t.x1, t.z0, bx[keep], bz[keep],
+                                  np.concatenate(wx), np.concatenate(wz))
+            keep = np.ones(bx.size, dtype=bool)
         wx.append(bx[keep])
         wz.append(bz[keep])
     for s in scene.structures:

@@ -20,7 +20,7 @@ from collections.abc import Mapping
 
 import numpy as np
 
-from .geometry import Layout, _polyline_distance, wall_layers
+from .geometry import Layout, _along_slope, _polyline_distance, wall_layers
 from .scene import Rect, Scene
 
 
@@ -114,6 +114,11 @@ def build_layout_3d(scene: Scene, buffers: Mapping[str, int] | None = None) -> L
         d, below = _polyline_distance(bed, gx, gz)
         keep = below & (d < th)
         x2, z2 = gx[keep], gz[keep]
+        if bed.layout == "along_slope":      # against the tank's x-z section: floor, x walls
+            sx, sz = _grid(xin, zfl)
+            cx, cz = _grid(np.concatenate([xlo, xhi]), zcol)
+            x2, z2 = _along_slope(bed, dp, nl, t.x0, t.x1, t.z0, x2, z2,
+                                  np.concatenate([sx, cx]), np.concatenate([sz, cz]))
         parts.append((np.repeat(x2, yin.size), np.tile(yin, x2.size), np.repeat(z2, yin.size)))
     for s in scene.structures:
         if s.shape == "cylinder":

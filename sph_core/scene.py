@@ -107,9 +107,14 @@ class WaterBlock(Rect):
 
 
 class Bed(_Model):
-    """A sloping bed: a polyline (x increasing) with dummy particles in layers below it."""
+    """A sloping bed: a polyline (x increasing) with dummy particles in layers below it (in 3D
+    extruded across the width)."""
 
     points: list[tuple[float, float]] = Field(min_length=2)
+    layout: Literal["lattice", "along_slope"] = Field(
+        "lattice", description="the dummy particles: `lattice` the tank's lattice points below "
+        "the line (a staircase along a slope); `along_slope` rows parallel to each segment, dp "
+        "apart along and across it (a smooth bed; docs/studies/runup.md)")
 
     @model_validator(mode="after")
     def _increasing(self) -> "Bed":

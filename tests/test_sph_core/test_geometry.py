@@ -41,6 +41,42 @@ def test_every_column_on_a_slope_meets_the_bed_at_spacing_dp(dp, slope):
     assert np.allclose(gaps, dp, rtol=1e-6), sorted(set(np.round(np.array(gaps) / dp, 3)))
 
 
+@pytest.mark.parametrize("dp,slope", [(0.02, 0.1), (0.01, 1 / 19.85), (0.02, 0.3)])
+def test_an_along_slope_bed_is_rows_parallel_to_it_that_leave_no_hole(dp, slope):
+    """``layout = along_slope``: along the slope the dummy particles are rows (k + 1/2) dp below
+    the line (a smooth bed, not the lattice's staircase); where the slope meets the floor, a
+    crest (a convex joint) and the right wall, no two are closer than 0.7 dp and no point
+    of the walls' thickness below the line is 0.9 dp or farther from one (no hole)."""
+    x_crest = 2.0 + 0.3 / slope
+    scene = make_scene({"dp": dp, "t_end": 0.1, "tank": {"x0": 0.0, "x1": x_crest + 0.5,
+                                                         "z0": 0.0, "z1": 0.6},
+                        "water_blocks": [{"x0": 0.0, "x1": 2.0 + 0.24 / slope, "z0": 0.0,
+                                          "z1": 0.24}],
+                        "beds": [{"points": [[2.0, 0.0], [x_crest, 0.3], [x_crest + 0.5, 0.3]],
+                                  "layout": "along_slope"}]})
+    lay = build_layout(scene)
+    bed, th = scene.beds[0], lay.n_layers * dp
+    wx, wz = lay.wall_x, lay.wall_z
+    dist, below = _polyline_distance(bed, wx, wz)
+    # the rows away from the toe's wedge (where the floor's rows take over) and the crest
+    mid = below & (wx > 2.0 + 2 * dp / slope) & (wx < x_crest - 0.1) & (dist < th) & (wz > 0.0)
+    rows = dist[mid] / dp - 0.5
+    assert mid.sum() > 20 * lay.n_layers
+    assert np.allclose(rows, np.round(rows), atol=1e-9), sorted(set(np.round(rows, 3)))
+    pts = np.column_stack([wx, wz])
+    gap = np.sqrt(((pts[:, None, :] - pts[None, :, :]) ** 2).sum(-1))
+    np.fill_diagonal(gap, np.inf)
+    assert gap.min() > 0.7 * dp
+    sx, sz = np.meshgrid(np.linspace(1.9, x_crest + 0.5, 400), np.linspace(0.0, 0.31, 80))
+    sx, sz = sx.ravel(), sz.ravel()
+    d, under = _polyline_distance(bed, sx, sz)
+    band = under & (d > 0.5 * dp) & (d < th - 0.5 * dp) & (sx < x_crest + 0.5 - dp)
+    probe = np.column_stack([sx, sz])[band]
+    reach = np.sqrt(((probe[:, None, :] - pts[None, :, :]) ** 2).sum(-1)).min(axis=1)
+    assert reach.max() < 0.9 * dp, reach.max() / dp   # the lattice's: 0.71 dp; seams ~0.85 dp
+    _, fluid_below = _polyline_distance(bed, lay.fluid_x, lay.fluid_z)
+    assert not fluid_below.any()
+
 
 def tank_scene(length: float, dp: float, h_over_dp: float = 1.4142, beds=()):
     return make_scene({"dp": dp, "t_end": 1.0,

@@ -152,3 +152,21 @@ def test_a_vertical_cylinder_is_rings_of_wall_particles_with_the_fluid_outside()
                                             z0=0.0, z1=0.4)]))
     with pytest.raises(SceneError, match="3D scene"):
         make_scene(_box(2, structures=[dict(shape="cylinder", x0=0.1, x1=0.3, z0=0.0, z1=0.4)]))
+
+
+def test_an_along_slope_bed_is_its_2d_rows_in_every_y_column():
+    from sph_core.geometry import _polyline_distance
+    from sph_core.geometry3d import build_layout_3d
+
+    bed = dict(points=[[0.1, 0.0], [0.4, 0.1]], layout="along_slope")
+    sc = make_scene(_box(3, beds=[bed]))
+    lay = build_layout_3d(sc)
+    dist, below = _polyline_distance(sc.beds[0], lay.wall_x, lay.wall_z)
+    inside = (lay.wall_y > 0.0) & (lay.wall_y < 0.3) & (lay.wall_z > 0.0)   # not the y walls
+    on = inside & below & (lay.wall_x > 0.25) & (lay.wall_x < 0.4) & (dist < 0.04)
+    rows = dist[on] / 0.02 - 0.5
+    np.testing.assert_allclose(rows, np.round(rows), atol=1e-9)   # (k + 1/2) dp below the line
+    ys = np.unique(np.round(lay.wall_y[on], 9))
+    assert ys.size == round(0.3 / 0.02)                          # every column across the width
+    per_y = [np.sum(np.isclose(lay.wall_y[on], y)) for y in ys]
+    assert min(per_y) == max(per_y) > 10
