@@ -53,15 +53,17 @@ def test_runup_probe_needs_still_water_level():
                     "probes": [{"kind": "runup", "name": "r"}]})
 
 
-def test_still_water_on_a_beach_runs_up_to_the_still_water_level():
-    """d = 0.1 m, dp = 0.01 m, a 1:5 beach: for 0.3 s the shoreline stays within dp of still water
-    (the layout fills the wedge to the still shoreline x = 0.8 m) and R is the running max."""
+@pytest.mark.parametrize("layout", ["lattice", "along_slope"])
+def test_still_water_on_a_beach_runs_up_to_the_still_water_level(layout):
+    """d = 0.1 m, dp = 0.01 m, a 1:5 beach of either layout: for 0.3 s the shoreline stays within
+    dp of still water (the layout fills the wedge to the still shoreline x = 0.8 m), R is the
+    running max, and no water goes into the bed."""
     dp, d = 0.01, 0.1
     scene = make_scene({
         "dp": dp, "t_end": 0.3, "still_water_level": d,
         "tank": {"x0": 0.0, "x1": 1.0, "z0": 0.0, "z1": 0.2},
         "water_blocks": [{"x0": 0.0, "x1": 0.8, "z0": 0.0, "z1": d}],
-        "beds": [{"points": [[0.3, 0.0], [1.0, 0.14]]}],
+        "beds": [{"points": [[0.3, 0.0], [1.0, 0.14]], "layout": layout}],
         "constants": {"wall_slip": "no_slip"},
         "output": {"probe_every": 0.05},
         "probes": [{"kind": "runup", "name": "shore", "near_bed": 2 * dp}]})
@@ -76,3 +78,6 @@ def test_still_water_on_a_beach_runs_up_to_the_still_water_level():
     assert np.all((z - 0.2 * (xs - 0.3) > 0) & (z - 0.2 * (xs - 0.3) <= 2 * dp))  # near_bed
     np.testing.assert_allclose(R, np.maximum.accumulate(z - d), atol=1e-12)
     assert np.all(np.abs(z - d) <= dp), z - d
+    st = sim.fluid_state()
+    # the layouts put water up to the line (the lattice's lowest points 0.0-1 dp above it)
+    assert (st["z"] - bed_elevation([[(0.3, 0.0), (1.0, 0.14)]], 0.0, st["x"])).min() > 0.0
