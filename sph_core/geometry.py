@@ -7,7 +7,9 @@ at the wall sees a full kernel support (2h) of dummy particles. The side walls a
 sloping beds) between them are spaced ``wall_dx`` = (x1 - x0) / round((x1 - x0) / dp), so that
 they meet both columns one spacing away whatever the tank length. (On the dp lattice a tank
 402.5 dp long left a gap of 1.5 dp at the right corner in every layer, through which a violent
-impact pushed fluid out of the tank: docs/studies/wall_pressure.md.)
+impact pushed fluid out of the tank: docs/studies/wall_pressure.md.) A bed's dummies are those
+lattice points below its line (a staircase along a slope), or with ``layout = "along_slope"``
+rows parallel to each segment (a smooth bed: more run-up, docs/studies/runup.md).
 """
 
 from __future__ import annotations
@@ -18,6 +20,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.spatial import cKDTree
 
 from .scene import Bed, Rect, Scene
 
@@ -94,7 +97,6 @@ def _along_slope(bed: Bed, dp: float, n_layers: int, x0: float, x1: float, z0: f
     or the tank's walls (``other``) meet, a row point closer than 0.7 dp to one kept before is
     dropped (concave joints); the staircase's ``lattice`` points farther than 0.8 dp from every
     row point fill the wedges the rows leave at convex joints."""
-    from scipy.spatial import cKDTree
     pts = np.asarray(bed.points, dtype=float)
     kx, kz = [other_x], [other_z]
     for (ax, az), (bx, bz) in zip(pts[:-1], pts[1:]):
