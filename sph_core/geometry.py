@@ -162,12 +162,12 @@ def build_layout(scene: Scene, buffers: Mapping[str, int] | None = None) -> Layo
                           max(pts[:, 1].min() - th, t.z0), min(pts[:, 1].max(), t.z1), dx)
         d, below = _polyline_distance(bed, bx, bz)
         keep = below & (d < th)
+        bx, bz = bx[keep], bz[keep]
         if bed.layout == "along_slope":
-            bx, bz = _along_slope(bed, dp, nl, t.x0, t.x1, t.z0, bx[keep], bz[keep],
+            bx, bz = _along_slope(bed, dp, nl, t.x0, t.x1, t.z0, bx, bz,
                                   np.concatenate(wx), np.concatenate(wz))
-            keep = np.ones(bx.size, dtype=bool)
-        wx.append(bx[keep])
-        wz.append(bz[keep])
+        wx.append(bx)
+        wz.append(bz)
     for s in scene.structures:
         sx, sz = _rect_shell(scene, s, th)
         keep = (sx > t.x0) & (sx < t.x1) & (sz > t.z0)

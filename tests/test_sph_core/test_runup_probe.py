@@ -80,4 +80,4 @@ def test_still_water_on_a_beach_runs_up_to_the_still_water_level(layout):
     assert np.all(np.abs(z - d) <= dp), z - d
     st = sim.fluid_state()
     # the layouts put water up to the line (the lattice's lowest points 0.0-1 dp above it)
-    assert (st["z"] - bed_elevation([[(0.3, 0.0), (1.0, 0.14)]], 0.0, st["x"])).min() > 0.0
+    assert (st["z"] - bed_elevation([scene.beds[0].points], 0.0, st["x"])).min() > 0.0
