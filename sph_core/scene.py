@@ -748,7 +748,7 @@ def datum_mismatch(swl: float, block_top: float, z0: float, dp: float) -> str | 
     if not math.isfinite((block_top - z0) / dp):   # dp 5e-324: the particle cap refuses it
         return None
     surface = filled_surface(block_top, z0, dp)
-    if abs(surface - swl) <= 1e-3 * dp:   # round-off of dp values such as H/3
+    if _on_level(surface, swl, dp):
         return None
     depth = swl - z0
     rows = depth / dp
@@ -756,7 +756,24 @@ def datum_mismatch(swl: float, block_top: float, z0: float, dp: float) -> str | 
     return (f"{swl:g} m is {rows:.4g} dp above the tank floor z0 = {z0:g} m (dp = {dp:g} m): "
             f"the particles would fill to {surface:.4g} m and every elevation gauge would read "
             f"{surface - swl:+.3g} m in still water; pick a dp that divides the depth {depth:g} m, "
-            f"e.g. {fine:.4g} or {coarse:.4g} m")
+            f"e.g. {divisor_text(depth, fine)} or {divisor_text(depth, coarse)} m")
+
+
+def divisor_text(depth: float, dp: float) -> str:
+    """The shortest decimal of ``dp``, a divisor of ``depth``, that a scene accepts as one (its
+    rows still fill to the depth, datum_mismatch): what to write in a scene file. Four digits are
+    not always enough (0.3 m / 17 = 0.01765 fills to 0.30005 m)."""
+    rows = round(depth / dp)
+    for digits in range(1, 18):
+        text = f"{dp:.{digits}g}"
+        d = float(text)
+        if round(depth / d) == rows and _on_level(filled_surface(depth, 0.0, d), depth, d):
+            return text
+    return repr(dp)
+
+
+def _on_level(surface: float, swl: float, dp: float) -> bool:
+    return abs(surface - swl) <= 1e-3 * dp   # round-off of dp values such as H/3
 
 
 def _format_errors(exc: ValidationError) -> str:

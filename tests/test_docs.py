@@ -47,6 +47,32 @@ def test_check_flag_exits_1_with_the_regenerate_command_when_stale(tool, page, m
     assert mod.main([]) == 0 and capsys.readouterr().out == "not the page\n"
 
 
+def test_speed_accuracy_rows_are_the_shipped_sweeps() -> None:
+    """The validation page's speed-accuracy rows and its chart come from the sweep data the plan
+    fits (docs/tools/accuracy_chart.py), repeats merged into one row with their range."""
+    import json
+
+    from wavesph.studies import sweeps
+
+    tool = _load("accuracy_chart")
+    shipped = [json.loads(ln) for ln in tool.ROWS.read_text(encoding="utf-8").splitlines()]
+    assert shipped == tool.all_rows(), "stale: run python docs/tools/accuracy_chart.py"
+    for data, figure in tool.CHARTS:
+        meta = json.loads(data.with_suffix(".meta.json").read_text())
+        records = sweeps.read_csv(data)
+        rows = tool.result_rows(records, meta)
+        assert len(rows) == len({(r["case"], r["method"], r["dp"]) for r in records})
+        assert all(r["command"] == meta["made_by"] and r["date"] for r in rows)
+        assert figure.exists()
+    merged = tool.result_rows([{"case": "flume_V", "method": "m", "dp": 0.02, "H_over_dp": 3.0,
+                                "error": e, "wall_s": w, "particles": 9, "status": s}
+                               for e, w, s in ((0.05, 10.0, "ok"), (0.07, 14.0, "ok"),
+                                               (None, None, "unstable"))], meta)
+    assert [r["measured"] for r in merged] == [{
+        "method": "m", "dp_m": 0.02, "resolution": "H/dp 3", "error": "6.00 % (5.00-7.00)",
+        "wall_s": 12.0, "particles": 9, "status": "2 of 3 ok (unstable)"}]
+
+
 def test_scene_reference_lists_every_scene_key() -> None:
     """Each root key and each table's key of the Scene model has a row on the page."""
     from sph_core.scene import Constants, OpenBoundary, Scene, Scheme

@@ -1,27 +1,82 @@
-"""Redraw docs/figures/accuracy_quick.png from the shipped sweep data (no run).
+"""Redraw the speed-accuracy charts (docs/figures/accuracy_*.png) and the validation page's
+speed-accuracy rows (bench/results/accuracy_sweep.jsonl) from the shipped sweep data (no run).
 
     python docs/tools/accuracy_chart.py
+    python docs/tools/validation_tables.py > docs/validation.md    # then the page
 
-The data, wavesph/cases/data/accuracy_sweep.csv, are the records of the command in its
-.meta.json (``made_by``); `wavesph bench accuracy` writes the same chart beside its own CSV.
+The data: wavesph/cases/data/accuracy_sweep.csv (the quick preset, every method, with repeats:
+what `wavesph plan` fits) and bench/results/accuracy_sweep_full_defaults.csv (the full preset's
+spacings and windows for today's WCSPH defaults, the cases a 2-core machine runs). Each is the
+records of the command in its .meta.json (``made_by``, with the date and machine);
+`wavesph bench accuracy` writes the same chart beside its own CSV. Repeats of a point
+(``--repeats``) make one row: the mean error, its range and the mean wall time.
 """
 
 from __future__ import annotations
 
 import json
 from pathlib import Path
+from typing import Any
 
 from wavesph.studies import sweeps
 
 ROOT = Path(__file__).resolve().parents[2]
 DATA = ROOT / "wavesph" / "cases" / "data" / "accuracy_sweep.csv"
-FIGURE = ROOT / "docs" / "figures" / "accuracy_quick.png"
+FULL = ROOT / "bench" / "results" / "accuracy_sweep_full_defaults.csv"
+CHARTS = [(FULL, ROOT / "docs" / "figures" / "accuracy_full_defaults.png"),   # (data, figure)
+          (DATA, ROOT / "docs" / "figures" / "accuracy_quick.png")]
+ROWS = ROOT / "bench" / "results" / "accuracy_sweep.jsonl"
+
+SCORES = {"flume": "RMSE/H at mid-flume vs theory",
+          "dambreak": "RMS front error vs Martin & Moyce (T ≤ 3)",
+          "coupled": "RMSE/H at the flat-bed gauge vs Boussinesq-only"}
+
+
+def result_rows(records: list[dict[str, Any]], meta: dict[str, str]) -> list[dict[str, Any]]:
+    """One results row per (case, method, dp): its repeats' mean error and range, mean wall time,
+    and how many ran through; in the sweep's order."""
+    groups: dict[tuple[str, str, float], list[dict[str, Any]]] = {}
+    for r in records:
+        groups.setdefault((r["case"], r["method"], float(r["dp"])), []).append(r)
+    rows = []
+    for (case, method, dp), rs in groups.items():
+        ok = [r for r in rs if r.get("status") == "ok" and r.get("error")]
+        measured: dict[str, Any] = {"method": method, "dp_m": float(f"{dp:.4g}")}
+        ratio = rs[0].get("H_over_dp")
+        if ratio:
+            measured["resolution"] = f"{'a' if case == 'dambreak' else 'H'}/dp {float(ratio):.3g}"
+        if ok:
+            err = [float(r["error"]) for r in ok]
+            measured["error"] = f"{100 * sum(err) / len(err):.2f} %" + (
+                f" ({100 * min(err):.2f}-{100 * max(err):.2f})" if len(err) > 1 else "")
+            measured["wall_s"] = float(f"{sum(float(r['wall_s']) for r in ok) / len(ok):.3g}")
+            measured["particles"] = ok[0].get("particles")
+        statuses = sorted({r.get("status") for r in rs})
+        measured["status"] = (f"{len(ok)} of {len(rs)} ok" if len(rs) > 1 else statuses[0]) + (
+            "" if len(ok) == len(rs) else f" ({', '.join(s for s in statuses if s != 'ok')})")
+        rows.append({"bench": "accuracy_sweep", "question": "accuracy",
+                     "case": f"{case}: {SCORES[case.split('_')[0]]}", "measured": measured,
+                     "command": meta["made_by"], "date": meta.get("date", ""),
+                     "machine": meta.get("machine", "")})
+    return rows
+
+
+def all_rows() -> list[dict[str, Any]]:
+    """The results rows of every chart's data, in CHARTS order."""
+    rows = []
+    for data, _ in CHARTS:
+        rows += result_rows(sweeps.read_csv(data), json.loads(data.with_suffix(".meta.json").read_text()))
+    return rows
 
 
 def main() -> None:
-    made_by = json.loads(DATA.with_suffix(".meta.json").read_text())["made_by"]
-    sweeps.plot_accuracy(sweeps.read_csv(DATA), FIGURE, title=f"{made_by} (under load)")
-    print(f"wrote {FIGURE.relative_to(ROOT)} from {DATA.relative_to(ROOT)}")
+    for data, figure in CHARTS:
+        meta = json.loads(data.with_suffix(".meta.json").read_text())
+        sweeps.plot_accuracy(sweeps.read_csv(data), figure, title=sweeps.chart_title(meta))
+        print(f"wrote {figure.relative_to(ROOT)} from {data.relative_to(ROOT)}")
+    ROWS.write_text("".join(json.dumps(r, ensure_ascii=False) + "\n" for r in all_rows()),
+                    encoding="utf-8")
+    print(f"wrote {ROWS.relative_to(ROOT)}")
 
 
 if __name__ == "__main__":

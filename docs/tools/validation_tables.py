@@ -42,15 +42,15 @@ QUESTIONS: dict[str, tuple[str, ...]] = {
                  "`wcsph_kdk` (h/dp √2, wall AV 1), `wcsph_kdk_h2_wallav0` (today's WCSPH defaults), "
                  "`riemann_muscl`, `isph_bicgstab`; flume cases of Verbrugghe et al. (2019); "
                  "`coupled`: 2 wavelengths of Boussinesq before the SPH zone, against SPH alone over "
-                 "the same length. Wall times under load. Filled points: each method's Pareto "
-                 "front (more time bought less error); hollow: a refinement that cost more and "
-                 "erred more; dashed grey: the front over all methods; `--repeats N` runs each "
-                 "point N times (a flume's ramp 0.1 % longer each) and draws the run-to-run "
-                 "scatter as bars. Its flume_I points were scored against the linear standing "
-                 "wave; the sweep now scores case I against the second-order one (2.6 % at H/dp 8 "
-                 "against 5.2 %). Redrawn from the shipped data by "
-                 "`python docs/tools/accuracy_chart.py`.",
-                 "![speed-accuracy chart, quick preset, under load](figures/accuracy_quick.png)"),
+                 "the same length. Filled points: each method's Pareto front (more time bought "
+                 "less error); hollow: a refinement that cost more and erred more; dashed grey: "
+                 "the front over all methods; `--repeats N` runs each point N times (a flume's "
+                 "ramp 0.1 % longer each): a row gives the repeats' mean error with its range "
+                 "and their mean wall time, and the chart draws the range as bars. The full "
+                 "preset (every method, H/dp 3, 5 and 8, every case: case II at H/dp 8 has 0.5 M "
+                 "particles) is for a bigger machine (`--scheduler`). The chart is at the top of "
+                 "this page; it and these rows are redrawn from the shipped data by "
+                 "`python docs/tools/accuracy_chart.py`."),
     "bodies": ("Rigid bodies", "Floating and moving bodies against theory."),
     "runup": ("Run-up", "How far up a 1:19.85 plane beach does a solitary wave run in SPH, against "
                         "Synolakis' (1987) law R/d = 2.831 sqrt(cot beta) (H/d)^(5/4)? "
@@ -137,10 +137,37 @@ def table(records: list[dict[str, Any]]) -> list[str]:
     return lines
 
 
+# the speed-accuracy charts, first on the page: (what it shows, its data's meta.json, figure)
+CHARTS = [("Today's WCSPH defaults at the full preset's spacings (H/dp 3, 5, 8) and windows (3 "
+           "periods), the cases a 2-core machine runs",
+           ROOT / "bench" / "results" / "accuracy_sweep_full_defaults.meta.json",
+           "figures/accuracy_full_defaults.png"),
+          ("Four methods at the quick preset's coarse spacings, each point three times (the data "
+           "`wavesph plan` fits)",
+           ROOT / "wavesph" / "cases" / "data" / "accuracy_sweep.meta.json",
+           "figures/accuracy_quick.png")]
+
+
+def chart_block() -> list[str]:
+    """The speed-accuracy charts with the command, date and machine of the sweep each was drawn
+    from."""
+    out = ["## Speed against accuracy: the charts", "",
+           "Redrawn by `python docs/tools/accuracy_chart.py`. Filled points: each method's Pareto "
+           "front; hollow: a refinement that cost more and erred more; bars: the run-to-run "
+           "scatter of repeats; the rows and what each case scores are under [Speed against "
+           "accuracy](#speed-against-accuracy) ([study](studies/speed_accuracy.md)).", ""]
+    for what, meta_path, figure in CHARTS:
+        meta = json.loads(meta_path.read_text())
+        when = ", ".join(meta[k] for k in ("date", "machine") if k in meta)
+        out += [f"{what}: `{meta['made_by']}`" + (f" ({when})." if when else "."), "",
+                f"![speed against accuracy: {Path(figure).stem}]({figure})", ""]
+    return out
+
+
 def render(results: Path = RESULTS) -> str:
     records = load_records(results)
     order = list(QUESTIONS) + sorted({r["question"] for r in records} - set(QUESTIONS))
-    out = [HEADER]
+    out = [HEADER] + chart_block()
     for q in order:
         group = [r for r in records if r["question"] == q]
         if not group:

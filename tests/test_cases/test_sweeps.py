@@ -9,8 +9,10 @@ quick presets end to end and the plan against measured runs (test_plan_predictio
 from __future__ import annotations
 
 import csv
+import datetime
 import json
 import math
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -69,8 +71,13 @@ def test_sweep_csv_and_chart(swept, tmp_path):
     path = tmp_path / "accuracy.csv"
     sweeps.write_csv(records, path, command="wavesph bench accuracy --test")
     assert path.read_text().startswith("case,method,")     # one header row, no # line
-    assert json.loads(path.with_suffix(".meta.json").read_text())["made_by"] == \
-        "wavesph bench accuracy --test"
+    meta = json.loads(path.with_suffix(".meta.json").read_text())
+    assert meta["made_by"] == "wavesph bench accuracy --test"
+    # the chart says when and where its wall times were taken (a loaded machine's are slower)
+    assert meta["date"] == datetime.datetime.now(datetime.timezone.utc).date().isoformat()
+    assert f"{os.cpu_count()} cores" in meta["machine"] and "load average" in meta["machine"]
+    assert sweeps.chart_title(meta).splitlines() == [meta["made_by"], meta["date"], meta["machine"]]
+    assert sweeps.chart_title({"made_by": "x"}) == "x"     # a table of an earlier version
     import pandas
 
     assert pandas.read_csv(path).shape == (3, len(ACCURACY_COLUMNS))
@@ -94,6 +101,11 @@ def test_presets_cover_every_method_and_case():
     assert len({p.key for p in full}) == len(full)
     with pytest.raises(ValueError, match="unknown methods"):
         sweeps.accuracy_points(methods=["no_such_scheme"])
+    # a subset of the cases: the same points as the preset's, nothing else
+    some = sweeps.accuracy_points(quick=False, cases=["flume_V", "dambreak"])
+    assert some == [p for p in full if p.case in ("flume_V", "dambreak")]
+    with pytest.raises(ValueError, match="unknown cases"):
+        sweeps.accuracy_points(cases=["flume_VII"])
 
 
 def test_repeats_are_other_realisations_and_the_chart_shows_their_scatter(tmp_path):
@@ -119,6 +131,11 @@ def test_repeats_are_other_realisations_and_the_chart_shows_their_scatter(tmp_pa
 
     records = [rec(0.02, 0, 0.05, 10.0), rec(0.02, 1, 0.07, 14.0), rec(0.02, 2, 0.06, 12.0),
                rec(0.01, 0, 0.03, 80.0), rec(0.01, 1, None, None, "unstable")]
+    # three equal errors whose mean rounds above them (a deterministic case repeated): no
+    # negative bar
+    same = [rec(0.005, j, 0.7767689168250291, 0.48950868077918164) for j in range(3)]
+    g = sweeps.repeat_groups(same)[0]
+    assert g["error"] > g["error_max"] and g["wall_s"] < g["wall_min"]
     groups = sweeps.repeat_groups(records)
     assert [(g["dp"], g["n"]) for g in groups] == [(0.02, 3), (0.01, 1)]
     g = groups[0]
@@ -128,7 +145,7 @@ def test_repeats_are_other_realisations_and_the_chart_shows_their_scatter(tmp_pa
     sweeps.write_csv(records, path)
     assert [r["repeat"] for r in sweeps.read_csv(path)] == [0, 1, 2, 0, 1]
     png = tmp_path / "accuracy.png"
-    sweeps.plot_accuracy(records, png)
+    sweeps.plot_accuracy(records + same, png)
     assert png.stat().st_size > 10_000
 
 
@@ -206,6 +223,14 @@ def test_plan_dp_divides_the_depth_and_counts_steps_at_the_scenes_c0(tmp_path):
     req = planning.PlanRequest(height=0.04, period=2.0, depth=0.25, duration=10.0)
     plan = planning.make_plan(req, data)
     assert round(0.25 / plan.dp, 3) == 38 and plan.expected_error <= 0.05
+    # ... written so that a scene accepts it: 0.3 m / 17 rounded to 0.01765 fills to 0.30005 m
+    # and the scene refuses it (datum_mismatch)
+    from sph_core.scene import datum_mismatch
+
+    odd = planning.make_plan(planning.PlanRequest(height=0.06, period=2.0, depth=0.3,
+                                                  duration=10.0, target_error=0.3 / 3.4), data)
+    assert round(0.3 / odd.dp) == 17 and datum_mismatch(0.3, 0.3, 0.0, odd.dp) is None
+    assert datum_mismatch(0.25, 0.25, 0.0, plan.dp) is None
     # a scene's default c0 is 10 sqrt(2 g d), sqrt 2 that of the plan's own flumes: as many more
     # steps (the review measured x1.49 more than `plan` predicted)
     fast = planning.make_plan(req, data, dp=0.01)
@@ -314,15 +339,17 @@ def test_plan_predictions_slow(height, period, depth):
     from wavesph.analysis import group_velocity
     from wavesph.cases.wave_flume import flume_case
 
-    tp = planning.measure_throughput("wcsph_kdk")
+    method = "wcsph_kdk_h2_wallav0"   # today's WCSPH defaults (the plan's own choice of scheme)
+    tp = planning.measure_throughput(method)
     model = build_theory("stream", height=height, period=period, depth=depth, ramp_time=period,
                          n_fourier=16)
     wl = float(model.length)
     periods = 2.0
     duration = period + 0.5 * wl / group_velocity(wl, period, depth) + periods * period
     req = planning.PlanRequest(height=height, period=period, depth=depth, duration=duration,
-                               target_error=0.08)
-    plan = planning.make_plan(req, throughput=tp, methods=["wcsph_kdk"])
+                               target_error=0.02)   # inside the sweep's H/dp range, not
+    # clamped to its coarsest end: a plan of a few seconds' run is mostly fixed per-step costs
+    plan = planning.make_plan(req, throughput=tp, methods=[method])
     res = flume_case(model, height=height, period=period, depth=depth, wavelength=wl, dp=plan.dp,
                      periods=periods, ramp=period, **sweeps.METHODS[plan.method])
     info = {"plan": plan.to_json(), "measured_error": res["rmse_over_H"],
@@ -416,7 +443,8 @@ def test_plan_table_says_what_to_do_and_what_it_rests_on(tmp_path, capsys):
     assert not any(line.startswith("{") for line in out.splitlines())   # JSON only with --json
     assert "Rests on: error = 0.3 (H/dp)^-1.00 fitted to 3 flume points" in out
     assert "H/dp 2-8" in out and "c0 = 15.3 m/s" in out     # the scene's own c0
-    assert "To apply it, in the scene file:" in out and "    dp = 0.006667" in out
+    # 0.24 m / 36 in the digits the scene accepts (0.006667 fills to 0.240012 m: refused)
+    assert "To apply it, in the scene file:" in out and "    dp = 0.0066667\n" in out
     assert "flat + 3.4 structures" in out
 
 

@@ -5,7 +5,7 @@ from pathlib import Path
 
 import pytest
 
-from sph_core.scene import SceneError, load_scene, make_scene
+from sph_core.scene import SceneError, datum_mismatch, divisor_text, load_scene, make_scene
 
 ROOT = Path(__file__).resolve().parents[2]
 BASE = {"dp": 0.01, "t_end": 1.0, "tank": {"x0": 0, "x1": 1, "z0": 0, "z1": 1},
@@ -83,4 +83,23 @@ def test_a_dp_that_does_not_divide_the_depth_is_refused_with_divisors_to_pick():
         make_scene(scene)
     for dp in (0.0375, 0.04286, 0.03, 0.1 / 3):   # divisors (the last one as a float)
         assert make_scene({**scene, "dp": dp}).dp == dp
+
+
+@pytest.mark.parametrize("depth, rows", [(0.3, 17), (0.24, 17), (0.7, 75), (0.7, 38), (1.0, 3),
+                                         (0.3, 16), (0.24, 400)])
+def test_a_suggested_divisor_is_one_the_scene_accepts(depth, rows):
+    # four digits are not always enough: 0.3 m / 17 written 0.01765 fills to 0.30005 m, and the
+    # refusal's own suggestion, or a plan's dp, must not be refused in turn
+    text = divisor_text(depth, depth / rows)
+    assert round(depth / float(text)) == rows and len(text) <= len(repr(depth / rows))
+    scene = {"dp": float(text), "t_end": 1.0, "still_water_level": depth,
+             "tank": {"x0": 0.0, "x1": 1.0, "z0": 0.0, "z1": 2 * depth},
+             "water_blocks": [{"x0": 0.0, "x1": 1.0, "z0": 0.0, "z1": depth}]}
+    assert datum_mismatch(depth, depth, 0.0, float(text)) is None
+    digits = len(text.replace(".", "").lstrip("0"))
+    if digits > 1:   # the shortest: one significant digit fewer is another divisor or refused
+        short = float(f"{depth / rows:.{digits - 1}g}")
+        assert round(depth / short) != rows or datum_mismatch(depth, depth, 0.0, short) is not None
+    if rows < 100:   # (a 0.24 m deep, 0.0006 m lattice is not built here)
+        assert make_scene(scene).dp == float(text)
 

@@ -9,6 +9,7 @@ same command again and finished points are not rerun (``--retry-failed`` reruns 
 from __future__ import annotations
 
 import argparse
+import json
 import shlex
 import sys
 from pathlib import Path
@@ -32,6 +33,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                        help=f"comma-separated subset of {','.join(sweeps.METHODS)}")
         p.add_argument("--retry-failed", action="store_true", help="rerun points that failed")
         if name == "accuracy":
+            p.add_argument("--cases", default=None,
+                           help="comma-separated subset of flume_I..flume_V, dambreak, coupled")
             p.add_argument("--repeats", type=int, default=1,
                            help="realisations of every point (a flume's ramp 0.1 %% longer per "
                                 "repeat); the chart draws their run-to-run scatter")
@@ -43,7 +46,8 @@ def main(args: argparse.Namespace) -> int:
     kw = {"scheduler": args.scheduler, "n_workers": args.workers, "retry_failed": args.retry_failed}
     try:
         if args.what == "accuracy":
-            points = sweeps.accuracy_points(args.quick, methods, args.repeats)
+            points = sweeps.accuracy_points(args.quick, methods, args.repeats,
+                                            args.cases.split(",") if args.cases else None)
         else:
             points = stability.stability_points(args.quick, methods)
     except ValueError as exc:
@@ -53,7 +57,8 @@ def main(args: argparse.Namespace) -> int:
     if args.what == "accuracy":
         records = sweeps.run_sweep(points, out, desc="accuracy", **kw)
         sweeps.write_csv(records, out / "accuracy.csv", command)
-        sweeps.plot_accuracy(records, out / "accuracy.png", title=command)
+        meta = json.loads((out / "accuracy.meta.json").read_text())
+        sweeps.plot_accuracy(records, out / "accuracy.png", title=sweeps.chart_title(meta))
         files = [out / "accuracy.csv", out / "accuracy.png"]
     else:
         records = stability.run_stability(points, out, **kw)

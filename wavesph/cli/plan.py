@@ -52,7 +52,7 @@ def main(args: argparse.Namespace) -> int:
     # a table for a person; the JSON only with --json
     rows = [("", "plan", "scene as written"),
             ("method", plan.method, own["method"]),
-            ("dp [m]", f"{plan.dp:g}", f"{scene.dp:g}"),
+            ("dp [m]", repr(plan.dp), f"{scene.dp:g}"),
             ("H/dp", f"{plan.H_over_dp:g}", f"{args.height / scene.dp:.3g}"),
             ("SPH zone [m]", f"{plan.zone_length_m:.3g} = {plan.flat_m:.3g} flat + "
                              f"{plan.structures_m:.3g} structures", f"{scene.tank.x1 - scene.tank.x0:g}"),
@@ -98,7 +98,7 @@ def toml_snippet(plan: Plan) -> str:
     """The scene-file lines that make a scene run the plan's dp and method."""
     opts = dict(METHODS[plan.method])
     scheme = opts.pop("scheme", None)
-    lines = [f"dp = {plan.dp:g}"]
+    lines = [f"dp = {plan.dp!r}"]   # the digits the scene needs (sph_core.scene.divisor_text)
     if scheme:
         lines += ["[scheme]"] + [f"{k} = {json.dumps(v)}" for k, v in scheme.items()]
     if opts:

@@ -43,6 +43,8 @@ import numpy as np
 
 from wave_client import G
 
+from sph_core.scene import divisor_text
+
 from .sweeps import METHODS, read_csv
 
 SWEEP_CSV = "data/accuracy_sweep.csv"
@@ -285,7 +287,8 @@ def make_plan(req: PlanRequest, data: list[dict[str, Any]] | None = None,
             # inside the measured range: the fit says nothing about other resolutions
             ratio = min(max(ratio, fit["H_over_dp_min"]), fit["H_over_dp_max"])
             dp_m = min(req.height / ratio, req.depth / MIN_DEPTH_ROWS)
-            dp_m = float(f"{depth_divisor(req.depth, dp_m):.4g}")   # whole rows of the depth
+            # whole rows of the depth, in the fewest digits the scene accepts
+            dp_m = float(divisor_text(req.depth, depth_divisor(req.depth, dp_m)))
         else:
             dp_m = dp
         # a fit that barely converges asks for a spacing no machine runs (p 0.04 gave dp 1e-5

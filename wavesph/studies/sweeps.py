@@ -106,14 +106,21 @@ class Point:
 
 # ---------------------------------------------------------------------------- presets
 def accuracy_points(quick: bool = False, methods: Iterable[str] | None = None,
-                    repeats: int = 1) -> list[Point]:
+                    repeats: int = 1, cases: Iterable[str] | None = None) -> list[Point]:
     """The points of the accuracy sweep. quick: <= 10 min on 2 quiet cores (two methods, two or
     three coarse spacings, one measured period, flume cases I, IV, V); full: every method, three
-    spacings, every case (hours on 2 cores: case II at H/dp = 8 has 0.5 M particles).
-    ``repeats``: realisations of every point (REPEAT_RAMP_STEP), for the chart's run-to-run
-    scatter."""
+    spacings, every case (thousands of core-hours: case II at H/dp = 8 has 0.5 M particles,
+    docs/studies/speed_accuracy.md). ``repeats``: realisations of every point
+    (REPEAT_RAMP_STEP), for the chart's run-to-run scatter. ``cases``: a subset of the preset's
+    cases (flume_I ... flume_V, dambreak, coupled)."""
     if int(repeats) != repeats or repeats < 1:
         raise ValueError(f"repeats must be an integer >= 1, got {repeats!r}")
+    if cases is not None:
+        cases = list(cases)
+        known = [f"flume_{c}" for c in FLUME_CASES] + ["dambreak", "coupled"]
+        if unknown := [c for c in cases if c not in known]:
+            raise ValueError(f"unknown cases {unknown}; known: {known}")
+        return [p for p in accuracy_points(quick, methods, repeats) if p.case in cases]
     if methods is None:
         methods = ["wcsph_kdk", "wcsph_symplectic"] if quick else list(METHODS)
     methods = list(methods)
@@ -405,11 +412,13 @@ def write_table(rows: list[dict[str, Any]], path: Path, columns: list[str],
                 formats: dict[str, str], command: str = "") -> None:
     """A CSV of ``columns``, one row per record; numbers in ``formats`` columns written with that
     format spec. accuracy.csv and stability.csv both. One header row and nothing else, as every
-    wavesph CSV (pandas.read_csv reads it): ``command`` goes to ``<stem>.meta.json`` beside it."""
+    wavesph CSV (pandas.read_csv reads it): ``command``, the date and the machine go to
+    ``<stem>.meta.json`` beside it (a chart made from the CSV says where its wall times come from)."""
     path.parent.mkdir(parents=True, exist_ok=True)
     meta = path.with_suffix(".meta.json")
     if command:
-        meta.write_text(json.dumps({"csv": path.name, "made_by": command}, indent=1) + "\n")
+        meta.write_text(json.dumps({"csv": path.name, "made_by": command, **machine_note()},
+                                   indent=1) + "\n")
     with open(path, "w", newline="") as fh:
         w = csv.DictWriter(fh, fieldnames=columns, extrasaction="ignore")
         w.writeheader()
@@ -419,6 +428,26 @@ def write_table(rows: list[dict[str, Any]], path: Path, columns: list[str],
                 if isinstance(row[k], (int, float)) and not isinstance(row[k], bool):
                     row[k] = format(row[k], spec)
             w.writerow(row)
+
+
+def machine_note() -> dict[str, str]:
+    """When and where the wall times were taken: the UTC date, the machine's cores and Python, and
+    its load average over the last 15 minutes when the table is written (above the core count:
+    other jobs shared the cores)."""
+    import datetime
+    import platform
+
+    cores = os.cpu_count() or 1
+    load = os.getloadavg()[2] if hasattr(os, "getloadavg") else float("nan")
+    return {"date": datetime.datetime.now(datetime.timezone.utc).date().isoformat(),
+            "machine": f"{cores} cores, {platform.machine()}, Python {platform.python_version()}, "
+                       f"load average {load:.1f} over the last 15 min"}
+
+
+def chart_title(meta: dict[str, str]) -> str:
+    """A chart's title from its table's meta.json: the command, and when and where its wall times
+    were taken."""
+    return meta["made_by"] + "".join(f"\n{meta[k]}" for k in ("date", "machine") if k in meta)
 
 
 def write_csv(records: list[dict[str, Any]], path: Path, command: str = "") -> None:
@@ -483,7 +512,7 @@ def plot_accuracy(records: list[dict[str, Any]], path: Path, title: str = "") ->
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    from matplotlib.ticker import NullFormatter
+    from matplotlib.ticker import FuncFormatter, LogLocator
 
     cases = sorted({r["case"] for r in records})
     n = max(1, len(cases))
@@ -513,10 +542,13 @@ def plot_accuracy(records: list[dict[str, Any]], path: Path, title: str = "") ->
                 ax.plot(*zip(*off), "o", mfc="none", color=colour[method])
             for g in pts:
                 if g["n"] > 1:   # the run-to-run scatter of the repeats
+                    # (a mean of equal values can land an ulp outside them: clip at 0)
                     ax.errorbar(g["wall_s"], g["error"], fmt="none", color=colour[method],
                                 alpha=0.6, lw=1, capsize=2,
-                                xerr=[[g["wall_s"] - g["wall_min"]], [g["wall_max"] - g["wall_s"]]],
-                                yerr=[[g["error"] - g["error_min"]], [g["error_max"] - g["error"]]])
+                                xerr=[[max(0.0, g["wall_s"] - g["wall_min"])],
+                                      [max(0.0, g["wall_max"] - g["wall_s"])]],
+                                yerr=[[max(0.0, g["error"] - g["error_min"])],
+                                      [max(0.0, g["error_max"] - g["error"])]])
                 ax.annotate(f"{g['dp']:.3g}" + (f" ×{g['n']}" if g["n"] > 1 else ""),
                             (g["wall_s"], g["error"]), fontsize=7, xytext=(3, 3),
                             textcoords="offset points")
@@ -525,7 +557,12 @@ def plot_accuracy(records: list[dict[str, Any]], path: Path, title: str = "") ->
             ax.step(*zip(*best), where="post", ls="--", color="0.5", lw=1, label="front, all methods")
         ax.set_xscale("log")
         ax.set_yscale("log")
-        ax.xaxis.set_minor_formatter(NullFormatter())   # minor labels overlap on short decades
+        # wall times as plain numbers at 1, 2, 5 x 10^n: a panel within one decade still has
+        # labels, and the default minor labels (every integer multiple) overlap
+        plain = FuncFormatter(lambda v, _: f"{v:g}")
+        ax.xaxis.set_minor_locator(LogLocator(base=10.0, subs=(2.0, 5.0)))
+        ax.xaxis.set_major_formatter(plain)
+        ax.xaxis.set_minor_formatter(plain)
         ax.set_title(case, fontsize=10)
         ax.set_xlabel("wall time [s]")
         ax.set_ylabel("error (relative)")
