@@ -57,7 +57,7 @@ def test_speed_accuracy_rows_are_the_shipped_sweeps() -> None:
     tool = _load("accuracy_chart")
     shipped = [json.loads(ln) for ln in tool.ROWS.read_text(encoding="utf-8").splitlines()]
     assert shipped == tool.all_rows(), "stale: run python docs/tools/accuracy_chart.py"
-    for data, figure in tool.CHARTS:
+    for data, figure, _ in tool.CHARTS:
         meta = json.loads(data.with_suffix(".meta.json").read_text())
         records = sweeps.read_csv(data)
         rows = tool.result_rows(records, meta)

@@ -23,6 +23,7 @@ PAGE = ROOT / "docs" / "validation.md"
 if str(Path(__file__).resolve().parent) not in sys.path:  # generated_page, beside this file
     sys.path.insert(0, str(Path(__file__).resolve().parent))
 
+from accuracy_chart import CHARTS  # noqa: E402  (data, figure, what): the speed-accuracy charts
 from generated_page import page_main  # noqa: E402
 
 # question -> (title, what it asks[, a figure]); tables appear in this order, unknown ones last
@@ -137,17 +138,6 @@ def table(records: list[dict[str, Any]]) -> list[str]:
     return lines
 
 
-# the speed-accuracy charts, first on the page: (what it shows, its data's meta.json, figure)
-CHARTS = [("Today's WCSPH defaults at the full preset's spacings (H/dp 3, 5, 8) and windows (3 "
-           "periods), the cases a 2-core machine runs",
-           ROOT / "bench" / "results" / "accuracy_sweep_full_defaults.meta.json",
-           "figures/accuracy_full_defaults.png"),
-          ("Four methods at the quick preset's coarse spacings, each point three times (the data "
-           "`wavesph plan` fits)",
-           ROOT / "wavesph" / "cases" / "data" / "accuracy_sweep.meta.json",
-           "figures/accuracy_quick.png")]
-
-
 def chart_block() -> list[str]:
     """The speed-accuracy charts with the command, date and machine of the sweep each was drawn
     from."""
@@ -156,11 +146,12 @@ def chart_block() -> list[str]:
            "front; hollow: a refinement that cost more and erred more; bars: the run-to-run "
            "scatter of repeats; the rows and what each case scores are under [Speed against "
            "accuracy](#speed-against-accuracy) ([study](studies/speed_accuracy.md)).", ""]
-    for what, meta_path, figure in CHARTS:
-        meta = json.loads(meta_path.read_text())
+    for data, figure, what in CHARTS:
+        meta = json.loads(data.with_suffix(".meta.json").read_text())
         when = ", ".join(meta[k] for k in ("date", "machine") if k in meta)
         out += [f"{what}: `{meta['made_by']}`" + (f" ({when})." if when else "."), "",
-                f"![speed against accuracy: {Path(figure).stem}]({figure})", ""]
+                f"![speed against accuracy: {figure.stem}]"
+                f"({figure.relative_to(PAGE.parent).as_posix()})", ""]
     return out
 
 

@@ -41,9 +41,8 @@ from typing import Any
 
 import numpy as np
 
-from wave_client import G
-
 from sph_core.scene import divisor_text
+from wave_client import G
 
 from .sweeps import METHODS, read_csv
 
