@@ -101,7 +101,9 @@ elif [ -n "${FLUMES:-}" ]; then
     # the wave flumes at H/dp 8 on the GPU, two lanes side by side (one process each, its own
     # numba cache; the small flumes leave the GPU idle between launches, so lanes overlap):
     #   b: the long flume's loss per wavelength (H 0.04 m, dp 0.005 m, 12 periods, its gauge
-    #      records kept in $OUT/records), then case III at H/dp 16
+    #      records kept in $OUT/records), then the same at h/dp 3 (the closed tank's loss halves
+    #      there, the flume's at H/dp 4 does not move: docs/studies/wave_decay_study.md, "At one
+    #      smoothing length, more neighbours"), then case III at H/dp 16
     #   c: cases III, IV, V, I at H/dp 8 (IV and I: dp 0.7 m / 38, a whole number of layers)
     # each run prints its JSON line (device, particles, wall_s, wall_s_per_sim_s) when it ends;
     # measured with case II as a third lane (H200, 2026-11-27): lane c 382 s, the long flume 217 s
@@ -117,6 +119,7 @@ elif [ -n "${FLUMES:-}" ]; then
         done
     }
     lane b "bench/wave_decay.py --long --dp 0.005 --device cuda --records $OUT/records" \
+           "bench/wave_decay.py --long --dp 0.005 --h-over-dp 3 --device cuda --records $OUT/records_h3" \
            "$FA --case III --dp 0.005 --periods 3 --steady" &
     lane c "$FA --case III --dp 0.01 --periods 3 --steady" \
            "$FA --case IV --dp 0.0184210526 --periods 4 --steady" \

@@ -221,10 +221,16 @@ class Constants(_Model):
     c0_factor: float = Field(10.0, gt=0, description="c0 = c0_factor * sqrt(2 g H), H = water height")
     # h/dp 2 (~50 neighbours): the wave keeps far more of itself than at sqrt(2) (flume 14 ->
     # 6.2 %/m at H/dp 2, 25x less particle noise, phase speed -3.6 -> -0.3 %; one step costs
-    # ~2x, 0.7x the steps: ~1.25x per simulated second; docs/studies/wave_decay_study.md)
-    h_over_dp: float = Field(2.0, ge=1.0, le=2.0, description=(
-        "smoothing length h / dp; 2 (default) for waves, sqrt(2) is cheaper (~0.8x per "
-        "simulated second) and noisier"))
+    # ~2x, 0.7x the steps: ~1.25x per simulated second; docs/studies/wave_decay_study.md).
+    # At a fixed h/dp the particles' discretisation error is a floor under a standing wave's loss
+    # in a closed tank: h/dp 3 (~110 neighbours) halves it at H/dp 8 (1.85 -> 0.84 % per
+    # wavelength, 1.3x the wall time); the open flume's loss at H/dp 4 does not move (0.92 ->
+    # 0.90 %/m). Above 4 nothing was measured (the study's "At one smoothing length, more
+    # neighbours")
+    h_over_dp: float = Field(2.0, ge=1.0, le=4.0, description=(
+        "smoothing length h / dp; 2 (default), sqrt(2) is cheaper (~0.8x per simulated second) "
+        "and noisier; 3 halves a closed tank's wave loss at H/dp 8 (~1.3x the cost) but not an "
+        "open flume's at H/dp 4"))
     cfl: float = Field(0.25, gt=0, le=0.5, description="Courant number of the adaptive time step")
     alpha: float = Field(0.01, ge=0, description="Monaghan artificial viscosity coefficient")
     nu: float = Field(1.0e-6, ge=0, description="laminar kinematic viscosity [m^2/s]")
