@@ -44,9 +44,9 @@ def test_standing_wave_loss_converges_with_resolution():
 
 @pytest.mark.slow
 def test_at_one_smoothing_length_more_neighbours_lose_less():
-    # the floor under the loss at fixed h/dp 2 is the particles' discretisation, not the
-    # h-proportional terms (artificial viscosity, delta-SPH): at the same h = 0.04 m (the same
-    # alpha c0 h and delta h c0) the tank at h/dp 3 loses less than at h/dp 2. Measured (6
+    # in the closed tank the floor under the loss at fixed h/dp 2 is the particles'
+    # discretisation, not the h-proportional terms (artificial viscosity, delta-SPH): at the same
+    # h = 0.04 m (the same alpha c0 h and delta h c0) h/dp 3 loses less than h/dp 2. Measured (6
     # periods): 1.80 against 1.28 %/m, noise 0.10 against 0.03 % of the wave's kinetic energy
     # (docs/studies/wave_decay_study.md, "At one smoothing length, more neighbours")
     h = 0.04
