@@ -222,11 +222,9 @@ class Constants(_Model):
     # h/dp 2 (~50 neighbours): the wave keeps far more of itself than at sqrt(2) (flume 14 ->
     # 6.2 %/m at H/dp 2, 25x less particle noise, phase speed -3.6 -> -0.3 %; one step costs
     # ~2x, 0.7x the steps: ~1.25x per simulated second; docs/studies/wave_decay_study.md).
-    # At a fixed h/dp the particles' discretisation error is a floor under a standing wave's loss
-    # in a closed tank: h/dp 3 (~110 neighbours) halves it at H/dp 8 (1.85 -> 0.84 % per
-    # wavelength, 1.3x the wall time); the open flume's loss at H/dp 4 does not move (0.92 ->
-    # 0.90 %/m). Above 4 nothing was measured (the study's "At one smoothing length, more
-    # neighbours")
+    # Up to 4: at a fixed h/dp the particles' discretisation error is a floor under a closed
+    # tank's wave loss, which more neighbours lower (the description's figures); above 4 nothing
+    # was measured (the study's "At one smoothing length, more neighbours")
     h_over_dp: float = Field(2.0, ge=1.0, le=4.0, description=(
         "smoothing length h / dp; 2 (default), sqrt(2) is cheaper (~0.8x per simulated second) "
         "and noisier; 3 halves a closed tank's wave loss at H/dp 8 (~1.3x the cost) but not an "
