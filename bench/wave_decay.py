@@ -7,7 +7,7 @@
         [--shifting none|fickian|dplus] [--shift-a 2.0]
         [--shift-fs-div 1.8] [--shift-open-end full|none] [--flume-wavelengths 1]
         [--gauge-wavelengths 0.75] [--n-gauges 12]
-        [--long] [--noise] [--records DIR]
+        [--long] [--noise] [--records DIR] [--velocity-z Z [Z ...]]
         [--scheme wcsph|riemann|isph] [--reconstruction muscl|none] [--ppe-solver bicgstab|amg]
         [--isph-density-relaxation 0.01] [--isph-wall-stop 1] [--isph-relaxation-zone 0]
 
@@ -46,6 +46,11 @@ group_decay_per_period, group_decay_per_m, group_loss_per_wavelength: the same f
 period down the flume, each gauge x / c_g later (wavesph.cases.wave_decay.group_decays; the
 periods whose last gauge the record reaches): an inlet amplitude that changes over time does
 not read as decay there. The figure to quote.
+--velocity-z Z...: velocity probes at every gauge's x, Z m above the floor; prints
+velocity_group_decay_per_m (per Z, the horizontal velocity's first harmonic fitted along the
+groups as the elevation is) and velocity_group_decay_per_period: a loss that the velocity field
+shows too is the wave's own, not the gauge's (with --records, its records in
+wave_decay_dp<dp>_velocity.npz: velocity_z, u, u_theory at the gauges' x and times).
 --records DIR keeps the gauge records (an npz per dp) to fit again without re-running, e.g.
 group_decays(**npz) with an earlier t0 (a long run's groups before the window start).
 separated_decay_per_m, separated_k_over_k_theory (SPH's wavenumber: phase-speed error),
@@ -120,6 +125,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--records", type=Path, default=None, metavar="DIR",
                     help="keep each dp's gauge records in DIR/wave_decay_dp<dp>.npz (t, x, eta, "
                          "theory, t0, period, cg, k, k_beat: group_decays' arguments)")
+    ap.add_argument("--velocity-z", type=float, nargs="+", default=[], metavar="Z",
+                    help="velocity probes at every gauge's x, Z m above the floor")
     add_constant_arguments(ap, open_ends=True)
     ap.add_argument("--c0-factor", type=float, default=10.0, help="c0 = factor * sqrt(g d)")
     ap.add_argument("--no-outlet-absorb", action="store_true",
@@ -146,12 +153,15 @@ def main(argv: list[str] | None = None) -> int:
                                  outlet_absorb=not a.no_outlet_absorb,
                                  gauge_wavelengths=a.gauge_wavelengths, n_gauges=a.n_gauges,
                                  wait_reflection=a.long, noise=a.noise,
+                                 velocity_z=tuple(a.velocity_z),
                                  c0=c0, scheme=scheme, device=a.device, **cst)
         length = float(model.length)
         decays.append(prof.decay_per_m)
         if a.records is not None:
             a.records.mkdir(parents=True, exist_ok=True)
             np.savez(a.records / f"wave_decay_dp{dp:g}.npz", **prof.records)
+            if prof.velocity_records is not None:
+                np.savez(a.records / f"wave_decay_dp{dp:g}_velocity.npz", **prof.velocity_records)
         sep_decay, sep_k, sep_kr = separated_decay(prof.x, prof.amp, prof.k)
         print(json.dumps({"H": a.H, "T": a.T, "d": a.d, "dp": dp, "H_over_dp": round(a.H / dp, 3),
                           "device": a.device or "cpu",
@@ -172,6 +182,13 @@ def main(argv: list[str] | None = None) -> int:
                           "modulated_decay_per_period": [round(float(v), 4)
                                                          for v in prof.decay_per_period],
                           **_along_groups(prof.group_decay_per_period, length),
+                          **({} if prof.velocity_group_decay_per_period is None else {
+                              "velocity_group_decay_per_m": {
+                                  f"{z:g}": _finite(float(v.mean()) if v.size else math.nan)
+                                  for z, v in prof.velocity_group_decay_per_period.items()},
+                              "velocity_group_decay_per_period": {
+                                  f"{z:g}": [round(float(x), 4) for x in v]
+                                  for z, v in prof.velocity_group_decay_per_period.items()}}),
                           "loss_per_wavelength": round(1.0 - math.exp(-prof.decay_per_m * length), 4),
                           "separated_decay_per_m": round(sep_decay, 4),
                           "separated_k_over_k_theory": round(sep_k / prof.k, 4),

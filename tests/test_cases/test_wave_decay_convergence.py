@@ -112,3 +112,37 @@ def test_group_decays_do_not_read_the_inlets_envelope_as_decay(tmp_path):
     assert np.array_equal(group_decays(**rec), along)
     rec["t0"] = rec["t0"] - 3 * period
     assert np.array_equal(group_decays(**rec)[3:], along)
+
+
+def test_velocity_probes_follow_the_wave_at_their_height_and_fit_along_the_groups():
+    # a coarse flume (dp 0.04, two periods: one group reaches the last gauge): the probes' velocity is the SPH wave's at
+    # their height, and the theory is read at the same height (the model's z is measured from
+    # the still water, the scene's from the floor; read at the surface, both heights would
+    # get the same theory): its orbital speed lower near the floor, the SPH's the theory's
+    # within the coarse flume's loss
+    from wave_client.theories import build_theory
+    from wavesph.cases.wave_decay import amplitude_profile
+
+    period, depth = 1.4, 0.24
+    model = build_theory("stokes", height=0.04, period=period, depth=depth, ramp_time=period,
+                         order=2)
+    with pytest.raises(ValueError, match="velocity_z"):
+        amplitude_profile(model, ramp=period, height=0.04, period=period, depth=depth, dp=0.04,
+                          periods=1.0, velocity_z=(0.3,))
+    prof = amplitude_profile(model, ramp=period, height=0.04, period=period, depth=depth,
+                             dp=0.04, periods=2.0, n_gauges=4, flume_wavelengths=2.0,
+                             gauge_wavelengths=0.5, velocity_z=(0.04, 0.2))
+    rec, omega = {**prof.records, **prof.velocity_records}, 2 * math.pi / period
+    sel = slice(int(np.searchsorted(rec["t"], rec["t0"] - 1e-9)), None)
+
+    def amp(series):
+        n = int(round(period / (rec["t"][1] - rec["t"][0])))
+        return abs(harmonic_amplitude(rec["t"][sel][:n], series[sel][:n], omega))
+
+    u, u_th = rec["u"], rec["u_theory"]
+    assert u.shape == u_th.shape == (2, 4, rec["t"].size)
+    assert amp(u_th[0, 0]) < amp(u_th[1, 0])        # orbital speed grows towards the surface
+    for j in range(2):
+        assert 0.8 < amp(u[j, 0]) / amp(u_th[j, 0]) < 1.1
+    decays = prof.velocity_group_decay_per_period
+    assert set(decays) == {0.04, 0.2} and all(v.size >= 1 for v in decays.values())

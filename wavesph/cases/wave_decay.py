@@ -21,7 +21,7 @@ import numpy as np
 from scipy.optimize import minimize
 
 from sph_core.absorption import linear_wavenumber
-from sph_core.scene import ElevationProbe
+from sph_core.scene import ElevationProbe, PointProbe
 
 from .particle_noise import binned_noise, noise_energy
 from ..analysis import group_velocity, harmonic_amplitude
@@ -77,6 +77,11 @@ class AmplitudeProfile:
     # the gauge records, for a re-analysis without re-running (bench/wave_decay.py --records):
     # t [s], eta and theory [m] (rows: gauges at x), t0 the window's start [s], cg [m/s]
     records: dict[str, Any] | None = None
+    # with velocity_z: per height above the floor [m], group_decays of the horizontal velocity's
+    # first harmonic at the gauges' x (the wave's own loss, without the elevation gauge); its
+    # records: velocity_z [m], u and u_theory [m/s] (height, gauge, time at records' t)
+    velocity_group_decay_per_period: dict[float, np.ndarray] | None = None
+    velocity_records: dict[str, np.ndarray] | None = None
 
     def ratio_at(self, x: float) -> float:
         """The fitted ratio at ``x`` [m] (the outlet's small reflection ripples the profile)."""
@@ -89,7 +94,7 @@ def amplitude_profile(model: Any, *, ramp: float, height: float, period: float, 
                       settle_periods: float = 0.0, outlet_absorb: bool = True,
                       gauge_wavelengths: float = 0.75, wait_reflection: bool = False,
                       noise: bool = False, device: str | None = None,
-                      **constants: Any) -> AmplitudeProfile:
+                      velocity_z: tuple[float, ...] = (), **constants: Any) -> AmplitudeProfile:
     """Run the flume driven by ``model`` (its start-up ramp lasting ``ramp`` s) and measure
     the amplitude ratio along it (``constants`` override the scene's, e.g. alpha). The flume is
     ``flume_wavelengths`` long; the gauges stay within ``gauge_wavelengths`` of the inlet
@@ -97,7 +102,10 @@ def amplitude_profile(model: Any, *, ramp: float, height: float, period: float, 
     after the front has passed the last gauge, or with ``wait_reflection`` after the front's
     reflection from the outlet has come back to the inlet (the separated fit assumes a steady
     reflected wave). ``noise``: sample the particle-noise energy along x every period / 5
-    (wavesph.cases.particle_noise; about 1 s of numpy per sample at dp 0.02, outside ``wall_s``)."""
+    (wavesph.cases.particle_noise; about 1 s of numpy per sample at dp 0.02, outside ``wall_s``).
+    ``velocity_z``: heights above the floor [m] of velocity probes at every gauge's x, whose
+    horizontal velocity is fitted along the wave groups as the gauges are: a loss the velocity
+    field shows too is the wave's, not the elevation gauge's."""
     length = float(model.length)
     if not 0.0 < gauge_wavelengths < flume_wavelengths:
         raise ValueError(f"gauge_wavelengths ({gauge_wavelengths}) must lie inside the flume "
@@ -122,8 +130,15 @@ def amplitude_profile(model: Any, *, ramp: float, height: float, period: float, 
         raise ValueError(f"the gauges' span ends at {last} m, inside the first gauge's {first} m "
                          "(an ISPH relaxation zone longer than the span)")
     xs = np.round(np.linspace(first, last, n_gauges), 4)
+    for z in velocity_z:
+        if not 0.0 < z < depth:
+            raise ValueError(f"velocity_z: {z} m must lie between the floor (0) and the still "
+                             f"water level ({depth} m)")
     probes = [ElevationProbe(kind="elevation", name=f"g{i}", x=float(x)) for i, x in enumerate(xs)]
-    scene = scene.model_copy(update={"probes": probes})
+    vnames = [[f"v{j}_{i}" for i in range(xs.size)] for j in range(len(velocity_z))]
+    points = [PointProbe(kind="point", name=vnames[j][i], x=float(x), z=float(z))
+              for j, z in enumerate(velocity_z) for i, x in enumerate(xs)]
+    scene = scene.model_copy(update={"probes": probes + points})
     edges = np.arange(0.0, scene.tank.x1 + 1e-9, NOISE_BIN_M)
     noise_rec: list[tuple[float, np.ndarray]] = []
 
@@ -173,12 +188,20 @@ def amplitude_profile(model: Any, *, ramp: float, height: float, period: float, 
     by_period = np.array([modulated_decay(xs, window_ratio(sel[j:j + per]), k, kb)[0]
                           for j in range(0, sel.size - per + 1, per)])
     along = group_decays(res.t, etas, theories, xs, t0=t0, period=period, cg=cg, k=k, k_beat=kb)
+    records = {"t": res.t, "x": xs, "eta": etas, "theory": theories, "t0": t0,
+               "period": period, "cg": cg, "k": k, "k_beat": kb}
+    vel_along = vel_records = None
+    if velocity_z:
+        u = np.array([[res.velocity[nm][0] for nm in row] for row in vnames])
+        u_th = np.array([[res.theory_velocity[nm][0] for nm in row] for row in vnames])
+        vel_along = {float(z): group_decays(res.t, u[j], u_th[j], xs, t0=t0, period=period,
+                                            cg=cg, k=k, k_beat=kb)
+                     for j, z in enumerate(velocity_z)}
+        vel_records = {"velocity_z": np.array(velocity_z, dtype=float), "u": u, "u_theory": u_th}
     return AmplitudeProfile(xs, ratio, float(-slope), float(icpt), res.wall_s, res.particles,
                             res.steps, amp, k, window_ratio(sel[:nh]),
                             window_ratio(sel[nh:]), mean_err, drift, ratio2, nx, nfr, nt, nft,
-                            res.counts, *mod, by_period, along,
-                            {"t": res.t, "x": xs, "eta": etas, "theory": theories, "t0": t0,
-                             "period": period, "cg": cg, "k": k, "k_beat": kb})
+                            res.counts, *mod, by_period, along, records, vel_along, vel_records)
 
 
 def group_decays(t: np.ndarray, eta: np.ndarray, theory: np.ndarray, x: np.ndarray, *,

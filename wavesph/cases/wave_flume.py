@@ -3,6 +3,7 @@
     scene = wave_flume_scene(depth=0.3, wavelength=3.26, height=0.06, dp=0.01, t_end=10.0)
     run = run_wave_flume(scene, model, window=T / 50)     # model: WaveModel duck type
     run.eta["mid"], run.theory["mid"]                      # gauge records [m] vs the model
+    run.velocity["p"], run.theory_velocity["p"]            # a point probe's (u, w) [m/s] vs the model
 
 The model is any object with the WaveModel duck type of ``wave_client`` (passed in: this module
 imports no wave model): the left face stands at the model's abscissa ``x_model_left``, the right face at
@@ -83,7 +84,8 @@ def wave_flume_scene(*, depth: float, wavelength: float, height: float, dp: floa
 
 @dataclass
 class FlumeRun:
-    """Records of one flume run: gauge x [m], times [s], measured and model elevation [m]."""
+    """Records of one flume run: gauge x [m], times [s], measured and model elevation [m];
+    per point probe, measured and model velocity [m/s] (rows u, w)."""
 
     gauge_x: dict[str, float]
     t: np.ndarray
@@ -95,6 +97,8 @@ class FlumeRun:
     n_fluid: np.ndarray
     counts: dict[str, dict[str, int]] = field(default_factory=dict)
     flume: Simulation | None = None
+    velocity: dict[str, np.ndarray] = field(default_factory=dict)
+    theory_velocity: dict[str, np.ndarray] = field(default_factory=dict)
 
 
 def run_wave_flume(scene: Scene, model: Any, *, window: float, x_model_left: float = 0.0,
@@ -108,6 +112,7 @@ def run_wave_flume(scene: Scene, model: Any, *, window: float, x_model_left: flo
     hook; its time is not in ``wall_s``)."""
     nodes_x0 = scene.tank.x0
     flume_probe = {p.name: p.x for p in scene.probes if p.kind == "elevation"}
+    points = {p.name: (p.x, p.z) for p in scene.probes if p.kind == "point"}
     nodes = flume_nodes(scene)
     sources = {side: WaveModelBoundary(model, nd, scene.still_water_level,
                                        x_model_left + (nd.x_face - nodes_x0))
@@ -130,14 +135,24 @@ def run_wave_flume(scene: Scene, model: Any, *, window: float, x_model_left: flo
     eta = {nm: np.array([np.nan if row[f"{nm}_eta"] is None else row[f"{nm}_eta"] for row in hist])
            for nm in flume_probe}
     theory = {nm: np.empty(t.size) for nm in flume_probe}
+    vel = {nm: np.array([[np.nan if row[f"{nm}_{c}"] is None else row[f"{nm}_{c}"]
+                          for row in hist] for c in "uw"]) for nm in points}
+    theory_vel = {nm: np.empty((2, t.size)) for nm in points}
     xm = np.array([x_model_left + (x - nodes_x0) for x in flume_probe.values()])
+    xp = np.array([x_model_left + (x - nodes_x0) for x, _ in points.values()])
+    zp = np.array([z - scene.still_water_level for _, z in points.values()])  # model: z from SWL
     for k, tk in enumerate(t):
         model.advance_to(float(tk))
         vals = np.asarray(model.elevation(xm), dtype=float)
         for j, nm in enumerate(flume_probe):
             theory[nm][k] = vals[j]
+        if points:
+            u, w = model.velocity(xp, zp)
+            for j, nm in enumerate(points):
+                theory_vel[nm][:, k] = u[j], w[j]
     run = FlumeRun(flume_probe, t, eta, theory, wall, flume.steps, flume.n_particles,
-                   np.array(n_fluid), flume.boundary_counts(), flume if keep_flume else None)
+                   np.array(n_fluid), flume.boundary_counts(), flume if keep_flume else None,
+                   vel, theory_vel)
     flume.close()
     return run
 
