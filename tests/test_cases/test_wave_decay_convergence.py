@@ -115,11 +115,11 @@ def test_group_decays_do_not_read_the_inlets_envelope_as_decay(tmp_path):
 
 
 def test_velocity_probes_follow_the_wave_at_their_height_and_fit_along_the_groups():
-    # a coarse flume (dp 0.04, two periods: one group reaches the last gauge): the probes' velocity is the SPH wave's at
-    # their height, and the theory is read at the same height (the model's z is measured from
-    # the still water, the scene's from the floor; read at the surface, both heights would
-    # get the same theory): its orbital speed lower near the floor, the SPH's the theory's
-    # within the coarse flume's loss
+    # a coarse flume (dp 0.04, two periods: one group reaches the last gauge): the probes'
+    # velocity is the SPH wave's at their height, and the theory is read at the same height (the
+    # model's z is measured from the still water, the scene's from the floor; read at the
+    # surface, both heights would get the same theory): its orbital speed lower near the floor,
+    # the SPH's the theory's within the coarse flume's loss
     from wave_client.theories import build_theory
     from wavesph.cases.wave_decay import amplitude_profile
 

@@ -132,11 +132,13 @@ def run_wave_flume(scene: Scene, model: Any, *, window: float, x_model_left: flo
             sample(flume)
     hist = flume.history
     t = np.array([row["t"] for row in hist])
-    eta = {nm: np.array([np.nan if row[f"{nm}_eta"] is None else row[f"{nm}_eta"] for row in hist])
-           for nm in flume_probe}
+
+    def column(key: str) -> np.ndarray:   # a probe's record; None (no fluid there) -> nan
+        return np.array([np.nan if row[key] is None else row[key] for row in hist])
+
+    eta = {nm: column(f"{nm}_eta") for nm in flume_probe}
     theory = {nm: np.empty(t.size) for nm in flume_probe}
-    vel = {nm: np.array([[np.nan if row[f"{nm}_{c}"] is None else row[f"{nm}_{c}"]
-                          for row in hist] for c in "uw"]) for nm in points}
+    vel = {nm: np.array([column(f"{nm}_u"), column(f"{nm}_w")]) for nm in points}
     theory_vel = {nm: np.empty((2, t.size)) for nm in points}
     xm = np.array([x_model_left + (x - nodes_x0) for x in flume_probe.values()])
     xp = np.array([x_model_left + (x - nodes_x0) for x, _ in points.values()])
