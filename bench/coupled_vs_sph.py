@@ -3,6 +3,8 @@
     python bench/coupled_vs_sph.py [--dp 0.01] [--wavelengths 12] [--sph-only-seconds 3]
                                    [--modes two_way,absorption_only] [--out DIR]   (~30 min)
                                    [--scheme isph --isph-... (wavesph.cases.schemes)]
+    python bench/coupled_vs_sph.py --end outlet --x-flat 2.4 --wavelengths 2 --dp 0.02 \
+        --no-sph-only [--scheme isph ...]              (the zone open at both ends, ~1 min)
 
 The flume of wavesph/cases/coupled_flume.py: regular waves (H = 0.04 m, T = 1.4 s, d = 0.24 m) from a
 Boussinesq source --wavelengths wavelengths (12: 23.6 m) up-flume of an SPH zone (open inlet,
@@ -28,8 +30,14 @@ incident wave is the reference's within 0.2 % and 0.02 rad. Smaller parts: the m
 closed beach holds after the ramped front, the Boussinesq model's own bound second harmonic
 (3.6 mm against Stokes' 3.1 mm here); docs/studies/absorption.md, "The coupled flume's window".
 --scheme and its options set both SPH scenes' [scheme] (each line carries it): ISPH does not
-run this flume yet, its 1:10 beach loses still water within seconds (docs/studies/schemes.md,
+run this flume, its 1:10 beach loses still water within seconds (docs/studies/schemes.md,
 "The coupled flume's beach under ISPH"); the line then says state "unstable".
+--end outlet: the SPH zone is --x-flat of flat bed ending in an open outlet that the model feeds
+too (absorption-only, the client absorbing at both ends; FlumeCase.end), against the model alone
+over the same flat flume: the coupling and the zone's own travel without a beach, for any scheme
+(ISPH with its wave options: --h-over-dp 1.2 --isph-density-relaxation 0.05 --isph-wall-stop 100
+--isph-relaxation-zone 0.4). The reflection split then reads the outlet's: outlet_reflection
+and outlet_reflection_reference (flat and mid gauges).
 Speed figures want a quiet machine and OpenMP's default (active) wait policy: on a shared,
 loaded machine set OMP_WAIT_POLICY=passive, which costs the small SPH zone ~27 % of its
 throughput (its parallel regions are short; a sleeping worker takes ~0.1 ms to wake).
@@ -83,29 +91,33 @@ def _accuracy(c: FlumeCase, res: dict, gauge: str = "flat") -> dict:
            "correlation": round(correlation(t, eta, ref, c.compare_from), 4),
            "mean_level_m": round(float(np.mean(eta[sel]) - np.mean(ref[sel])), 5),
            "amplitude_ratio": round(float(np.std(eta[sel]) / np.std(ref[sel])), 4)}
-    return {**out, **_beach_reflection(c, t[sel], {n: e[sel] for n, e in res["eta"].items()},
-                                       {n: r[sel] for n, r in refs.items()})}
+    return {**out, **_far_end_reflection(c, t[sel], {n: e[sel] for n, e in res["eta"].items()},
+                                         {n: r[sel] for n, r in refs.items()})}
 
 
-def _beach_reflection(c: FlumeCase, t: np.ndarray, eta: dict, ref: dict) -> dict:
-    """The first harmonic split into the incident wave and the beach's reflection at the flat
-    and toe gauges (0.4 m apart, same depth), for SPH and the reference: the compared gauge
-    stands in their partial standing wave, so a beach that reflects more moves its phase and
-    size though the incident wave is the same. ``battjes_reflection``: Battjes (1974) 0.1 xi^2
-    for the 1:10 slope (xi = tan beta / sqrt(H / L0)). ``rmse_over_H_incident``: rmse_over_H
-    with each record's reflected first harmonic at the flat gauge taken out, i.e. what the
-    coupling delivers (the incident wave, and any reflection the inlet failed to absorb, which
-    comes back as incident) without the beach's own reflection, which the reference's beach
-    does not make."""
-    xs = np.array([c.gauges["flat"], c.gauges["toe"]])
+def _far_end_reflection(c: FlumeCase, t: np.ndarray, eta: dict, ref: dict) -> dict:
+    """The first harmonic split into the incident wave and the far end's reflection (the
+    beach's, or the outlet's) at two gauges 0.4 m apart on the flat bed (c.reflection_pair),
+    for SPH and the reference: the compared gauge stands in their partial standing wave, so an
+    end that reflects more moves its phase and size though the incident wave is the same.
+    ``battjes_reflection`` (beach): Battjes (1974) 0.1 xi^2 for the 1:10 slope (xi = tan beta /
+    sqrt(H / L0)). ``rmse_over_H_incident``: rmse_over_H with each record's reflected first
+    harmonic at the flat gauge taken out, i.e. what the coupling delivers (the incident wave,
+    and any reflection the inlet failed to absorb, which comes back as incident) without the
+    far end's own reflection, which the reference's does not make."""
+    a, b = c.reflection_pair
+    xs = np.array([c.gauges[a], c.gauges[b]])
     k = float(wavenumber(c.omega, c.depth))   # Airy: the SPH wave's
-    s, s_ref = (separate_harmonics(t, np.array([e["flat"], e["toe"]]), xs, c.period, [k])[0]
+    s, s_ref = (separate_harmonics(t, np.array([e[a], e[b]]), xs, c.period, [k])[0]
                 for e in (eta, ref))
-    incident, incident_ref = (e["flat"] - reflected_wave(sep, t, c.period, k, xs[0])
+    incident, incident_ref = (e[a] - reflected_wave(sep, t, c.period, k, xs[0])
                               for e, sep in ((eta, s), (ref, s_ref)))
-    xi = c.slope / math.sqrt(c.height / (G * c.period ** 2 / (2.0 * math.pi)))
-    return {"beach_reflection": round(s.kr, 4), "beach_reflection_reference": round(s_ref.kr, 4),
-            "battjes_reflection": round(0.1 * xi * xi, 4),
+    end = {"reflection": round(s.kr, 4), "reflection_reference": round(s_ref.kr, 4)}
+    if c.end == "beach":
+        xi = c.slope / math.sqrt(c.height / (G * c.period ** 2 / (2.0 * math.pi)))
+        end["battjes_reflection"] = round(0.1 * xi * xi, 4)
+    return {**{(f"{c.end}_{key}" if key.startswith("refl") else key): v
+               for key, v in end.items()},
             "incident_ratio": round(s.a_incident / s_ref.a_incident, 4),
             "incident_phase_rad": round(float(np.angle(np.exp(
                 1j * (s.phase_incident - s_ref.phase_incident)))), 4),
@@ -131,7 +143,14 @@ def main(argv: list[str] | None = None) -> int:
                     help="Boussinesq source to SPH inlet, in wavelengths")
     ap.add_argument("--sph-only-seconds", type=float, default=3.0,
                     help="simulated seconds of the SPH-only run, extrapolated to t_end (0: full run)")
-    ap.add_argument("--modes", default="two_way,absorption_only")
+    ap.add_argument("--modes", default=None,
+                    help="coupled runs (default: two_way,absorption_only; absorption_only with "
+                         "--end outlet)")
+    ap.add_argument("--end", choices=("beach", "outlet"), default="beach",
+                    help="the SPH zone's far end: the 1:10 beach, or an open outlet fed by the "
+                         "model (flat bed, absorption-only)")
+    ap.add_argument("--x-flat", type=float, default=None,
+                    help="flat bed inside SPH, inlet -> beach toe or outlet [m] (default 1.2)")
     ap.add_argument("--no-sph-only", action="store_true",
                     help="coupled runs only (no SPH-only run, no speed-up summary)")
     ap.add_argument("--absorb", choices=("none", "client", "incident", "sph"), default=None,
@@ -147,14 +166,20 @@ def main(argv: list[str] | None = None) -> int:
     out = args.out or Path(tempfile.mkdtemp(prefix="coupled_vs_sph-"))
     constants = {k: v for k, v in (("h_over_dp", args.h_over_dp),
                                    ("alpha_wall_factor", args.alpha_wall)) if v is not None}
-    c = FlumeCase(wavelengths=args.wavelengths).at(args.dp)
+    case = {"wavelengths": args.wavelengths, "end": args.end,
+            **({} if args.x_flat is None else {"x_flat": args.x_flat})}
+    c = FlumeCase(**case).at(args.dp)
+    modes = (args.modes or ("absorption_only" if args.end == "outlet"
+                            else "two_way,absorption_only")).split(",")
+    if args.end == "outlet" and modes != ["absorption_only"]:
+        ap.error("--end outlet runs absorption_only only (the model hears SPH at one boundary)")
     common = {"dp": args.dp, "scheme": scheme, "H": c.height, "T": c.period, "depth": c.depth,
               "H_over_dp": round(c.height / args.dp, 3), "wavelengths": c.wavelengths,
               "wavelength_m": round(c.wavelength, 4), "t_end": round(c.t_end, 3),
               "compare_from": round(c.compare_from, 3), "gauge_x_from_inlet": c.gauge,
-              "t_sph_start": round(c.t_sph_start, 3)}
+              "t_sph_start": round(c.t_sph_start, 3), "end": c.end, "x_flat": c.x_flat}
     coupled, records = {}, {}
-    for mode in args.modes.split(","):
+    for mode in modes:
         res = run_coupled(c, args.dp, out / f"coupled_{mode}", two_way=mode == "two_way",
                           absorb=args.absorb, constants=constants, scheme=scheme)
         records[mode] = res

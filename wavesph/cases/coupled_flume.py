@@ -1,4 +1,4 @@
-"""Two-way coupled Boussinesq-SPH flume with a 1:10 beach (issue 5), and its two references.
+"""Two-way coupled Boussinesq-SPH flume with a 1:10 beach, and its two references.
 
 One flume, three ways to compute it (x in the Boussinesq model's frame: source at x = 0):
 
@@ -21,6 +21,12 @@ One flume, three ways to compute it (x in the Boussinesq model's frame: source a
   second-order Stokes theory (the server's standalone theory run), the same beach. Its inlet
   does not absorb: the beach's reflection would reach it only after t_end, and the boundary's
   own correction has the reference flaw described in `run_coupled`.
+
+``FlumeCase(end="outlet")`` ends the SPH zone instead with an open outlet ``x_flat`` past the inlet,
+flat bed throughout, fed by the model (which runs on past it over flat bed into its sponge): both
+ends are the model's, absorption-only (the client absorbs at both), and the reference is the
+model alone over the same flat flume. No beach, so what it scores is the coupling and the SPH
+zone's own travel; and it runs schemes that cannot hold the beach's shoreline (ISPH).
 
 Datum: SPH floor z = 0, still water z = d (`still_water_level`); the wave model measures z up
 from still water. SPH x = model x - x_c.
@@ -63,6 +69,14 @@ class FlumeCase:
     compare_periods: float = 4.0  # periods compared after the ramped wave reached the gauge
     dx_per_wavelength: int = 40   # Boussinesq grid
     settle_periods: float = 2.0   # SPH zone at rest before the first waves reach it [periods]
+    end: str = "beach"            # "beach": closed by the 1:10 beach; "outlet": open, x_flat on
+
+    def __post_init__(self) -> None:
+        if self.end not in ("beach", "outlet"):
+            raise ValueError(f"FlumeCase.end: 'beach' or 'outlet', got {self.end!r}")
+        if self.end == "outlet" and not 0.0 < self.gauge < self.x_flat:
+            raise ValueError(f"FlumeCase: the gauge ({self.gauge} m) must lie inside the zone "
+                             f"(0, x_flat = {self.x_flat} m)")
 
     def at(self, dp: float) -> "FlumeCase":
         """The case with its depth rounded to whole particle rows of spacing dp."""
@@ -115,9 +129,18 @@ class FlumeCase:
 
     @property
     def gauges(self) -> dict[str, float]:
-        """SPH-zone gauges, x [m] from the SPH inlet: flat bed (compared), toe, mid-beach."""
+        """SPH-zone gauges, x [m] from the SPH inlet: flat bed (compared), toe, mid-beach; with
+        an outlet: the compared one, mid-zone, and the compared one's mirror from the outlet."""
+        if self.end == "outlet":
+            return {"flat": self.gauge, "mid": 0.5 * self.x_flat, "far": self.x_flat - self.gauge}
         return {"flat": self.gauge, "toe": self.x_flat,
                 "beach": self.x_flat + 0.5 * self.depth / self.slope}
+
+    @property
+    def reflection_pair(self) -> tuple[str, str]:
+        """The two gauges (same depth) that split the first harmonic into incident and
+        reflected waves: the far end's reflection (the beach's or the outlet's)."""
+        return ("flat", "mid") if self.end == "outlet" else ("flat", "toe")
 
     @property
     def compare_from(self) -> float:
@@ -144,7 +167,10 @@ def depth_for_case(depth: float, dp: float) -> float:
 
 # ---------------------------------------------------------------------------- scenes
 def _tank_end(c: FlumeCase, x_toe: float, dp: float) -> float:
-    """x [m] of the closed end: the beach rises 0.1 m above still water (room for run-up)."""
+    """x [m] of the closed end: the beach rises 0.1 m above still water (room for run-up); with
+    an outlet, its face (x_toe is then the outlet's x)."""
+    if c.end == "outlet":
+        return dp * round(x_toe / dp)
     return dp * round((x_toe + (c.depth + 0.1) / c.slope) / dp)
 
 
@@ -164,9 +190,11 @@ def _sph_scene(c: FlumeCase, dp: float, t_end: float, x_toe: float, gauges: dict
         # Cost: the level drops by ~ 2 dp^2 / (slope x wet length), 2.2 mm at dp = 0.02. The
         # absorption-only inlet refills it; the two-way one does not (measured mean -2.8 mm at
         # the flat gauge, 7 % of H in its RMSE/H of 9.5 %)
-        "water_blocks": [{"x0": 0.0, "x1": x_toe + (d - SHORE_ROWS * dp) / c.slope, "z0": 0.0,
-                          "z1": d}],
-        "beds": [{"points": [[x_toe, 0.0], [x1, c.slope * (x1 - x_toe)]]}],
+        "water_blocks": [{"x0": 0.0,
+                          "x1": x1 if c.end == "outlet" else x_toe + (d - SHORE_ROWS * dp) / c.slope,
+                          "z0": 0.0, "z1": d}],
+        **({} if c.end == "outlet" else
+           {"beds": [{"points": [[x_toe, 0.0], [x1, c.slope * (x1 - x_toe)]]}]}),
         # c0 = 10 sqrt(g d) bounds orbital speeds x10. No-slip walls although both wave models
         # are inviscid: free slip left the thin film on the staircase beach undamped, and at
         # dp = 0.02 (late start, absorption-only) a run-up jet threw a particle over the tank
@@ -179,7 +207,11 @@ def _sph_scene(c: FlumeCase, dp: float, t_end: float, x_toe: float, gauges: dict
         # the server gets its boundary data pushed, so the scene sizes the buffer from the
         # wave it is built for (sph_core.open_ends.buffer_widths)
         "open_boundaries": [{"side": "left", "elevation": "imposed", "absorb": absorb,
-                             "buffer_width": buffer_width_for(c.height, c.period, d, dp)}],
+                             "buffer_width": buffer_width_for(c.height, c.period, d, dp)}]
+        # the outlet as the wave flume's (wave_flume_scene): its level from the fluid beside it
+        + ([{"side": "right", "elevation": "extrapolated", "absorb": absorb,
+             "buffer_width": buffer_width_for(c.height, c.period, d, dp)}]
+           if c.end == "outlet" else []),
     }
 
 
@@ -187,7 +219,8 @@ def sph_zone_scene(c: FlumeCase, dp: float, absorb: bool = False,
                    constants: dict[str, Any] | None = None,
                    scheme: dict[str, Any] | None = None) -> dict[str, Any]:
     """The SPH zone of the coupled flume (server scene): inlet at SPH x = 0 (model x_c),
-    clock from ``c.t_sph_start``; ``constants`` and ``scheme`` (the [scheme] table,
+    clock from ``c.t_sph_start``, an open outlet at x_flat if ``c.end`` says so; ``constants``
+    and ``scheme`` (the [scheme] table,
     wavesph.cases.schemes) override the scene's (e.g. h_over_dp, kind = "isph")."""
     c = c.at(dp)
     scene = _sph_scene(c, dp, c.t_end, c.x_flat, c.gauges, "coupled-flume-sph-zone", absorb,
@@ -212,15 +245,15 @@ def wave_scene(c: FlumeCase, two_way: bool = True, reference: bool = False) -> d
     x_c = c.x_couple
     sponge_left = 1.5 * wl
     x_start = -(0.5 * wl + sponge_left)  # source half-width, then the sponge
-    if reference:
+    if reference and c.end == "beach":
         h_min = H_MIN_FRACTION * c.depth
         x_shelf = c.x_toe + (c.depth - h_min) / c.slope
         sponge_right = 2.5 * 2.0 * math.pi / _k(c.omega, h_min)  # 2.5 shallow wavelengths
         x_end = x_shelf + sponge_right
         bathy = {"x": [c.x_toe, x_shelf], "depth": [c.depth, h_min]}
-    else:  # flat overlap past x_c: one wavelength, then a sponge (absorption-only needs it)
+    else:  # flat overlap past x_c (and an outlet's zone): one wavelength, then a sponge
         sponge_right = 2.0 * wl
-        x_end = x_c + wl + sponge_right
+        x_end = x_c + (c.x_flat if c.end == "outlet" else 0.0) + wl + sponge_right
         bathy = {"x": [x_start, x_end], "depth": [c.depth, c.depth]}
     xs = [round(x_c + x, 6) for x in c.gauges.values()]
     return {
@@ -334,6 +367,11 @@ def run_coupled(c: FlumeCase, dp: float, out: Path, two_way: bool = True,
         0.25 rad and was 9 % low, RMSE/H 12 %. Kept to show it (bench --absorb sph).
     """
     absorb = absorb or ("incident" if two_way else "client")
+    if c.end == "outlet" and (two_way or absorb == "sph"):
+        # the model's characteristic boundary stands at the inlet only, and the SPH absorber's
+        # reference over the socket is the face's elevation (see "sph" above)
+        raise ValueError("a coupled zone with an outlet runs absorption-only with the client "
+                         "absorbing (two_way=False, absorb='client' or 'none')")
     if absorb not in ("none", "client", "incident", "sph"):
         raise ValueError(f"absorb: 'none', 'client', 'incident' or 'sph', got {absorb!r}")
     import httpx
@@ -427,6 +465,11 @@ def run_sph_only(c: FlumeCase, dp: float, out: Path, t_end: float | None = None,
 
 # ---------------------------------------------------------------------------- examples
 EXAMPLE_DP = 0.02
+OUTLET_ZONE = {"end": "outlet", "x_flat": 2.4}   # the zone open at both ends: a wavelength and more
+# ISPH's options for open-ended wave runs (docs/physics/isph.md, "What runs, what does not")
+ISPH_WAVES = {"kind": "isph", "isph_density_relaxation": 0.05, "isph_wall_stop": 100.0,
+              "isph_relaxation_zone": 0.4}
+ISPH_WAVES_CONSTANTS = {"h_over_dp": 1.2}
 EXAMPLE_FILES = {
     "wave_two_way.toml": ("the Boussinesq far field of the coupled flume, two-way coupling",
                           lambda c: wave_scene(c, two_way=True)),
@@ -436,6 +479,14 @@ EXAMPLE_FILES = {
                             "depth d/3, then a sponge", lambda c: wave_scene(c, reference=True)),
     "sph_zone.toml": (f"the SPH zone (server scene, dp = {EXAMPLE_DP} m): open inlet at model "
                       "x = [coupling] x, flat bed, 1:10 beach", lambda c: sph_zone_scene(c, EXAMPLE_DP)),
+    "wave_outlet.toml": ("the Boussinesq model of the zone open at both ends (absorption-only: "
+                         "flat bed on past the outlet, then a sponge)",
+                         lambda c: wave_scene(replace(c, **OUTLET_ZONE), two_way=False)),
+    "sph_zone_outlet_isph.toml": (
+        f"the SPH zone open at both ends under ISPH (server scene, dp = {EXAMPLE_DP} m): inlet at "
+        "model x = [coupling] x, 2.4 m of flat bed, outlet; relaxation zones at both ends",
+        lambda c: sph_zone_scene(replace(c, **OUTLET_ZONE), EXAMPLE_DP,
+                                 constants=ISPH_WAVES_CONSTANTS, scheme=ISPH_WAVES)),
 }
 
 
