@@ -22,7 +22,7 @@ RIEMANN_VARIANTS: dict[str, dict[str, Any]] = {
 
 def add_scheme_arguments(ap: argparse.ArgumentParser) -> None:
     """--scheme, --reconstruction, and the isph options --ppe-solver, --isph-density-relaxation,
-    --isph-wall-stop, --isph-relaxation-zone."""
+    --isph-wall-stop, --isph-relaxation-zone, --isph-relaxation-time."""
     ap.add_argument("--scheme", choices=["wcsph", "riemann", "isph"], default="wcsph",
                     help="[scheme] kind (sph_core.scene.Scheme)")
     ap.add_argument("--reconstruction", choices=["muscl", "none"], help="riemann: reconstruction")
@@ -36,6 +36,9 @@ def add_scheme_arguments(ap: argparse.ArgumentParser) -> None:
     ap.add_argument("--isph-relaxation-zone", type=float,
                     help="isph: relaxation zone inside each open end [m] (scene default 0: "
                          "none)")
+    ap.add_argument("--isph-relaxation-time", type=float,
+                    help="isph: time scale of the relaxation zone's pull at the face [s] "
+                         "(scene default 0.2)")
 
 
 def scheme_from_args(a: argparse.Namespace) -> dict[str, Any]:
@@ -46,7 +49,7 @@ def scheme_from_args(a: argparse.Namespace) -> dict[str, Any]:
             out["reconstruction"] = a.reconstruction
     if a.scheme == "isph":
         for key in ("ppe_solver", "isph_density_relaxation", "isph_wall_stop",
-                    "isph_relaxation_zone"):
+                    "isph_relaxation_zone", "isph_relaxation_time"):
             if getattr(a, key) is not None:
                 out[key] = getattr(a, key)
     return out
