@@ -65,6 +65,8 @@ harmonic from the inlet beats along x). --noise (wavesph.cases.particle_noise): 
 (0.25 m); noise_fraction, the particle-noise kinetic energy (velocity minus a local quadratic
 fit) per bin over the wave's energy 0.5 rho0 g a^2 per bin, mean over the window; noise_t_s,
 noise_fraction_t: the same over the gauged span at each sample (every T/5 from the start).
+A run that goes unstable prints its line with state "unstable", t_stop, steps and status (the
+other dp go on; exit status 1), as a marginal scheme's flume (ISPH at dp 0.01) does.
 """
 
 from __future__ import annotations
@@ -84,6 +86,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from wavesph.cases.wave_decay import amplitude_profile, convergence_record, separated_decay  # noqa: E402
 from wavesph.cases.schemes import (add_constant_arguments, add_scheme_arguments,  # noqa: E402
                                    constants_from_args, scheme_from_args)
+from sph_core.simulation import UnstableError  # noqa: E402
 from wave_client.theories import build_theory  # noqa: E402
 
 
@@ -144,17 +147,27 @@ def main(argv: list[str] | None = None) -> int:
     if a.periods is None:
         a.periods = 12.0 if a.long else 4.0
     c0 = a.c0_factor * math.sqrt(9.81 * a.d)
-    decays = []
+    decays, failed = [], False
     for dp in a.dp:
         model = build_theory("stokes", height=a.H, period=a.T, depth=a.d, ramp_time=a.T, order=2)
-        prof = amplitude_profile(model, ramp=a.T, height=a.H, period=a.T, depth=a.d, dp=dp,
-                                 periods=a.periods, flume_wavelengths=a.flume_wavelengths,
-                                 inlet_pressure=a.inlet_pressure, settle_periods=a.settle_periods,
-                                 outlet_absorb=not a.no_outlet_absorb,
-                                 gauge_wavelengths=a.gauge_wavelengths, n_gauges=a.n_gauges,
-                                 wait_reflection=a.long, noise=a.noise,
-                                 velocity_z=tuple(a.velocity_z),
-                                 c0=c0, scheme=scheme, device=a.device, **cst)
+        try:
+            prof = amplitude_profile(model, ramp=a.T, height=a.H, period=a.T, depth=a.d, dp=dp,
+                                     periods=a.periods, flume_wavelengths=a.flume_wavelengths,
+                                     inlet_pressure=a.inlet_pressure,
+                                     settle_periods=a.settle_periods,
+                                     outlet_absorb=not a.no_outlet_absorb,
+                                     gauge_wavelengths=a.gauge_wavelengths, n_gauges=a.n_gauges,
+                                     wait_reflection=a.long, noise=a.noise,
+                                     velocity_z=tuple(a.velocity_z),
+                                     c0=c0, scheme=scheme, device=a.device, **cst)
+        except UnstableError as exc:
+            failed = True
+            print(json.dumps({"H": a.H, "T": a.T, "d": a.d, "dp": dp,
+                              "H_over_dp": round(a.H / dp, 3), "device": a.device or "cpu",
+                              "constants": cst, "scheme": scheme, "long": a.long,
+                              "state": "unstable", "t_stop": round(exc.t, 4), "steps": exc.step,
+                              "status": str(exc)}), flush=True)
+            continue
         length = float(model.length)
         decays.append(prof.decay_per_m)
         if a.records is not None:
@@ -164,7 +177,7 @@ def main(argv: list[str] | None = None) -> int:
                 np.savez(a.records / f"wave_decay_dp{dp:g}_velocity.npz", **prof.velocity_records)
         sep_decay, sep_k, sep_kr = separated_decay(prof.x, prof.amp, prof.k)
         print(json.dumps({"H": a.H, "T": a.T, "d": a.d, "dp": dp, "H_over_dp": round(a.H / dp, 3),
-                          "device": a.device or "cpu",
+                          "device": a.device or "cpu", "state": "finished",
                           "constants": cst, "scheme": scheme, "c0_factor": a.c0_factor,
                           "inlet_pressure": a.inlet_pressure, "settle_periods": a.settle_periods,
                           "outlet_absorb": not a.no_outlet_absorb,
@@ -210,9 +223,9 @@ def main(argv: list[str] | None = None) -> int:
                           "steps": prof.steps,
                           "particle_steps_per_s": round(prof.particles * prof.steps
                                                         / max(prof.wall_s, 1e-9))}), flush=True)
-    if len(a.dp) > 1:
+    if len(a.dp) > 1 and not failed:
         print(json.dumps(convergence_record(a.dp, decays, "decay_per_m")), flush=True)
-    return 0
+    return 1 if failed else 0
 
 
 if __name__ == "__main__":

@@ -146,3 +146,28 @@ def test_velocity_probes_follow_the_wave_at_their_height_and_fit_along_the_group
         assert 0.8 < amp(u[j, 0]) / amp(u_th[j, 0]) < 1.1
     decays = prof.velocity_group_decay_per_period
     assert set(decays) == {0.04, 0.2} and all(v.size >= 1 for v in decays.values())
+
+
+def test_bench_prints_an_unstable_flume_as_a_line_and_goes_on(monkeypatch, capsys):
+    """bench/wave_decay.py: a dp whose flume goes unstable prints a JSON line saying so (state,
+    t_stop, steps) instead of a traceback, the next dp still runs, and the exit status is 1."""
+    import json
+    from pathlib import Path
+
+    from sph_core.simulation import UnstableError
+
+    monkeypatch.syspath_prepend(str(Path(__file__).resolve().parents[2] / "bench"))
+    import wave_decay as bench
+
+    ran = []
+
+    def fake_profile(model, *, dp, **kwargs):
+        ran.append(dp)
+        raise UnstableError(7828, 8.40995, "fluid particle left the tank")
+
+    monkeypatch.setattr(bench, "amplitude_profile", fake_profile)
+    assert bench.main(["--dp", "0.02", "0.01", "--scheme", "isph"]) == 1
+    lines = [json.loads(x) for x in capsys.readouterr().out.splitlines()]
+    assert ran == [0.02, 0.01] and [x["dp"] for x in lines] == [0.02, 0.01]
+    assert lines[1]["state"] == "unstable" and lines[1]["t_stop"] == 8.41
+    assert lines[1]["steps"] == 7828 and lines[1]["scheme"]["kind"] == "isph"
