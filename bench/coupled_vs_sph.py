@@ -171,8 +171,9 @@ def main(argv: list[str] | None = None) -> int:
     c = FlumeCase(**case).at(args.dp)
     modes = (args.modes or ("absorption_only" if args.end == "outlet"
                             else "two_way,absorption_only")).split(",")
-    if args.end == "outlet" and modes != ["absorption_only"]:
-        ap.error("--end outlet runs absorption_only only (the model hears SPH at one boundary)")
+    if args.end == "outlet" and (modes != ["absorption_only"] or args.absorb == "sph"):
+        ap.error("--end outlet runs absorption_only with the client absorbing (the model hears "
+                 "SPH at one boundary; wavesph.cases.coupled_flume.run_coupled)")
     common = {"dp": args.dp, "scheme": scheme, "H": c.height, "T": c.period, "depth": c.depth,
               "H_over_dp": round(c.height / args.dp, 3), "wavelengths": c.wavelengths,
               "wavelength_m": round(c.wavelength, 4), "t_end": round(c.t_end, 3),
