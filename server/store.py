@@ -84,10 +84,7 @@ class RunStore:
                 continue
             if d.name == LOCK:
                 continue
-            if not d.is_dir():  # a user's file beside the runs (a scene, a log): not ours
-                log.debug("run store: skipping %s: a file, not a run directory", d)
-                continue
-            if not RUN_ID.fullmatch(d.name):
+            if not d.is_dir() or not RUN_ID.fullmatch(d.name):
                 log.warning("run store: skipping %s: not a run directory", d)
                 continue
             try:

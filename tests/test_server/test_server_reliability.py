@@ -64,24 +64,6 @@ def test_store_skips_a_symlinked_run_dir_and_serves_no_directory_as_gauges(tmp_p
         assert r.status_code == 404, r.text
 
 
-def test_store_passes_over_a_users_file_quietly_and_warns_of_a_stray_directory(tmp_path, caplog):
-    """A scene or a log beside the runs (as the coupled flume's bench writes its wave scene) is
-    not a run and says nothing; a directory that is not a run's is worth a line."""
-    import logging
-
-    from server.store import RunStore
-
-    root = tmp_path / "runs"
-    root.mkdir()
-    (root / "wave_scene.toml").write_text("# a user's file\n")
-    (root / "old runs").mkdir()
-    with caplog.at_level(logging.DEBUG, logger="wavesph.server"):
-        store = RunStore(root)
-        assert store.load_all() == []
-    warned = [r.getMessage() for r in caplog.records if r.levelno >= logging.WARNING]
-    assert warned == [f"run store: skipping {root / 'old runs'}: not a run directory"]
-
-
 # a full disk: the run ends, its slot comes back, no .tmp is left --------------------------------
 def test_full_disk_at_the_end_of_a_session_ends_the_run_and_frees_its_slot(tmp_path, factory,
                                                                            monkeypatch):
