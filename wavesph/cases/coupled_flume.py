@@ -345,7 +345,9 @@ def run_coupled(c: FlumeCase, dp: float, out: Path, two_way: bool = True,
                 constants: dict[str, Any] | None = None,
                 scheme: dict[str, Any] | None = None) -> dict[str, Any]:
     """The coupled flume over a real socket: in-process server, the client as `wavesph couple
-    --model boussinesq --config <out>/wave_scene.toml [--absorb]` runs it. Figures and series.
+    --model boussinesq --config <out>/wave_scene.toml [--absorb]` runs it (its log beside it;
+    the server's store is <out>/server, where a file of ours would be a stray entry). Figures
+    and series.
 
     absorb: who absorbs the beach's reflection at the SPH inlet; exactly one absorber, or the
     gain doubles (docs/developer/architecture.md). Default: "incident" for two-way (measured best,
@@ -389,7 +391,7 @@ def run_coupled(c: FlumeCase, dp: float, out: Path, two_way: bool = True,
 
     z_ref = BETA * c.depth  # Nwogu's z_alpha: the model's reference_level at x_c (flat bed)
     tic = time.perf_counter()
-    with InProcessServer(out) as srv, httpx.Client(base_url=f"http://127.0.0.1:{srv.port}",
+    with InProcessServer(out / "server") as srv, httpx.Client(base_url=f"http://127.0.0.1:{srv.port}",
                                                    timeout=60) as http:
         zone = sph_zone_scene(c, dp, absorb == "sph", constants=constants, scheme=scheme)
         r = http.post("/runs", json={"scene": zone,
@@ -421,7 +423,7 @@ def run_coupled(c: FlumeCase, dp: float, out: Path, two_way: bool = True,
               "state": info["state"], "status": info["status"], "particles": info["particles"],
               "steps": info["steps"], "windows": info["windows"], "wall_s": wall,
               "coupling_overhead_share": info.get("coupling_overhead_share")}
-    gauges = out / run["id"] / "gauges.csv"
+    gauges = out / "server" / run["id"] / "gauges.csv"
     if gauges.exists():
         result["t"], result["eta"] = _gauges_csv(gauges)
     return result
