@@ -41,7 +41,8 @@ and outlet_reflection_reference (flat and mid gauges).
 Speed figures want a quiet machine and OpenMP's default (active) wait policy: on a shared,
 loaded machine set OMP_WAIT_POLICY=passive, which costs the small SPH zone ~27 % of its
 throughput (its parallel regions are short; a sleeping worker takes ~0.1 ms to wake).
-Beside rmse_over_H, each coupled run prints the first harmonic split at the flat and toe gauges:
+Beside rmse_over_H, each coupled run prints the first harmonic split at the flat and toe gauges
+(flat and mid with --end outlet, its keys named outlet_ as above):
 beach_reflection (SPH), beach_reflection_reference, battjes_reflection (0.1 xi^2),
 incident_ratio and incident_phase_rad (SPH's incident wave against the reference's) and
 rmse_over_H_incident: rmse_over_H with each record's reflected first harmonic taken out (a

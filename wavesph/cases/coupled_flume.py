@@ -166,19 +166,26 @@ def depth_for_case(depth: float, dp: float) -> float:
 
 
 # ---------------------------------------------------------------------------- scenes
-def _tank_end(c: FlumeCase, x_toe: float, dp: float) -> float:
-    """x [m] of the closed end: the beach rises 0.1 m above still water (room for run-up); with
-    an outlet, its face (x_toe is then the outlet's x)."""
+def _tank_end(c: FlumeCase, x_flat_end: float, dp: float) -> float:
+    """x [m] of the tank's end, the flat bed ending at ``x_flat_end``: the outlet's face, or the
+    closed end where the beach rises 0.1 m above still water (room for run-up)."""
     if c.end == "outlet":
-        return dp * round(x_toe / dp)
-    return dp * round((x_toe + (c.depth + 0.1) / c.slope) / dp)
+        return dp * round(x_flat_end / dp)
+    return dp * round((x_flat_end + (c.depth + 0.1) / c.slope) / dp)
 
 
-def _sph_scene(c: FlumeCase, dp: float, t_end: float, x_toe: float, gauges: dict[str, float],
-               name: str, absorb: bool, constants: dict[str, Any] | None = None,
+def _sph_scene(c: FlumeCase, dp: float, t_end: float, x_flat_end: float,
+               gauges: dict[str, float], name: str, absorb: bool,
+               constants: dict[str, Any] | None = None,
                scheme: dict[str, Any] | None = None) -> dict[str, Any]:
+    """The SPH scene of a flume whose flat bed ends at ``x_flat_end`` (the beach's toe, or the
+    outlet's face)."""
     d = c.depth
-    x1 = _tank_end(c, x_toe, dp)
+    x1 = _tank_end(c, x_flat_end, dp)
+    width = buffer_width_for(c.height, c.period, d, dp)
+    x_water = x1 if c.end == "outlet" else x_flat_end + (d - SHORE_ROWS * dp) / c.slope
+    # the outlet as the wave flume's (wave_flume_scene): its level from the fluid beside it
+    ends = [("left", "imposed")] + ([("right", "extrapolated")] if c.end == "outlet" else [])
     return {
         "name": name, "dp": dp, "t_end": t_end, "still_water_level": d,
         # room above the beach's top (0.1 m above still water) for run-up and splashes: a drop
@@ -190,11 +197,9 @@ def _sph_scene(c: FlumeCase, dp: float, t_end: float, x_toe: float, gauges: dict
         # Cost: the level drops by ~ 2 dp^2 / (slope x wet length), 2.2 mm at dp = 0.02. The
         # absorption-only inlet refills it; the two-way one does not (measured mean -2.8 mm at
         # the flat gauge, 7 % of H in its RMSE/H of 9.5 %)
-        "water_blocks": [{"x0": 0.0,
-                          "x1": x1 if c.end == "outlet" else x_toe + (d - SHORE_ROWS * dp) / c.slope,
-                          "z0": 0.0, "z1": d}],
+        "water_blocks": [{"x0": 0.0, "x1": x_water, "z0": 0.0, "z1": d}],
         **({} if c.end == "outlet" else
-           {"beds": [{"points": [[x_toe, 0.0], [x1, c.slope * (x1 - x_toe)]]}]}),
+           {"beds": [{"points": [[x_flat_end, 0.0], [x1, c.slope * (x1 - x_flat_end)]]}]}),
         # c0 = 10 sqrt(g d) bounds orbital speeds x10. No-slip walls although both wave models
         # are inviscid: free slip left the thin film on the staircase beach undamped, and at
         # dp = 0.02 (late start, absorption-only) a run-up jet threw a particle over the tank
@@ -206,12 +211,8 @@ def _sph_scene(c: FlumeCase, dp: float, t_end: float, x_toe: float, gauges: dict
         "probes": [{"kind": "elevation", "name": n, "x": x} for n, x in gauges.items()],
         # the server gets its boundary data pushed, so the scene sizes the buffer from the
         # wave it is built for (sph_core.open_ends.buffer_widths)
-        "open_boundaries": [{"side": "left", "elevation": "imposed", "absorb": absorb,
-                             "buffer_width": buffer_width_for(c.height, c.period, d, dp)}]
-        # the outlet as the wave flume's (wave_flume_scene): its level from the fluid beside it
-        + ([{"side": "right", "elevation": "extrapolated", "absorb": absorb,
-             "buffer_width": buffer_width_for(c.height, c.period, d, dp)}]
-           if c.end == "outlet" else []),
+        "open_boundaries": [{"side": side, "elevation": elevation, "absorb": absorb,
+                             "buffer_width": width} for side, elevation in ends],
     }
 
 
@@ -391,8 +392,8 @@ def run_coupled(c: FlumeCase, dp: float, out: Path, two_way: bool = True,
 
     z_ref = BETA * c.depth  # Nwogu's z_alpha: the model's reference_level at x_c (flat bed)
     tic = time.perf_counter()
-    with InProcessServer(out / "server") as srv, httpx.Client(base_url=f"http://127.0.0.1:{srv.port}",
-                                                   timeout=60) as http:
+    with InProcessServer(out / "server") as srv, \
+            httpx.Client(base_url=f"http://127.0.0.1:{srv.port}", timeout=60) as http:
         zone = sph_zone_scene(c, dp, absorb == "sph", constants=constants, scheme=scheme)
         r = http.post("/runs", json={"scene": zone,
                                      "mode": "coupled",
