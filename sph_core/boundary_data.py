@@ -162,3 +162,24 @@ class WaveModelBoundary:
         s = BoundarySample(float(t), np.asarray(u, dtype=float), np.asarray(w, dtype=float),
                            float(eta[0]), float(eta[1]))
         return validate_sample(s, self.nodes, self.still_water_level, where=f"{self.nodes.side}")
+
+    def velocity_along(self, t: float, dx: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(u, w)[station, node] at time t at the nodes' heights of columns ``dx`` [m] from the
+        face (the model at x_model + dx): the wave inside the SPH domain, for ISPH's relaxation
+        zones (open_ends.OpenBoundaries). A model with ``front_factor(x)`` (a theory with a
+        start-up ramp, which holds at every x at once) gives the wave as it arrives: the columns
+        scaled alike by the front factor at the one nearest the wavemaker, so that a zone ahead
+        of the front holds still water and the scaled field stays divergence-free (a factor
+        varying along x would add a divergence that ISPH's projection turns into pressure)."""
+        self.model.advance_to(t)
+        x = self.x_model + np.asarray(dx, dtype=float)[:, None]
+        u, w = self.model.velocity(x, self._z_model[None, :])
+        shape = (x.shape[0], self.nodes.size)
+        front = getattr(self.model, "front_factor", None)
+        f = 1.0 if front is None else float(np.asarray(front(x.min()), dtype=float))
+        u = np.array(np.broadcast_to(u * f, shape), dtype=float)
+        w = np.array(np.broadcast_to(w * f, shape), dtype=float)
+        if not (np.all(np.isfinite(u)) and np.all(np.isfinite(w))):
+            raise BoundaryDataError(f"{self.nodes.side}: the model's velocity inside the domain "
+                                    f"is not finite at t = {t}")
+        return u, w

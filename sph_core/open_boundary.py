@@ -267,13 +267,18 @@ def buffer_update(ps, n, dt, r, zs0, du0, zs1, du1, ends, prm):
 
 
 @njit(parallel=True, cache=True)
-def relax_to_source(ps, n, t1, dt, ends, length, tau):
+def relax_to_source(ps, n, t1, dt, ends, length, tau, zt):
     """ISPH's relaxation zones (Scheme.isph_relaxation_zone): every fluid particle within
-    ``length`` of an open end's face has its velocity pulled towards the end's source velocity
-    (u, w)(z, t1) (the buffer's imposed profile without the absorption correction; above the
-    surface z_s the value at z_s) by a = 1 - exp(-dt q^2 / tau), q = 1 - s / length, s the
-    distance from the face: the pull is strongest at the face and vanishes with its slope at
-    the zone's end. Wave codes generate and absorb with such zones (Altomare et al. 2018 in
+    ``length`` of an open end's face has its velocity pulled towards the wave's velocity there
+    at t1 by a = 1 - exp(-dt q^2 / tau), q = 1 - s / length, s the distance from the face: the
+    pull is strongest at the face and vanishes with its slope at the zone's end. The target is
+    the wave's local value where the source knows it inside the domain (``zt``, a
+    state.ZoneTargets: the profiles at stations ds apart, linear between them; a theory's value
+    above its surface is its surface value), else the end's source profile at the face (u, w)(z,
+    t1) (the buffer's imposed profile without the absorption correction; above the face's surface
+    z_s the value at z_s): a pull towards the face's phase across a zone a good fraction of a
+    wavelength long, which reflects (docs/studies/schemes.md, "A zone that pulls towards the
+    local wave"). Wave codes generate and absorb with such zones (Altomare et al. 2018 in
     DualSPHysics). Why ISPH needs one: at outflow through the inlet the fluid's surface beside
     the face fell below the buffer's and then rose at twice its speed, and the flume broke down
     there within ~3 periods (docs/studies/schemes.md, "The wave flume's open ends with
@@ -284,6 +289,7 @@ def relax_to_source(ps, n, t1, dt, ends, length, tau):
     vx = ps.vx
     vz = ps.vz
     kind = ps.kind
+    last = zt.u.shape[1] - 2
     for i in prange(n):
         if kind[i] != FLUID:
             continue
@@ -293,11 +299,23 @@ def relax_to_source(ps, n, t1, dt, ends, length, tau):
             s = (ps.x[i] - ends.x_face[b]) * (-ends.nx[b])
             if s < 0.0 or s >= length:
                 continue
-            zi = min(ps.z[i], ends.zs[b])
             q = 1.0 - s / length
             a = 1.0 - math.exp(-dt * q * q / tau)
-            vx[i] += a * (profile_value(ends.zn[b], ends.win_u[b], r, zi) - vx[i])
-            vz[i] += a * (profile_value(ends.zn[b], ends.win_w[b], r, zi) - vz[i])
+            if zt.local[b]:
+                f = s / zt.ds
+                k = min(int(f), last)
+                f -= k
+                zi = ps.z[i]
+                ut = ((1.0 - f) * profile_value(ends.zn[b], zt.u[b, k], r, zi)
+                      + f * profile_value(ends.zn[b], zt.u[b, k + 1], r, zi))
+                wt = ((1.0 - f) * profile_value(ends.zn[b], zt.w[b, k], r, zi)
+                      + f * profile_value(ends.zn[b], zt.w[b, k + 1], r, zi))
+            else:
+                zi = min(ps.z[i], ends.zs[b])
+                ut = profile_value(ends.zn[b], ends.win_u[b], r, zi)
+                wt = profile_value(ends.zn[b], ends.win_w[b], r, zi)
+            vx[i] += a * (ut - vx[i])
+            vz[i] += a * (wt - vz[i])
 
 
 # what a slot does at the face crossings (transition_of)

@@ -32,7 +32,7 @@ from .open_boundary import INLET_IDLE
 from .particles import INLET, M, P, RHO, WALL, X, Y, Z, ParticleSet
 from .scene import (INLET_PRESSURE, ISPH_INLET_PRESSURE, OUTLET_PRESSURE, OpenBoundary,
                     Scene)
-from .state import OpenEnds, closed_ends
+from .state import OpenEnds, ZoneTargets, closed_ends, no_zone_targets
 
 SIDES = ("left", "right")
 
@@ -94,7 +94,7 @@ class OpenBoundaries:
 
     def __init__(self, sides: tuple[str, ...], nodes: Mapping[str, BoundaryNodes],
                  sources: Mapping[str, BoundaryData], window: float, ends: OpenEnds,
-                 still_water_level: float) -> None:
+                 still_water_level: float, zone: ZoneTargets | None = None) -> None:
         self.sides = sides
         self.nodes = dict(nodes)
         self.sources = dict(sources)
@@ -103,6 +103,10 @@ class OpenBoundaries:
         self.swl = still_water_level
         # samples at the window start: at rest until the first window is loaded
         self.samples = {s: still_sample(self.nodes[s], 0.0) for s in sides}
+        # ISPH's relaxation zones: local targets of the ends whose source knows the wave inside
+        # the domain, at stations k ds from the face into the fluid (the time of level 1)
+        self.zone = no_zone_targets() if zone is None else zone
+        self._zone_t = math.nan
 
     # ---------------------------------------------------------------- named constructors
     @classmethod
@@ -164,7 +168,8 @@ class OpenBoundaries:
         # 3D: long-crested boundary data, the gauges' lines at mid-width
         y_gauge = 0.5 * (scene.tank.y0 + scene.tank.y1) if scene.dim == 3 else 0.0
         e = e._replace(active=True, dz_gauge=0.25 * dp, dp=dp, y_gauge=y_gauge)
-        return cls(sides, nodes, sources, window, e, swl)
+        return cls(sides, nodes, sources, window, e, swl,
+                   zone_targets(scene, sources, nn))
 
     # ---------------------------------------------------------------- setup
     @property
@@ -240,7 +245,8 @@ class OpenBoundaries:
         return end
 
     def load_window(self, t0: float, t1: float, end: Mapping[str, BoundarySample]) -> None:
-        """The jitted window: data of the current start samples at t0, of ``end`` at t1."""
+        """The jitted window: data of the current start samples at t0, of ``end`` at t1 (and
+        the relaxation zones' local targets at both)."""
         e = self.ends
         e.win_t[:] = (t0, t1)
         for side in self.sides:
@@ -250,6 +256,24 @@ class OpenBoundaries:
                 e.win_w[b, lv] = s.w
                 e.win_eta[b, lv] = s.eta
                 e.win_etag[b, lv] = s.gauge_eta
+        if self.zone.local.any():
+            self._load_zone(t0, t1)
+
+    def _load_zone(self, t0: float, t1: float) -> None:
+        """The zones' local targets at t0 (the last window's t1 data, or sampled after a
+        restore) and t1, from each local end's source (``velocity_along``)."""
+        z = self.zone
+        k = np.arange(z.u.shape[1])
+        for b in np.nonzero(z.local)[0]:
+            src = self.sources[SIDES[b]]
+            dx = -self.ends.nx[b] * z.ds * k
+            if abs(self._zone_t - t0) <= 1e-9 * max(1.0, abs(t0)):   # NaN: none yet
+                z.u[b, :, 0] = z.u[b, :, 1]
+                z.w[b, :, 0] = z.w[b, :, 1]
+            else:
+                z.u[b, :, 0], z.w[b, :, 0] = src.velocity_along(t0, dx)
+            z.u[b, :, 1], z.w[b, :, 1] = src.velocity_along(t1, dx)
+        self._zone_t = t1
 
     # ---------------------------------------------------------------- readings and state
     def gauges(self) -> dict[str, float | None]:
@@ -279,6 +303,21 @@ class OpenBoundaries:
             self.ends.zs[:] = s.zs
         self.samples = dict(s.samples)
         self.ends.filt_x[:] = s.filt_x
+
+
+def zone_targets(scene: Scene, sources: Mapping[str, BoundaryData], n_nodes: int
+                 ) -> ZoneTargets:
+    """The ZoneTargets of an ISPH scene with relaxation zones: local at each end whose source
+    can say the wave inside the domain (``velocity_along``, a wave model's boundary), stations
+    at most dp apart over the zone; no local data otherwise."""
+    length = scene.scheme.isph_relaxation_zone if scene.scheme.kind == "isph" else 0.0
+    local = np.array([length > 0 and hasattr(sources.get(side), "velocity_along")
+                      for side in SIDES], dtype=np.bool_)
+    if not local.any():
+        return no_zone_targets(n_nodes)
+    k = max(2, math.ceil(length / scene.dp) + 1)
+    return ZoneTargets(local, length / (k - 1), np.zeros((2, k, 2, n_nodes)),
+                       np.zeros((2, k, 2, n_nodes)))
 
 
 def buffer_pressure(o: OpenBoundary, scheme: str = "wcsph") -> str:

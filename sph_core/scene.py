@@ -334,8 +334,10 @@ class Scheme(_Model):
         "ISPH: Fickian particle shifting (Lind et al. 2012) with Constants.shift_a after each step"))
     isph_relaxation_zone: float = Field(0.0, ge=0, description=(
         "ISPH: length [m] of a relaxation zone inside each open end's face, where the fluid's "
-        "velocity is pulled towards the end's source velocity at the rate q^2 / "
-        "isph_relaxation_time, q = 1 - s / length, s the distance from the face; 0: none (the "
+        "velocity is pulled towards the wave's at the rate q^2 / isph_relaxation_time, q = 1 - "
+        "s / length, s the distance from the face: the wave model at the particle when a model "
+        "drives the run in-process (the benches' theory flumes), else the face's profile (an end "
+        "fed over the protocol, a [source] included: its data stop at the face); 0: none (the "
         "wave flume's inlet then breaks down within a few periods: docs/studies/schemes.md)"))
     isph_relaxation_time: float = Field(0.2, gt=0, description=(
         "ISPH: time scale [s] of the relaxation zone's pull at the face"))

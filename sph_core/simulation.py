@@ -129,7 +129,7 @@ class Simulation:
         self.particles = ps = ParticleSet(max(int(n * (1.0 + spare)), n + 1),
                                           np.float32 if c.precision == "float32" else np.float64)
         # the scheme: its Params, initial state and time loop (steppers.py)
-        self.stepper: Stepper = make_stepper(scene, ps.capacity)
+        self.stepper: Stepper = make_stepper(scene, ps.capacity, self.open.zone)
         self.dim = scene.dim
         vol = dp ** scene.dim
         flat = scene.dim == 2

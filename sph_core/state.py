@@ -198,6 +198,25 @@ class OpenEnds(NamedTuple):
     y_gauge: float = 0.0
 
 
+class ZoneTargets(NamedTuple):
+    """What ISPH's relaxation zones pull towards where the source knows the wave inside the SPH
+    domain (a wave model evaluated there: open_ends.OpenBoundaries): the velocity profiles at
+    stations s_k = k ds into the fluid from each face, k = 0..K-1, at the window's two times.
+    ``local[b]`` False: end b's zone pulls towards the face's profile (the window's data; ends
+    fed from outside, whose data stop at the face). open_boundary.relax_to_source reads it."""
+
+    local: np.ndarray     # bool[2]
+    ds: float             # station spacing [m]
+    u: np.ndarray         # [2 ends, K stations, 2 levels, nodes]
+    w: np.ndarray
+
+
+def no_zone_targets(n_nodes: int = 2) -> ZoneTargets:
+    """ZoneTargets of no local data (every zone pulls towards its face's profile)."""
+    return ZoneTargets(np.zeros(2, dtype=np.bool_), 1.0, np.zeros((2, 2, 2, n_nodes)),
+                       np.zeros((2, 2, 2, n_nodes)))
+
+
 def closed_ends(capacity: int, n_nodes: int = 2) -> OpenEnds:
     """An inactive OpenEnds (a closed tank): same types as an open one, hooks do nothing."""
     z2 = lambda: np.zeros(2)  # noqa: E731

@@ -1,6 +1,6 @@
 """The schemes behind one stepper: what a ``Simulation`` asks of WCSPH / Riemann SPH and of ISPH.
 
-    stepper = make_stepper(scene, capacity)        # by [scheme] kind
+    stepper = make_stepper(scene, capacity[, zone_targets])   # by [scheme] kind
     rho, p = stepper.initial_fluid(z, surface)     # the lattice's density (and pressure, or None)
     prm = stepper.params(scene, base, n_layers)    # the scheme's Params (base: scheme-neutral)
     dt, n = stepper.initialise(ps, ps2, cells, ends, bd, n)
@@ -28,7 +28,7 @@ import numpy as np
 from . import riemann, step, wcsph
 from .eos import hydrostatic_density, tait_b
 from .scene import Scene, Scheme
-from .state import Params
+from .state import Params, ZoneTargets
 from .wall_contact import face_shares
 
 
@@ -124,11 +124,13 @@ class WcsphStepper:
         return {}
 
 
-def make_stepper(scene: Scene, capacity: int) -> Stepper:
-    """The stepper of the scene's [scheme] kind, for ``capacity`` particle slots."""
+def make_stepper(scene: Scene, capacity: int, zone_targets: ZoneTargets | None = None
+                 ) -> Stepper:
+    """The stepper of the scene's [scheme] kind, for ``capacity`` particle slots;
+    ``zone_targets``: the open ends' local targets of ISPH's relaxation zones (None: none)."""
     if scene.scheme.kind == "isph":
         from .isph import IsphStepper
-        return IsphStepper(scene, capacity)
+        return IsphStepper(scene, capacity, zone_targets)
     return WcsphStepper(scene)
 
 

@@ -17,7 +17,7 @@ from ..particles import FLUID, N_SORTED_KDK, WALL
 from ..riemann import NO_RECONSTRUCTION
 from ..scene import Scene
 from ..shifting import shift_particles
-from ..state import Params
+from ..state import Params, ZoneTargets, no_zone_targets
 from ..steppers import drive
 from ..wcsph import ST_CAPACITY, ST_LEFT_DOMAIN, ST_NONFINITE, ST_REACHED_T
 from .passes import correct, free_surface_flags, predict, scatter_pressure, wall_state
@@ -47,7 +47,8 @@ class IsphStepper:
 
     passes_per_step = 1   # one pressure solve per step, whatever constants.integrator says
 
-    def __init__(self, scene: Scene, capacity: int) -> None:
+    def __init__(self, scene: Scene, capacity: int,
+                 zone_targets: ZoneTargets | None = None) -> None:
         sc = scene.scheme
         c = scene.constants
         if sc.ppe_solver not in PPE_SOLVERS:
@@ -62,6 +63,8 @@ class IsphStepper:
         self.relax = float(sc.isph_density_relaxation)
         self.zone = float(sc.isph_relaxation_zone)
         self.zone_tau = float(sc.isph_relaxation_time)
+        # the zones' local targets, filled per window by open_ends.OpenBoundaries
+        self.zone_targets = no_zone_targets() if zone_targets is None else zone_targets
         self.rho0 = c.rho0
         self.g = c.g
         self.vol = scene.dp * scene.dp
@@ -205,7 +208,8 @@ class IsphStepper:
             if n < 0:
                 return -1, int(n_bad), int(n_out), float(v2), float(a2)
             if self.zone > 0.0:
-                relax_to_source(ps, n, t + dt, dt, ends, self.zone, self.zone_tau)
+                relax_to_source(ps, n, t + dt, dt, ends, self.zone, self.zone_tau,
+                                self.zone_targets)
         n = sort_by_cell(ps, ps2, N_SORTED_KDK, n, cells)
         if self.shifting:
             shift_particles(ps2, n, cells, prm, dt)

@@ -75,6 +75,37 @@ def test_wave_model_adapter_converts_the_datum_and_reads_the_gauge():
     assert s.gauge_eta == pytest.approx(0.01 * 2.05 + 0.003)
 
 
+class FrontModel(LinearShallowModel):
+    """u = x, w = z at every point, with a front: the wave has reached x < 2.1 m only."""
+
+    def velocity(self, x, z):
+        x, z = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(z, dtype=float))
+        return x.copy(), z.copy()
+
+    def front_factor(self, x):
+        return np.where(np.asarray(x, dtype=float) < 2.1, 0.5, 0.0)
+
+
+def test_wave_model_adapter_gives_the_wave_inside_the_domain():
+    """velocity_along: the model at x_model + dx at the nodes' heights, for ISPH's relaxation
+    zones; with a front, every column scaled by the front factor at the one nearest the
+    wavemaker (smallest model x)."""
+    nd = nodes()
+    dx = np.array([0.0, 0.1, 0.2])
+    u, w = WaveModelBoundary(LinearShallowModel(), nd, SWL, x_model=2.0).velocity_along(1.5, dx)
+    assert u.shape == w.shape == (3, nd.size)
+    np.testing.assert_allclose(u, np.tile(nd.z - SWL, (3, 1)))
+    np.testing.assert_allclose(w, 1.5)
+    src = WaveModelBoundary(FrontModel(), nd, SWL, x_model=2.0)
+    u, w = src.velocity_along(1.0, dx)
+    np.testing.assert_allclose(u, 0.5 * (2.0 + dx)[:, None] * np.ones(nd.size))
+    np.testing.assert_allclose(w, 0.5 * np.tile(nd.z - SWL, (3, 1)))
+    u, _ = src.velocity_along(1.0, -dx + 0.2)   # the outlet's way: columns at 2.2 ... 2.0 m
+    np.testing.assert_allclose(u[:, 0], 0.5 * (2.2 - dx))
+    u, _ = WaveModelBoundary(FrontModel(), nd, SWL, x_model=2.15).velocity_along(1.0, dx)
+    assert np.all(u == 0.0)   # ahead of the front: still water
+
+
 def test_wave_model_adapter_refuses_a_depth_mismatch():
     with pytest.raises(BoundaryDataError, match="model.depth"):
         WaveModelBoundary(LinearShallowModel(depth=0.7), nodes(), SWL, x_model=0.0)

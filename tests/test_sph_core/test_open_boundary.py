@@ -189,7 +189,8 @@ def test_isph_relaxation_zone_pulls_the_fluid_towards_the_source():
     fluid = ps.kind[:n] == FLUID
     ps.view.vx[:n][fluid] = 0.0
     ps.view.vz[:n][fluid] = 0.0
-    ob.relax_to_source(ps.view, n, 0.25, dt, fl.open.ends, zone, tau)
+    assert not fl.open.zone.local.any()   # a source of face data only: the face's profile
+    ob.relax_to_source(ps.view, n, 0.25, dt, fl.open.ends, zone, tau, fl.open.zone)
     x = ps.f[X, :n][fluid]
     s = np.minimum(x, sc.tank.x1 - x)
     q = np.where(s < 0.0, 0.0, np.clip(1.0 - s / zone, 0.0, None))   # s < 0: in a buffer's face
@@ -200,6 +201,50 @@ def test_isph_relaxation_zone_pulls_the_fluid_towards_the_source():
     assert inside.sum() > 20 and (~inside).sum() > 20
     assert np.all(ps.view.vx[:n][fluid][~inside] == 0.0)
     assert expected.max() > 0.01 * 0.2   # the pull at the face: ~1.5 % of U a step
+
+
+def test_isph_relaxation_zone_pulls_towards_the_wave_where_a_model_knows_it():
+    """Where an end's source is a wave model (WaveModelBoundary), the zone's target is the wave's
+    own velocity at the particle (the model evaluated there, open_ends.zone_targets), not the
+    face's profile: a zone 0.3 m long holds a sixth of this 1.7 m wave, whose phase turns by a
+    rad across it. Checked against the model at each particle to the stations' interpolation."""
+    from sph_core.boundary_data import WaveModelBoundary
+    from wave_client.theories.linear import AiryWave
+
+    zone, tau, dt, t = 0.3, 0.2, 0.003, 0.25
+    sc = flume_scene(length=1.0, scheme="isph")
+    sc = sc.model_copy(update={"scheme": sc.scheme.model_copy(update={
+        "isph_relaxation_zone": zone, "isph_relaxation_time": tau})})
+    wave = AiryWave(0.02, 1.1, D)
+    src = {s: WaveModelBoundary(wave, nd, D, nd.x_face) for s, nd in flume_nodes(sc).items()}
+    fl = Simulation(sc, sources=src, window=0.05)
+    assert fl.open.zone.local.all() and fl.open.zone.ds <= DP
+    assert fl.stepper.zone_targets is fl.open.zone
+    fl.advance_to(t)
+    ps = fl.particles
+    n = ps.n
+    fluid = ps.kind[:n] == FLUID
+    ps.view.vx[:n][fluid] = 0.0
+    ps.view.vz[:n][fluid] = 0.0
+    ob.relax_to_source(ps.view, n, t, dt, fl.open.ends, zone, tau, fl.open.zone)
+    x, z = ps.f[X, :n][fluid], ps.f[Z, :n][fluid]
+    s = np.minimum(x, sc.tank.x1 - x)
+    inside = (s >= 0.0) & (s < zone)
+    assert inside.sum() > 100
+    a = 1.0 - np.exp(-dt * (1.0 - s[inside] / zone) ** 2 / tau)
+    wave.advance_to(t)
+    u, w = wave.velocity(x[inside], z[inside] - D)
+    vx, vz = ps.view.vx[:n][fluid][inside], ps.view.vz[:n][fluid][inside]
+    scale = a * 0.01 * wave.omega / math.tanh(wave.k * D)   # a times the surface orbit speed
+    # nodes, not exact heights, and stations DP apart: within 5 % of the orbit speed
+    assert np.max(np.abs(vx - a * u) / scale) < 0.05
+    assert np.max(np.abs(vz - a * w) / scale) < 0.05
+    # the face's profile (the old target) is a wave's sixth off at the zone's end: far from it
+    nd = flume_nodes(sc)["left"]
+    u_face = a * np.interp(z[inside], nd.z, src["left"].sample(t).u)
+    far = s[inside] > 0.2
+    assert np.max(np.abs(vx - u_face)[far] / scale[far]) > 0.5
+    assert np.all(ps.view.vx[:n][fluid][~inside] == 0.0)
 
 
 class Straining:

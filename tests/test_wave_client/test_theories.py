@@ -407,6 +407,27 @@ def test_half_cosine_ramp():
         assert ramped.velocity(x, z)[0][0] == pytest.approx(r * plain.velocity(x, z)[0][0], abs=1e-15)
 
 
+def test_front_factor_delays_the_ramp_by_the_travel_at_the_group_velocity():
+    """RegularWaveTheory.front_factor: the wave a wavemaker at x = 0 sends reaches x at the
+    linear group velocity; the factor is the delayed ramp over the ramp in force (1 behind the
+    front, 0 ahead of it, 1 without a ramp)."""
+    wave = AiryWave(0.04, 1.4, 0.24, ramp_time=1.4)
+    kd = wave.k * wave.depth
+    cg = 0.5 * wave.length / wave.period * (1.0 + 2.0 * kd / np.sinh(2.0 * kd))
+    x = np.array([-1.0, 0.0, 0.5, 1.0, 3.0, 20.0])
+    for t in (0.7, 1.4, 2.5, 6.0):
+        wave.advance_to(t)
+        expected = [ramp_factor(t - max(xi, 0.0) / cg, 1.4) / ramp_factor(t, 1.4) for xi in x]
+        assert wave.front_factor(x) == pytest.approx(expected, abs=1e-12)
+    wave.advance_to(6.0)
+    f = wave.front_factor(x)
+    assert f[0] == f[1] == 1.0 and f[-1] == 0.0 and 0.0 < f[4] <= 1.0
+    wave.advance_to(0.0)   # before the ramp: nothing anywhere
+    assert np.all(wave.front_factor(x) == 0.0)
+    plain = AiryWave(0.04, 1.4, 0.24)
+    assert np.all(plain.front_factor(x) == 1.0)
+
+
 # --- validation -----------------------------------------------------------------------------
 @pytest.mark.parametrize(
     "kwargs,param",

@@ -149,3 +149,21 @@ class RegularWaveTheory(WaveTheory):
         self.depth = require_positive("depth", depth)
         self.g = require_positive("g", g)
         check_not_breaking(self.height, self.period, self.depth)
+
+    def front_factor(self, x: ArrayLike) -> np.ndarray:
+        """How much of the wave has reached x [m] at ``self.t``, as a fraction of the ramp in
+        force: the start-up ramp delayed by the travel max(x, 0) / c_g at the linear group
+        velocity (x = 0 the ramp's origin, the wavemaker), over the ramp at x = 0. 1 without a
+        ramp or once the front has passed, 0 ahead of it. The theory's own ramp holds at every x
+        at once; a wavemaker's wave takes time to arrive, and what stands inside a flume
+        (ISPH's relaxation zones' targets, sph_core.boundary_data) is the arriving wave."""
+        xa = np.maximum(np.asarray(x, dtype=float), 0.0)
+        r0 = ramp_factor(self.t, self.ramp_time)
+        if self.ramp_time <= 0.0 or r0 <= 0.0:
+            return np.full(xa.shape, 1.0 if self.ramp_time <= 0.0 else 0.0)
+        from wave_client.theories.linear import wavenumber   # linear.py imports this module
+        omega = 2.0 * math.pi / self.period
+        kd = float(wavenumber(omega, self.depth, self.g)) * self.depth
+        cg = 0.5 * omega * self.depth / kd * (1.0 + 2.0 * kd / math.sinh(2.0 * kd))
+        delayed = np.vectorize(ramp_factor)(self.t - xa / cg, self.ramp_time)
+        return np.asarray(delayed / r0, dtype=float)
