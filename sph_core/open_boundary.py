@@ -5,7 +5,7 @@ The step (step.run) calls three hooks, each a no-op when ``ends.active`` is Fals
     extrapolate_buffers after the sort: ghost-node pressure of extrapolating ends
     measure_boundaries  after the forces: the boundary gauges (eta_meas)
 and ISPH's stepper a fourth after update_buffers where its scheme asks for relaxation zones:
-    relax_to_source     the fluid's velocity pulled towards the source's near each face
+    relax_to_source     the fluid's velocity pulled towards the wave's near each face
 The Python side (settings, sources, windows, validation) is open_ends.OpenBoundaries.
 
 A flume has at most two open ends, index b = 0 (left, particle kinds INLET / INLET_IDLE) and

@@ -12,7 +12,9 @@ The scene's ``open_boundaries`` say which tank walls are open (see ``scene.OpenB
 [t0, t1] the jitted loop interpolates the two end samples linearly in time (seed 001,
 Algorithm 2), so no Python runs between sub-steps. Bad boundary data raise ``BoundaryDataError``
 before any step is taken. The jitted physics is open_boundary.py; the kernels see this value as
-``state.OpenEnds`` (``self.ends``), whose window arrays ``load_window`` fills in place.
+``state.OpenEnds`` (``self.ends``), whose window arrays ``load_window`` fills in place, and
+ISPH's relaxation zones the wave inside the domain as ``state.ZoneTargets`` (``self.zone``, filled
+by the same call where a wave model drives the run in-process).
 """
 
 from __future__ import annotations
@@ -104,7 +106,8 @@ class OpenBoundaries:
         # samples at the window start: at rest until the first window is loaded
         self.samples = {s: still_sample(self.nodes[s], 0.0) for s in sides}
         # ISPH's relaxation zones: local targets of the ends whose source knows the wave inside
-        # the domain, at stations k ds from the face into the fluid (the time of level 1)
+        # the domain, at stations k ds from the face into the fluid; _zone_t: the time of their
+        # level-1 data (NaN: none loaded yet)
         self.zone = no_zone_targets() if zone is None else zone
         self._zone_t = math.nan
 
@@ -267,7 +270,7 @@ class OpenBoundaries:
         for b in np.nonzero(z.local)[0]:
             src = self.sources[SIDES[b]]
             dx = -self.ends.nx[b] * z.ds * k
-            if abs(self._zone_t - t0) <= 1e-9 * max(1.0, abs(t0)):   # NaN: none yet
+            if abs(self._zone_t - t0) <= 1e-9 * max(1.0, abs(t0)):
                 z.u[b, :, 0] = z.u[b, :, 1]
                 z.w[b, :, 0] = z.w[b, :, 1]
             else:
