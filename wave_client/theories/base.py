@@ -7,6 +7,7 @@ Waves travel towards +x; the crest is at x = 0 at t = 0 for regular waves.
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -161,9 +162,13 @@ class RegularWaveTheory(WaveTheory):
         r0 = ramp_factor(self.t, self.ramp_time)
         if self.ramp_time <= 0.0 or r0 <= 0.0:
             return np.full(xa.shape, 1.0 if self.ramp_time <= 0.0 else 0.0)
+        delayed = np.vectorize(ramp_factor)(self.t - xa / self.group_velocity, self.ramp_time)
+        return np.asarray(delayed / r0, dtype=float)
+
+    @functools.cached_property
+    def group_velocity(self) -> float:
+        """Linear theory's group velocity [m/s] at this period and depth (the front's speed)."""
         from wave_client.theories.linear import wavenumber   # linear.py imports this module
         omega = 2.0 * math.pi / self.period
         kd = float(wavenumber(omega, self.depth, self.g)) * self.depth
-        cg = 0.5 * omega * self.depth / kd * (1.0 + 2.0 * kd / math.sinh(2.0 * kd))
-        delayed = np.vectorize(ramp_factor)(self.t - xa / cg, self.ramp_time)
-        return np.asarray(delayed / r0, dtype=float)
+        return 0.5 * omega * self.depth / kd * (1.0 + 2.0 * kd / math.sinh(2.0 * kd))
