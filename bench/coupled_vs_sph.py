@@ -37,7 +37,10 @@ too (absorption-only, the client absorbing at both ends; FlumeCase.end), against
 over the same flat flume: the coupling and the zone's own travel without a beach, for any scheme
 (ISPH with its wave options: --h-over-dp 1.2 --isph-density-relaxation 0.05 --isph-wall-stop 100
 --isph-relaxation-zone 0.4). The reflection split then reads the outlet's: outlet_reflection
-and outlet_reflection_reference (flat and mid gauges).
+and outlet_reflection_reference (flat and mid gauges). ISPH's relaxation zones pull towards the
+model's wave at each x inside them, which the client sends (protocol 1.2 ZONE_NODES; the line's
+zone_targets "local"); --face-zone-targets sends the faces only (zone_targets "face": the zones
+pull towards the face's profile).
 Speed figures want a quiet machine and OpenMP's default (active) wait policy: on a shared,
 loaded machine set OMP_WAIT_POLICY=passive, which costs the small SPH zone ~27 % of its
 throughput (its parallel regions are short; a sleeping worker takes ~0.1 ms to wake).
@@ -162,6 +165,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--alpha-wall", type=float, help="SPH wall viscosity factor (scene default)")
     add_scheme_arguments(ap)
     ap.add_argument("--out", type=Path, default=None, help="run directories (default: a temp dir)")
+    ap.add_argument("--face-zone-targets", action="store_true",
+                    help="ISPH: the client sends the wave at the faces only, so the relaxation "
+                         "zones pull towards the face's profile (default: the wave inside them)")
     args = ap.parse_args(argv)
     scheme = scheme_from_args(args)
     out = args.out or Path(tempfile.mkdtemp(prefix="coupled_vs_sph-"))
@@ -179,11 +185,14 @@ def main(argv: list[str] | None = None) -> int:
               "H_over_dp": round(c.height / args.dp, 3), "wavelengths": c.wavelengths,
               "wavelength_m": round(c.wavelength, 4), "t_end": round(c.t_end, 3),
               "compare_from": round(c.compare_from, 3), "gauge_x_from_inlet": c.gauge,
-              "t_sph_start": round(c.t_sph_start, 3), "end": c.end, "x_flat": c.x_flat}
+              "t_sph_start": round(c.t_sph_start, 3), "end": c.end, "x_flat": c.x_flat,
+              **({"zone_targets": "face" if args.face_zone_targets else "local"}
+                 if (scheme or {}).get("isph_relaxation_zone") else {})}
     coupled, records = {}, {}
     for mode in modes:
         res = run_coupled(c, args.dp, out / f"coupled_{mode}", two_way=mode == "two_way",
-                          absorb=args.absorb, constants=constants, scheme=scheme)
+                          absorb=args.absorb, constants=constants, scheme=scheme,
+                          zone_nodes=not args.face_zone_targets)
         records[mode] = res
         line = {"run": "coupled", "mode": res["mode"], "absorb": res["absorb"], **common,
                 "state": res["state"],

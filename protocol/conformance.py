@@ -177,7 +177,8 @@ def check_server(url: str, run_id: str = "", error_run_id: str | None = None, wi
             last = elapsed
 
     try:
-        want = int(Capability.GOBACK | Capability.GAUGE_INFO | Capability.KEEPALIVE)
+        want = int(Capability.GOBACK | Capability.GAUGE_INFO | Capability.KEEPALIVE
+                   | Capability.ZONE_NODES)
         got = ask(Hello(want, NO_SCENE_HASH, "" if ws and not run_id else run_id, "protocol.conformance"))
         if not rep.check("handshake: HELLO -> WELCOME", got is not None and isinstance(got[1], Welcome)
                          and got[0] == 1, _seen(got)):
@@ -191,10 +192,19 @@ def check_server(url: str, run_id: str = "", error_run_id: str | None = None, wi
         got = ask(GetNodes())
         ok = got is not None and isinstance(got[1], Nodes) and got[0] == seq
         n: Nodes | None = got[1] if ok else None  # type: ignore[assignment]
+        sides = {0, 1, 2, 3} if w.capabilities & Capability.ZONE_NODES else {0, 1}
         rep.check("GETNODES -> NODES of N nodes and G gauges", n is not None
                   and n.x.size == w.n_nodes and n.gauge_x.size == w.n_gauges
-                  and bool(np.all(np.isfinite(n.z))) and set(np.unique(n.side).tolist()) <= {0, 1},
+                  and bool(np.all(np.isfinite(n.z))) and set(np.unique(n.side).tolist()) <= sides,
                   _seen(got))
+        if n is not None and w.capabilities & Capability.ZONE_NODES:
+            face = n.side <= 1
+            k = int(face.sum())
+            rep.check("NODES with ZONE_NODES (1.2): the faces' nodes first, then zone columns on "
+                      "their face's levels", bool(np.all(face[:k]) and not np.any(face[k:]))
+                      and all(np.array_equal(n.z[(n.side == s) & (n.x == x)], n.z[n.side == s - 2])
+                              for s in (2, 3) for x in np.unique(n.x[n.side == s])),
+                      f"sides {n.side.tolist()[:8]}...")
         if w.capabilities & Capability.GAUGE_INFO:
             got = ask(GetGauges())
             g = got[1] if got is not None and isinstance(got[1], Gauges) else None

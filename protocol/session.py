@@ -96,10 +96,13 @@ class SphSession:
     set to the largest frame the client may send for this scene (a SET). ``nodes`` is the reply
     to GETNODES; its lengths must agree with ``welcome``. ``gauges`` (1.1) is the reply to
     GETGAUGES: given, the GAUGE_INFO capability is offered; a 1.0 client does not ask for it and
-    is served as before.
+    is served as before. ``zone_nodes`` (1.2) is the reply to GETNODES when ZONE_NODES is in
+    force: ``nodes`` followed by the relaxation zones' columns (sides 2, 3); given, the
+    capability is offered, and a client granted it sends SETs of that many nodes.
     """
 
-    def __init__(self, welcome: Welcome, nodes: Nodes, gauges: Gauges | None = None) -> None:
+    def __init__(self, welcome: Welcome, nodes: Nodes, gauges: Gauges | None = None,
+                 zone_nodes: Nodes | None = None) -> None:
         if not (nodes.x.size == nodes.z.size == nodes.side.size == welcome.n_nodes
                 and nodes.gauge_x.size == welcome.n_gauges):
             raise ValueError("nodes: array lengths disagree with welcome.n_nodes / n_gauges")
@@ -107,7 +110,16 @@ class SphSession:
             if not len(gauges.names) == gauges.kind.size == welcome.n_gauges:
                 raise ValueError("gauges: names / kind lengths disagree with welcome.n_gauges")
             welcome = replace(welcome, capabilities=welcome.capabilities | Capability.GAUGE_INFO)
+        if zone_nodes is not None:
+            n_face = nodes.x.size
+            if not (zone_nodes.x.size == zone_nodes.z.size == zone_nodes.side.size > n_face
+                    and np.array_equal(zone_nodes.x[:n_face], nodes.x)
+                    and np.array_equal(zone_nodes.side[:n_face], nodes.side)
+                    and np.array_equal(zone_nodes.gauge_x, nodes.gauge_x)):
+                raise ValueError("zone_nodes: must be nodes followed by the zones' columns")
+            welcome = replace(welcome, capabilities=welcome.capabilities | Capability.ZONE_NODES)
         self.gauges = gauges
+        self.zone_nodes = zone_nodes
         # after HELLO the client may send nothing larger than a SET for this scene
         self.client_limit = max(set_payload_size(welcome.n_nodes), 4 + 4 + MAX_TEXT)
         self.offer = replace(welcome, max_payload=self.client_limit)
@@ -185,6 +197,11 @@ class SphSession:
                                 f"client expects scene {msg.scene_hash.hex()[:16]}..., "
                                 f"this run has {self.offer.scene_hash.hex()[:16]}...")
         self.capabilities = msg.capabilities & self.offer.capabilities
+        if self.capabilities & Capability.ZONE_NODES and self.zone_nodes is not None:
+            self.nodes = self.zone_nodes
+            self.client_limit = max(set_payload_size(self.nodes.x.size), 4 + 4 + MAX_TEXT)
+            self.offer = replace(self.offer, n_nodes=self.nodes.x.size,
+                                 max_payload=self.client_limit)
         self.state = State.READY
         return Reply(self._frame(replace(self.offer, capabilities=self.capabilities)))
 

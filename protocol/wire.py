@@ -46,6 +46,7 @@ class Capability(IntEnum):
     GOBACK = 1 << 0       # client may send GOBACK (implicit / iterated coupling)
     GAUGE_INFO = 1 << 1   # protocol 1.1: GETGAUGES -> GAUGES (names, kinds, the SPH-side eta gauges)
     KEEPALIVE = 1 << 2    # protocol 1.1: WORKING frames while a reply takes long (the JIT compile)
+    ZONE_NODES = 1 << 3   # protocol 1.2: NODES also lists columns inside the SPH zone's relaxation zones
 
 
 class Side(IntEnum):
@@ -53,6 +54,8 @@ class Side(IntEnum):
 
     INLET = 0
     OUTLET = 1
+    INLET_ZONE = 2    # 1.2 (ZONE_NODES): a column inside the inlet's relaxation zone
+    OUTLET_ZONE = 3   # 1.2 (ZONE_NODES): a column inside the outlet's relaxation zone
 
 
 class GaugeKind(IntEnum):

@@ -20,7 +20,8 @@ import numpy as np
 from protocol import (NO_SCENE_HASH, Capability, ErrorCode, GaugeKind, Gauges, Nodes, ProtocolError,
                       Result, SphSession, Welcome, encode_frame)
 from protocol.messages import Error, Hello, Message, Working
-from protocol.session import Measure, PeerError, Reply, Restore, SetWindow, SolveWindow
+from protocol.session import (Measure, PeerError, Reply, Restore, SetWindow, SolveWindow,
+                              set_payload_size)
 
 from .engine import CouplingEngine, Measurement, SolveCancelled
 from .run_manager import Run, RunManager
@@ -133,9 +134,11 @@ async def claim_run(manager: RunManager, run_id: str, hello: Hello,
             manager.unreserve(run)
 
 
-def welcome_for(run: Run, engine: CouplingEngine,
-                idle_timeout: float) -> tuple[Welcome, Nodes, Gauges]:
-    """WELCOME (the scene summary), NODES and, for 1.1 clients, GAUGES of a run's engine."""
+def welcome_for(run: Run, engine: CouplingEngine, idle_timeout: float, max_frame: int
+                ) -> tuple[Welcome, Nodes, Gauges, Nodes | None]:
+    """WELCOME (the scene summary), NODES, for 1.1 clients GAUGES, and for 1.2 clients the
+    NODES with the relaxation zones' columns (None: the engine has no zones, or their SET would
+    not fit in ``max_frame``) of a run's engine."""
     s, nodes = engine.summary, engine.nodes()
     welcome = Welcome(int(Capability.GOBACK | Capability.KEEPALIVE), bytes.fromhex(run.info.scene_hash), g=s.g, depth=s.depth,
                       still_water_level=s.still_water_level, z_ref=s.z_ref, t_start=s.t_start,
@@ -146,7 +149,11 @@ def welcome_for(run: Run, engine: CouplingEngine,
     gauges = Gauges(nodes.gauge_names or [f"g{j}" for j in range(n)],
                     nodes.gauge_kind if nodes.gauge_kind is not None
                     else np.full(n, GaugeKind.PROBE, np.uint32), np.array(nodes.eta_gauge, np.uint32))
-    return welcome, Nodes(nodes.x, nodes.z, nodes.side, nodes.gauge_x), gauges
+    zone = getattr(engine, "zone_nodes", lambda: None)()
+    if zone is not None and set_payload_size(zone.x.size) > max_frame:
+        zone = None
+    return (welcome, Nodes(nodes.x, nodes.z, nodes.side, nodes.gauge_x), gauges,
+            None if zone is None else Nodes(zone.x, zone.z, zone.side, zone.gauge_x))
 
 
 async def serve_client(manager: RunManager, run: Run, transport: DoorTransport,
@@ -155,8 +162,9 @@ async def serve_client(manager: RunManager, run: Run, transport: DoorTransport,
     settings, engine = manager.settings, run.engine
     assert engine is not None and run.gauges is not None
     loop = asyncio.get_running_loop()
-    welcome, nodes, gauges = welcome_for(run, engine, settings.idle_timeout)
-    session = SphSession(welcome, nodes, gauges)
+    welcome, nodes, gauges, zone_nodes = welcome_for(run, engine, settings.idle_timeout,
+                                                     settings.max_frame)
+    session = SphSession(welcome, nodes, gauges, zone_nodes)
     names = engine.nodes().gauge_names or [f"g{j}" for j in range(nodes.gauge_x.size)]
     pending = list(first)
     connected = time.perf_counter()

@@ -47,7 +47,7 @@ class EngineNodes:
 
     x: np.ndarray
     z: np.ndarray
-    side: np.ndarray           # 0 inlet, 1 outlet
+    side: np.ndarray           # 0 inlet, 1 outlet (2, 3: columns inside their relaxation zones)
     gauge_x: np.ndarray
     gauge_names: list[str] = field(default_factory=list)
     gauge_kind: np.ndarray | None = None   # protocol.GaugeKind per gauge; None: all probes
@@ -72,6 +72,9 @@ class CouplingEngine(Protocol):
     n_particles: int
 
     def nodes(self) -> EngineNodes: ...
+    # optional (protocol 1.2, ZONE_NODES): ``zone_nodes() -> EngineNodes | None``, the nodes
+    # followed by the columns inside the relaxation zones (sides 2, 3); a SET of that many
+    # nodes gives the zones their local targets (server/flume_engine.py)
     def set_window(self, t0: float, t1: float, u: np.ndarray, w: np.ndarray, eta: np.ndarray) -> None:
         """Boundary values at t1; the values in force at t0 are those of the previous window."""
     def solve_window(self) -> Measurement:

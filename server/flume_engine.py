@@ -6,6 +6,10 @@ Protocol view of the flume (PROTOCOL.md):
 - SET u, w at the nodes become the end's velocity profile at t1; eta (equal at the nodes of one
   end, which share their x) becomes the end's target elevation. The flume interpolates linearly
   in time inside the window, from the values in force at t0 (seed 001, Algorithm 2).
+- zone nodes (protocol 1.2, ZONE_NODES; an ISPH scene with relaxation zones): the nodes, then
+  per open end its zone's columns (the face's z levels at each x, side 2 + end): u, w there
+  become the zone's local targets (sph_core.open_ends, ``advance_window(zone=...)``); eta there
+  is not used. A SET of the face nodes alone leaves the zones pulling towards the face's profile.
 - gauges: each open end's boundary gauge (`left_boundary`, `right_boundary`, measured by the
   flume at x_gauge) then the scene's elevation probes; u_ref, w_ref at z_ref below still water
   at each gauge's x come from point probes the engine adds to its copy of the scene.
@@ -87,9 +91,25 @@ class FlumeEngine:
                                   np.array(gauge_x), list(self.gauge_names),
                                   np.where(boundary, GaugeKind.BOUNDARY, GaugeKind.PROBE).astype(np.uint32),
                                   eta_gauge)
+        self._zone_nodes: EngineNodes | None = None
+        self._zone_slices: dict[str, tuple[slice, int]] = {}   # side -> (slice, columns)
+        cols = f.zone_columns
+        if cols:
+            zx, zz, zside = [self._nodes.x], [self._nodes.z], [self._nodes.side]
+            for s in self.sides:
+                nd, c = f.nodes[s], cols[s]
+                self._zone_slices[s] = (slice(k, k + c.size * nd.size), c.size)
+                k += c.size * nd.size
+                zx.append(np.repeat(c, nd.size))
+                zz.append(np.tile(nd.z - swl, c.size))
+                zside.append(np.full(c.size * nd.size, 2 + SIDES.index(s), dtype=np.uint32))
+            self._zone_nodes = replace(self._nodes, x=np.concatenate(zx), z=np.concatenate(zz),
+                                       side=np.concatenate(zside))
         self.summary = SceneSummary(g=scene.constants.g, depth=depth, still_water_level=swl,
                                     z_ref=z_ref, t_start=f.t, t_end=scene.t_end, dt_sph=f.dt)
-        self._window: tuple[float, float, dict[str, BoundarySample]] | None = None
+        # t0, t1, each end's sample at t1, each zone's (u, w)[column, node] at t1
+        self._window: tuple[float, float, dict[str, BoundarySample],
+                            dict[str, tuple[np.ndarray, np.ndarray]]] | None = None
         self._saved = None
         self._window_steps = 0
         self.cancel: threading.Event | None = None  # the run's cancel flag (server/engine.py)
@@ -113,22 +133,30 @@ class FlumeEngine:
     def nodes(self) -> EngineNodes:
         return self._nodes
 
+    def zone_nodes(self) -> EngineNodes | None:
+        """The nodes followed by the relaxation zones' columns (None: the scene has no zones)."""
+        return self._zone_nodes
+
     def set_window(self, t0: float, t1: float, u: np.ndarray, w: np.ndarray, eta: np.ndarray) -> None:
-        samples = {}
+        samples: dict[str, BoundarySample] = {}
         for s in self.sides:
             sl = self._slices[s]
             samples[s] = BoundarySample(t1, np.asarray(u[sl]), np.asarray(w[sl]),
                                         float(np.mean(eta[sl])))
-        self._window = (t0, t1, samples)
+        zone: dict[str, tuple[np.ndarray, np.ndarray]] = {}
+        if self._zone_nodes is not None and u.size == self._zone_nodes.x.size:
+            for s, (sl, n_cols) in self._zone_slices.items():
+                zone[s] = (np.asarray(u[sl]).reshape(n_cols, -1), np.asarray(w[sl]).reshape(n_cols, -1))
+        self._window = (t0, t1, samples, zone)
 
     def solve_window(self) -> Measurement:
         if self._window is None:
             raise RuntimeError("solve_window before set_window")
-        _, t1, samples = self._window
+        _, t1, samples, zone = self._window
         before = self.flume.steps
         self._solve_started = time.perf_counter()
         try:
-            self.flume.advance_window(t1, **samples, progress=self._check_cancel)
+            self.flume.advance_window(t1, **samples, progress=self._check_cancel, zone=zone)
         except BoundaryDataError as exc:  # the client's data, not our failure
             raise ProtocolError(ErrorCode.BAD_VALUE, f"SET: {exc}") from None
         finally:

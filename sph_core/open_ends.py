@@ -14,7 +14,8 @@ Algorithm 2), so no Python runs between sub-steps. Bad boundary data raise ``Bou
 before any step is taken. The jitted physics is open_boundary.py; the kernels see this value as
 ``state.OpenEnds`` (``self.ends``), whose window arrays ``load_window`` fills in place, and
 ISPH's relaxation zones the wave inside the domain as ``state.ZoneTargets`` (``self.zone``, filled
-by the same call where a wave model drives the run in-process).
+by the same call: from the side's source where a wave model drives the run in-process, or from
+the zone's columns given with the window, ``zone_end``, where a coupling client sends them).
 """
 
 from __future__ import annotations
@@ -49,6 +50,13 @@ class OpenState:
     samples: dict[str, BoundarySample]
     filt_x: np.ndarray
     zs: np.ndarray | None = None   # the buffers' surfaces (None in checkpoints made before it)
+    # ISPH's relaxation zones: which ends pull towards local targets, those targets at the
+    # window start ([2, K, nodes] u and w) and their time (None: no local targets, or a
+    # checkpoint made before them)
+    zone_local: np.ndarray | None = None
+    zone_u: np.ndarray | None = None
+    zone_w: np.ndarray | None = None
+    zone_t: float | None = None
 
 
 def check_open_end_layout(scene: Scene) -> None:
@@ -109,6 +117,7 @@ class OpenBoundaries:
         # the domain, at stations k ds from the face into the fluid; _zone_t: the time of their
         # level-1 data (NaN: none loaded yet)
         self.zone = no_zone_targets() if zone is None else zone
+        self.has_zone = zone is not None   # ISPH's relaxation zones: local targets may be given
         self._zone_t = math.nan
 
     # ---------------------------------------------------------------- named constructors
@@ -247,9 +256,13 @@ class OpenBoundaries:
                                         f"ending at {t1}")
         return end
 
-    def load_window(self, t0: float, t1: float, end: Mapping[str, BoundarySample]) -> None:
+    def load_window(self, t0: float, t1: float, end: Mapping[str, BoundarySample],
+                    zone_end: Mapping[str, tuple[np.ndarray, np.ndarray]] | None = None) -> None:
         """The jitted window: data of the current start samples at t0, of ``end`` at t1 (and
-        the relaxation zones' local targets at both)."""
+        the relaxation zones' local targets at both). ``zone_end``: side -> (u, w)[station,
+        node] at t1 of that end's zone, given from outside (``check_zone_data``); the ends it
+        names pull towards them, the others towards their source's wave (in-process) or the
+        face's profile."""
         e = self.ends
         e.win_t[:] = (t0, t1)
         for side in self.sides:
@@ -259,24 +272,72 @@ class OpenBoundaries:
                 e.win_w[b, lv] = s.w
                 e.win_eta[b, lv] = s.eta
                 e.win_etag[b, lv] = s.gauge_eta
-        if self.zone.local.any():
-            self._load_zone(t0, t1)
+        if self.has_zone:
+            self._load_zone(t0, t1, zone_end or {})
 
-    def _load_zone(self, t0: float, t1: float) -> None:
-        """The zones' local targets at t0 (the last window's t1 data, or sampled after a
-        restore) and t1, from each local end's source (``velocity_along``)."""
+    def _load_zone(self, t0: float, t1: float,
+                   given: Mapping[str, tuple[np.ndarray, np.ndarray]]) -> None:
+        """The zones' local targets at t0 and t1: at t0 the last window's t1 data (else, after a
+        restore without them, the source sampled at t0, or the given data held over the
+        window); at t1 the given data, else each in-process source's (``velocity_along``). An
+        end with neither pulls towards its face's profile (``local`` False)."""
         z = self.zone
         k = np.arange(z.u.shape[1])
-        for b in np.nonzero(z.local)[0]:
-            src = self.sources[SIDES[b]]
-            dx = -self.ends.nx[b] * z.ds * k
-            if abs(self._zone_t - t0) <= 1e-9 * max(1.0, abs(t0)):
+        go_on = abs(self._zone_t - t0) <= 1e-9 * max(1.0, abs(t0))
+        for b, side in enumerate(SIDES):
+            src = self.sources.get(side)
+            if side in given:
+                u1, w1 = given[side]
+            elif side in self.sides and hasattr(src, "velocity_along"):
+                u1, w1 = src.velocity_along(t1, -self.ends.nx[b] * z.ds * k)
+            else:
+                z.local[b] = False
+                continue
+            if go_on and z.local[b]:
                 z.u[b, :, 0] = z.u[b, :, 1]
                 z.w[b, :, 0] = z.w[b, :, 1]
+            elif side not in given:
+                z.u[b, :, 0], z.w[b, :, 0] = src.velocity_along(t0, -self.ends.nx[b] * z.ds * k)
             else:
-                z.u[b, :, 0], z.w[b, :, 0] = src.velocity_along(t0, dx)
-            z.u[b, :, 1], z.w[b, :, 1] = src.velocity_along(t1, dx)
+                z.u[b, :, 0], z.w[b, :, 0] = u1, w1
+            z.u[b, :, 1], z.w[b, :, 1] = u1, w1
+            z.local[b] = True
         self._zone_t = t1
+
+    def zone_columns(self) -> dict[str, np.ndarray]:
+        """side -> the x [m] of the zone's stations inside the fluid (station 0, the face,
+        excluded: its data is the window's face sample) where local targets may be given from
+        outside (``load_window``'s ``zone_end``); empty without ISPH relaxation zones."""
+        z = self.zone
+        if not self.has_zone:
+            return {}
+        k = np.arange(1, z.u.shape[1])
+        return {side: self.ends.x_face[SIDES.index(side)]
+                - self.ends.nx[SIDES.index(side)] * z.ds * k for side in self.sides}
+
+    def check_zone_data(self, end: Mapping[str, BoundarySample],
+                        given: Mapping[str, tuple[np.ndarray, np.ndarray]]
+                        ) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+        """The zones' data at t1 given from outside as ``load_window`` takes it: (u, w)[station,
+        node], station 0 the face's sample in ``end`` (``end_samples``). ``given``: side -> (u,
+        w)[column, node] over ``zone_columns()[side]``. Raises BoundaryDataError naming the side
+        and field."""
+        cols = self.zone_columns()
+        out: dict[str, tuple[np.ndarray, np.ndarray]] = {}
+        for side, (u, w) in given.items():
+            if side not in cols:
+                raise BoundaryDataError(f"{side}.zone: this run has no relaxation zone there")
+            shape = (cols[side].size, self.nodes[side].size)
+            u, w = np.asarray(u, dtype=float), np.asarray(w, dtype=float)
+            for name, a in (("u", u), ("w", w)):
+                if a.shape != shape:
+                    raise BoundaryDataError(f"{side}.zone.{name}: shape {a.shape}, expected "
+                                            f"{shape} (columns, nodes)")
+                if not np.all(np.isfinite(a)):
+                    raise BoundaryDataError(f"{side}.zone.{name}: not finite at t = "
+                                            f"{end[side].t}")
+            out[side] = (np.vstack([end[side].u[None, :], u]), np.vstack([end[side].w[None, :], w]))
+        return out
 
     # ---------------------------------------------------------------- readings and state
     def gauges(self) -> dict[str, float | None]:
@@ -294,8 +355,14 @@ class OpenBoundaries:
     def state(self) -> OpenState | None:
         if not self.active:
             return None
+        z = self.zone
+        local = bool(z.local.any()) and math.isfinite(self._zone_t)
         return OpenState(self.ends.eta_meas.copy(), self.ends.counters.copy(), dict(self.samples),
-                         self.ends.filt_x.copy(), self.ends.zs.copy())
+                         self.ends.filt_x.copy(), self.ends.zs.copy(),
+                         z.local.copy() if local else None,
+                         z.u[:, :, 1].copy() if local else None,
+                         z.w[:, :, 1].copy() if local else None,
+                         float(self._zone_t) if local else None)
 
     def set_state(self, s: OpenState | None) -> None:
         if s is None:
@@ -306,18 +373,26 @@ class OpenBoundaries:
             self.ends.zs[:] = s.zs
         self.samples = dict(s.samples)
         self.ends.filt_x[:] = s.filt_x
+        self._zone_t = math.nan   # a local zone re-samples its source, or holds its given data
+        if s.zone_u is not None and s.zone_w is not None and s.zone_t is not None \
+                and s.zone_local is not None and s.zone_u.shape == self.zone.u[:, :, 1].shape:
+            self.zone.local[:] = s.zone_local
+            self.zone.u[:, :, 1] = s.zone_u
+            self.zone.w[:, :, 1] = s.zone_w
+            self._zone_t = float(s.zone_t)
 
 
 def zone_targets(scene: Scene, sources: Mapping[str, BoundaryData], n_nodes: int
-                 ) -> ZoneTargets:
-    """The ZoneTargets of an ISPH scene with relaxation zones: local at each end whose source
-    can say the wave inside the domain (``velocity_along``, a wave model's boundary), stations
-    at most dp apart over the zone; no local data otherwise."""
+                 ) -> ZoneTargets | None:
+    """The ZoneTargets of an ISPH scene with relaxation zones: stations at most dp apart over
+    the zone, local at each end whose source can say the wave inside the domain
+    (``velocity_along``, a wave model's boundary; ends fed from outside turn local when a
+    window gives their data); None without zones."""
     length = scene.scheme.isph_relaxation_zone if scene.scheme.kind == "isph" else 0.0
     local = np.array([length > 0 and hasattr(sources.get(side), "velocity_along")
                       for side in SIDES], dtype=np.bool_)
-    if not local.any():
-        return no_zone_targets(n_nodes)
+    if not (length > 0 and scene.open_boundaries):
+        return None
     k = max(2, math.ceil(length / scene.dp) + 1)
     return ZoneTargets(local, length / (k - 1), np.zeros((2, k, 2, n_nodes)),
                        np.zeros((2, k, 2, n_nodes)))

@@ -119,7 +119,7 @@ class Simulation:
         self.open = OpenBoundaries.from_scene(scene, sources, window)
         if spare is None:
             spare = 0.3 if self.open.active else 0.1
-        # rigid bodies (issue 14): their particles replace the fluid inside them
+        # rigid bodies: their particles replace the fluid inside them
         self.bodies = BodySet(scene, layout.n_layers * dp)
         if self.bodies.active:
             keep = self.bodies.fluid_outside(layout.fluid_x, layout.fluid_z, dp)
@@ -263,6 +263,12 @@ class Simulation:
     @property
     def open_sides(self) -> tuple[str, ...]:
         return self.open.sides
+
+    @property
+    def zone_columns(self) -> dict[str, np.ndarray]:
+        """side -> x [m] of the columns inside ISPH's relaxation zones where ``advance_window``
+        takes local targets (the face's nodes' heights); empty without zones."""
+        return self.open.zone_columns()
 
     @property
     def window(self) -> float:
@@ -449,9 +455,12 @@ class Simulation:
 
     def advance_window(self, t1: float, left: BoundarySample | None = None,
                        right: BoundarySample | None = None,
-                       progress: Callable[["Simulation"], None] | None = None) -> None:
+                       progress: Callable[["Simulation"], None] | None = None,
+                       zone: Mapping[str, tuple[np.ndarray, np.ndarray]] | None = None) -> None:
         """Advance one coupling window to ``t1`` with the data at t1 of each open end (given, or
-        sampled from that side's source); raises BoundaryDataError (state untouched) or
+        sampled from that side's source); ``zone``: side -> (u, w)[column, node] at t1 at the
+        columns ``zone_columns`` of ISPH's relaxation zones (their local targets; omitted, a
+        zone pulls towards its face's profile). Raises BoundaryDataError (state untouched) or
         UnstableError."""
         if not (math.isfinite(t1) and t1 > self.t):
             raise ValueError(f"t1: must be finite and after t = {self.t}, got {t1}")
@@ -459,12 +468,13 @@ class Simulation:
             raise RuntimeError("advance_window: the run is unstable; restore a checkpoint first")
         try:
             end = self.open.end_samples(t1, {"left": left, "right": right})
+            zone_end = self.open.check_zone_data(end, zone or {})
         except BoundaryDataError as exc:
             self.status = "failed"
             if self.writer:
                 self.writer.update_meta(**self._meta_fields(), cause=f"boundary data: {exc}")
             raise
-        self.open.load_window(self.t, t1, end)
+        self.open.load_window(self.t, t1, end, zone_end)
         if self._gpu is not None:
             self._gpu.load_window()     # the window's boundary data to the device
         self._advance_recording(t1, progress)

@@ -72,7 +72,7 @@ class IsphStepper:
         cap = int(capacity)
         self.flag = np.zeros(cap, dtype=np.int8)
         self.rho_k = np.zeros(cap)
-        self.rho_ref = 0.0
+        self.rho_ref = 0.0   # set by initialise
         self.wsum = np.zeros(cap)
         self.dwall = np.zeros(cap)
         self.idx = np.zeros(cap, dtype=np.int64)
@@ -134,6 +134,12 @@ class IsphStepper:
         place_bodies(ps, n, bd)
         n = sort_by_cell(ps, ps2, N_SORTED_KDK, n, cells)
         self._open_ends_sorted(ps2, n, cells, ends)
+        # the initial lattice's interior kernel density (~1.006 rho0), the PPE's density
+        # reference: taken here, from the scene's own start, so that a run restored from a
+        # checkpoint into a new Simulation steps on with the same reference
+        free_surface_flags(ps2, n, cells, self.prm, self.fs_threshold, self.flag, self.rho_k)
+        inner = self.flag[:n] == 0
+        self.rho_ref = float(np.median(self.rho_k[:n][inner])) if inner.any() else self.prm.rho0
         g2 = self.prm.gx ** 2 + self.prm.gz ** 2
         return isph_dt(0.0, g2, self.prm, self.v_ref), int(n)
 
@@ -184,9 +190,6 @@ class IsphStepper:
         the open ends ran out of particle capacity (state in ``ps``, not sorted)."""
         prm = self.prm
         free_surface_flags(ps, n, cells, prm, self.fs_threshold, self.flag, self.rho_k)
-        if self.rho_ref == 0.0:  # the initial lattice's interior kernel density (~1.006 rho0)
-            inner = self.flag[:n] == 0
-            self.rho_ref = float(np.median(self.rho_k[:n][inner])) if inner.any() else prm.rho0
         wall_state(ps, n, cells, prm, dt, self.wall_stop, self.wsum, self.dwall)
         a2 = predict(ps, n, cells, prm, dt)
         self._solve(ps, n, cells, dt)

@@ -78,14 +78,16 @@ def test_flume_refuses_boundary_data_outside_the_tank(tmp_path):
         assert "outside the tank" in info["status"]
 
 
-def test_resumed_flume_continues_exactly(tmp_path):
-    """Disconnect after 2 windows, resume, 2 more: the same as 4 windows without a break."""
-    body = {"scene": FLUME, "mode": "coupled", "coupling": {"window_max": WINDOW}}
+def broken_and_resumed(tmp_path, body: dict, check=lambda welcome, nodes: None, **couple_kw):
+    """A coupled run of ``body`` broken off after 2 windows of the linear wave, resumed, and
+    broken off after 2 more; ``check(welcome, nodes)`` at each session's start. Returns the 4
+    RESULTs, the last session's nodes and the run's id."""
     got = []
     with live_server(tmp_path) as srv:
         run = srv.http.post("/runs", json=body).json()
         for session in range(2):
-            c, welcome, nodes = srv.couple(run["id"], timeout=120)
+            c, welcome, nodes = srv.couple(run["id"], **couple_kw)
+            check(welcome, nodes)
             t = welcome.t_start
             for _ in range(2):
                 got.append(c.request(Set(t, t + WINDOW, *wave(nodes.x, nodes.z, t + WINDOW)), Solve(),
@@ -95,7 +97,14 @@ def test_resumed_flume_continues_exactly(tmp_path):
             assert srv.wait_state(run["id"], "failed")["resumable"]
             if session == 0:
                 assert srv.http.post(f"/runs/{run['id']}/resume").status_code == 202
-    assert (tmp_path / "runs" / run["id"] / "sph.1" / "probes.csv").exists()  # nothing overwritten
+    return got, nodes, run["id"]
+
+
+def test_resumed_flume_continues_exactly(tmp_path):
+    """Disconnect after 2 windows, resume, 2 more: the same as 4 windows without a break."""
+    body = {"scene": FLUME, "mode": "coupled", "coupling": {"window_max": WINDOW}}
+    got, nodes, run_id = broken_and_resumed(tmp_path, body, timeout=120)
+    assert (tmp_path / "runs" / run_id / "sph.1" / "probes.csv").exists()  # nothing overwritten
     engine = FlumeEngine(RunRequest.model_validate(body), None)
     t = 0.0
     for res in got:
@@ -139,3 +148,60 @@ def test_flume_window_stops_when_the_run_is_cancelled():
     with pytest.raises(SolveCancelled):
         engine.solve_window()
     assert engine.t < 1.0
+
+
+def test_zone_nodes_give_isph_zones_the_wave_and_resume_exactly(tmp_path):
+    """Protocol 1.2 ZONE_NODES on an ISPH flume with relaxation zones: a client that asks gets
+    the zones' columns after the face nodes and sends the wave there; the run, broken after 2
+    windows and resumed, equals an in-process engine fed the same 4 windows (the zones' targets
+    at the break are in the saved state), and differs from the face's profile as target."""
+    from protocol import Capability
+
+    scene = {**FLUME, "scheme": {"kind": "isph", "isph_relaxation_zone": 0.15}}
+    body = {"scene": scene, "mode": "coupled", "coupling": {"window_max": WINDOW}}
+
+    def check(welcome, nodes):
+        assert welcome.capabilities & Capability.ZONE_NODES
+        zone = nodes.side >= 2
+        assert sorted(set(nodes.side.tolist())) == [0, 1, 2, 3] and welcome.n_nodes == nodes.x.size
+        assert np.all((nodes.x[nodes.side == 2] > 0) & (nodes.x[nodes.side == 2] <= 0.15 + 1e-9))
+        assert np.all((nodes.x[nodes.side == 3] < 1.2) & (nodes.x[nodes.side == 3] >= 1.05 - 1e-9))
+        assert np.array_equal(np.unique(nodes.z[zone]), np.unique(nodes.z[~zone]))
+
+    got, nodes, _ = broken_and_resumed(tmp_path, body, check, timeout=300,
+                                       caps=int(Capability.GOBACK | Capability.ZONE_NODES))
+    engine = FlumeEngine(RunRequest.model_validate(body), None)
+    face = FlumeEngine(RunRequest.model_validate(body), None)
+    try:
+        zn, fn = engine.zone_nodes(), face.nodes()
+        assert np.array_equal(zn.x, nodes.x) and np.array_equal(zn.side, nodes.side)
+        t, differs = 0.0, False
+        for res in got:
+            engine.set_window(t, t + WINDOW, *wave(zn.x, zn.z, t + WINDOW))
+            face.set_window(t, t + WINDOW, *wave(fn.x, fn.z, t + WINDOW))
+            m, mf = engine.solve_window(), face.solve_window()
+            t += WINDOW
+            assert res.steps == m.steps
+            np.testing.assert_allclose(res.eta, np.where(m.wet, m.eta, 0.0), rtol=1e-12, atol=1e-15)
+            differs |= not np.array_equal(m.eta, mf.eta)
+        assert engine.flume.open.zone.local.all() and not face.flume.open.zone.local.any()
+        assert differs   # the zones' targets reach the gauges
+    finally:
+        engine.close()
+        face.close()
+
+
+def test_the_kit_passes_against_a_run_with_zone_nodes(tmp_path):
+    """The conformance kit asks ZONE_NODES (1.2): against an ISPH flume with relaxation zones
+    it is granted, the zones' columns pass its check, and still-water windows solve."""
+    from protocol.conformance import Report, check_server
+
+    scene = {**FLUME, "scheme": {"kind": "isph", "isph_relaxation_zone": 0.15}}
+    with live_server(tmp_path) as srv:
+        run = srv.http.post("/runs", json={"scene": scene, "mode": "coupled",
+                                           "coupling": {"window_max": WINDOW}}).json()
+        srv.wait_state(run["id"], "waiting_for_client", timeout=300)
+        rep = check_server(f"tcp://127.0.0.1:{srv.tcp_port}", run["id"], windows=2,
+                           timeout=120.0, report=Report(echo=False))
+    assert rep.ok, rep.lines
+    assert [v for v, n, _ in rep.lines if n.startswith("NODES with ZONE_NODES")] == ["PASS"]

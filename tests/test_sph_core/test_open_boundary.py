@@ -247,6 +247,60 @@ def test_isph_relaxation_zone_pulls_towards_the_wave_where_a_model_knows_it():
     assert np.all(ps.view.vx[:n][fluid][~inside] == 0.0)
 
 
+def test_isph_relaxation_zone_takes_the_wave_given_from_outside():
+    """A client that knows the wave inside the domain (a coupled run's wave model) gives it at
+    the zone's columns with each window (``advance_window(zone=...)``): the zone pulls towards
+    it, station 0 being the face's sample; a window without it falls back to the face's
+    profile; a checkpoint keeps the window start's targets; bad shapes are refused."""
+    from sph_core.boundary_data import BoundaryDataError, WaveModelBoundary
+    from wave_client.theories.linear import AiryWave
+
+    zone = 0.3
+    sc = flume_scene(length=1.0, scheme="isph")
+    sc = sc.model_copy(update={"scheme": sc.scheme.model_copy(update={
+        "isph_relaxation_zone": zone})})
+    wave = AiryWave(0.02, 1.1, D)
+    nodes = flume_nodes(sc)
+    src = {s: WaveModelBoundary(wave, nd, D, nd.x_face) for s, nd in nodes.items()}
+    fl = Simulation(sc, window=0.05)          # fed from outside: no source of its own
+    cols = fl.zone_columns
+    assert set(cols) == {"left", "right"} and not fl.open.zone.local.any()
+    assert np.all(np.diff(cols["left"]) > 0) and np.all(np.diff(cols["right"]) < 0)
+    assert cols["left"][-1] == pytest.approx(zone) and cols["right"][-1] == pytest.approx(1 - zone)
+
+    def given(t):
+        wave.advance_to(t)
+        return {s: wave.velocity(c[:, None], nodes[s].z[None, :] - D) for s, c in cols.items()}
+
+    def window(t1, zone_data):
+        fl.advance_window(t1, left=src["left"].sample(t1), right=src["right"].sample(t1),
+                          zone=zone_data)
+
+    window(0.05, given(0.05))
+    z = fl.open.zone
+    assert z.local.all()
+    for b, s in enumerate(("left", "right")):
+        u1, w1 = given(0.05)[s]
+        np.testing.assert_allclose(z.u[b, 1:, 1], u1)
+        np.testing.assert_allclose(z.w[b, 1:, 1], w1)
+        np.testing.assert_allclose(z.u[b, 0, 1], src[s].sample(0.05).u)
+        np.testing.assert_allclose(z.u[b, :, 0], z.u[b, :, 1])   # the first window holds
+    saved = fl.checkpoint()
+    window(0.10, given(0.10))
+    np.testing.assert_allclose(z.u[0, 1:, 0], given(0.05)["left"][0])   # t0: the last t1's
+    np.testing.assert_allclose(z.u[0, 1:, 1], given(0.10)["left"][0])
+    z.u[:] = 0.0                               # the checkpoint, not the arrays, carries them
+    fl.restore(saved)
+    window(0.10, given(0.10))
+    np.testing.assert_allclose(z.u[0, 1:, 0], given(0.05)["left"][0])
+    window(0.15, None)
+    assert not z.local.any()                   # no zone data: the face's profile
+    bad = given(0.20)
+    bad["left"] = (bad["left"][0][1:], bad["left"][1][1:])
+    with pytest.raises(BoundaryDataError, match="left.zone.u: shape"):
+        window(0.20, bad)
+
+
 class Straining:
     """No flow at the faces, w = w0 + A (z - z0) at every node."""
 

@@ -494,6 +494,57 @@ def test_core_names_the_nodes_a_model_cannot_serve():
         core.next_window()
 
 
+def test_core_sends_the_wave_inside_the_relaxation_zones_when_granted():
+    """Protocol 1.2 ZONE_NODES: the client asks by default; granted, NODES may carry columns
+    inside the zones (sides 2, 3) and the client sends the model's wave at each one's x and z
+    (the face's absorption correction only at the faces); not granted, such a side is refused."""
+    from protocol import Capability, Set
+
+    zx = np.array([0.1, 0.2])   # two columns of the inlet's zone on the face's levels
+    nodes = Nodes(np.concatenate([NODE_X, np.repeat(zx, 8)]), np.tile(Z_COL, 5),
+                  np.concatenate([NODE_SIDE, np.full(16, 2)]).astype(np.uint32), GAUGE_X)
+    welcome = make_welcome(capabilities=int(Capability.ZONE_NODES), n_nodes=nodes.x.size)
+    core = CouplingCore(AiryWave(H, T, DEPTH), CouplingOptions(window=WINDOW, absorb=True),
+                        run_id="r1")
+    assert decode_frame(core.hello())[1].capabilities & Capability.ZONE_NODES
+    core.on_welcome(1, welcome)
+    core.on_nodes(2, nodes)
+    set_frame, _ = core.next_window()
+    s: Set = decode_frame(set_frame)[1]
+    wave = AiryWave(H, T, DEPTH)
+    wave.advance_to(WINDOW)
+    for x in zx:
+        col = nodes.x == x
+        u, w = wave.velocity(x, Z_COL)
+        np.testing.assert_allclose(s.u[col], u, rtol=1e-12)
+        np.testing.assert_allclose(s.w[col], w, rtol=1e-12)
+        np.testing.assert_allclose(s.eta[col], wave.elevation(np.array([x]))[0], rtol=1e-12)
+    assert set(core.gauges) == {"inlet", "outlet"}   # the zones have no correction gauge
+    core = CouplingCore(AiryWave(H, T, DEPTH), CouplingOptions(window=WINDOW), run_id="r1")
+    core.hello()
+    core.on_welcome(1, make_welcome(n_nodes=nodes.x.size))   # a server that did not grant it
+    with pytest.raises(ProtocolError, match=r"NODES.side has unknown values \[2\]"):
+        core.on_nodes(2, nodes)
+    off = CouplingCore(AiryWave(H, T, DEPTH), CouplingOptions(zone_nodes=False), run_id="r1")
+    assert not decode_frame(off.hello())[1].capabilities & Capability.ZONE_NODES
+    # a theory's start-up ramp: the zone gets the wave as it arrives (one front factor, at the
+    # column nearest the wavemaker), the face the theory's ramped wave
+    ramped = CouplingCore(AiryWave(H, T, DEPTH, ramp_time=1.0), CouplingOptions(window=WINDOW),
+                          run_id="r1")
+    ramped.hello()
+    ramped.on_welcome(1, welcome)
+    ramped.on_nodes(2, nodes)
+    window(ramped, np.zeros(3))   # at t = 0.05 s the front (c_g 1.87 m/s) has not reached 0.1 m
+    s = decode_frame(ramped.next_window()[0])[1]
+    wave = AiryWave(H, T, DEPTH, ramp_time=1.0)
+    wave.advance_to(2 * WINDOW)
+    f = float(wave.front_factor(zx.min()))
+    assert 0.0 < f < 0.9
+    for x in zx:
+        np.testing.assert_allclose(s.u[nodes.x == x], f * wave.velocity(x, Z_COL)[0], rtol=1e-12)
+    np.testing.assert_allclose(s.u[nodes.x == 0.0], wave.velocity(0.0, Z_COL)[0], rtol=1e-12)
+
+
 def test_core_refuses_non_finite_model_output():
     class NaNWave(AiryWave):
         def elevation(self, x):

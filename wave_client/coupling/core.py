@@ -86,6 +86,10 @@ class CouplingOptions:
     inlet_gauge, outlet_gauge: index of the gauge that measures eta for that side's correction;
               None: the gauge nearest that side's nodes (and nearer to it than to the other side).
     depth_rtol: largest relative difference accepted between the model's depth and WELCOME.depth.
+    zone_nodes: ask for the columns inside the SPH zone's relaxation zones (protocol 1.2,
+              ZONE_NODES; a server grants it for runs that have them, ISPH's) and send the
+              model's wave there too, so that the zones pull towards the wave as it is at each x;
+              False: the faces' nodes only (the zones pull towards the face's profile).
     """
 
     window: float | None = None
@@ -97,6 +101,7 @@ class CouplingOptions:
     inlet_gauge: int | None = None
     outlet_gauge: int | None = None
     depth_rtol: float = 0.01
+    zone_nodes: bool = True
 
 
 @dataclass
@@ -116,6 +121,12 @@ class WindowRecord:
 
 
 ModelSource = WaveModel | Callable[[Welcome], WaveModel]
+
+
+def _span(xs: np.ndarray) -> str:
+    """'x' for one abscissa, 'x_min..x_max' for several (error messages)."""
+    a, b = float(xs.min()), float(xs.max())
+    return f"{a}" if a == b else f"{a}..{b}"
 
 
 @dataclass
@@ -164,8 +175,11 @@ class CouplingCore:
     # --- handshake ------------------------------------------------------------------------
     def hello(self) -> bytes:
         # 1.1: GAUGE_INFO (gauge names) and KEEPALIVE (WORKING frames while the first window
-        # waits for the solver's compile); a 1.0 server ignores both bits
+        # waits for the solver's compile); 1.2: ZONE_NODES (the wave inside the SPH zone's
+        # relaxation zones, where the run has them); an older server ignores the bits
         caps = Capability.GAUGE_INFO | Capability.KEEPALIVE
+        if self.options.zone_nodes:
+            caps |= Capability.ZONE_NODES
         return self.session.request(Hello(int(caps), self.scene_hash, self.run_id, self.client_name))
 
     def on_welcome(self, seq: int, msg: Message) -> bytes:
@@ -214,13 +228,16 @@ class CouplingCore:
         """Group the boundary nodes by side and column; pick the correction gauges."""
         nodes = self._reply(seq, msg, Nodes)
         self.nodes = nodes
-        for side in (Side.INLET, Side.OUTLET):
+        known = [Side.INLET, Side.OUTLET]
+        if self.welcome is not None and self.welcome.capabilities & Capability.ZONE_NODES:
+            known += [Side.INLET_ZONE, Side.OUTLET_ZONE]   # 1.2: the model's wave there too
+        for side in known:
             idx = np.flatnonzero(nodes.side == side)
             if idx.size:
                 xs = nodes.x[idx]
                 cols = [(float(x), idx[xs == x]) for x in np.unique(xs)]
                 self._sides[side] = _Side(idx, cols)
-        unknown = set(np.unique(nodes.side).tolist()) - {int(Side.INLET), int(Side.OUTLET)}
+        unknown = set(np.unique(nodes.side).tolist()) - {int(s) for s in known}
         if unknown:
             raise ProtocolError(ErrorCode.BAD_VALUE, f"NODES.side has unknown values {sorted(unknown)}")
         n_g = nodes.gauge_x.size
@@ -324,7 +341,8 @@ class CouplingCore:
     @property
     def gauges(self) -> dict[str, int | None]:
         """Gauge index used for each side's correction (None: no correction there)."""
-        return {("inlet" if s is Side.INLET else "outlet"): v.gauge for s, v in self._sides.items()}
+        return {("inlet" if s is Side.INLET else "outlet"): v.gauge for s, v in self._sides.items()
+                if s in (Side.INLET, Side.OUTLET)}
 
     # --- windows --------------------------------------------------------------------------
     @property
@@ -343,15 +361,31 @@ class CouplingCore:
         n = self.nodes.x.size
         u, w, eta = np.zeros(n), np.zeros(n), np.zeros(n)
         for key, side in self._sides.items():
-            for x, idx in side.columns:
-                try:
-                    uc, wc = self.model.velocity(x + x_off, self.nodes.z[idx])
-                    eta[idx] = np.asarray(self.model.elevation(np.array([x + x_off])), float)[0]
-                except ValueError as exc:  # e.g. a node outside the model's grid
-                    raise CouplingError(
-                        f"the wave model cannot give the {key.name.lower()} nodes at SPH x = {x} m "
-                        f"(model x = {x + x_off} m): {exc}") from exc
-                u[idx], w[idx] = uc, wc
+            xs = np.array([x for x, _ in side.columns])
+            try:
+                z0 = self.nodes.z[side.columns[0][1]]
+                if all(np.array_equal(self.nodes.z[idx], z0) for _, idx in side.columns):
+                    # columns on one set of levels (a zone's): one call for them all, as a
+                    # Boussinesq model differentiates its whole grid per call
+                    uc, wc = (np.broadcast_to(a, (xs.size, z0.size)) for a in
+                              self.model.velocity(xs[:, None] + x_off, z0[None, :]))
+                else:
+                    uc, wc = zip(*(self.model.velocity(x + x_off, self.nodes.z[idx])
+                                   for x, idx in side.columns))
+                ec = np.asarray(self.model.elevation(xs + x_off), float).reshape(xs.size)
+                front = getattr(self.model, "front_factor", None)
+                if key in (Side.INLET_ZONE, Side.OUTLET_ZONE) and front is not None:
+                    # a theory's ramp holds at every x at once: a zone gets the wave as it
+                    # arrives, all its columns scaled by the factor nearest the wavemaker (as
+                    # in-process, sph_core.boundary_data.WaveModelBoundary.velocity_along)
+                    f = float(np.asarray(front(xs.min() + x_off), dtype=float))
+                    uc, wc = np.asarray(uc) * f, np.asarray(wc) * f
+            except ValueError as exc:  # e.g. a node outside the model's grid
+                raise CouplingError(
+                    f"the wave model cannot give the {key.name.lower()} nodes at SPH x = "
+                    f"{_span(xs)} m (model x = {_span(xs + x_off)} m): {exc}") from exc
+            for k, (_, idx) in enumerate(side.columns):
+                u[idx], w[idx], eta[idx] = uc[k], wc[k], ec[k]
         c = math.sqrt(self.welcome.g / self.welcome.depth)
         du_in = du_out = 0.0
         if self.options.absorb:
@@ -382,6 +416,8 @@ class CouplingCore:
         eta_model = self._model_at_gauges(gx + x_off)
         a = (t1 - t0) / (self.filter_tau + (t1 - t0))  # 1 when unfiltered (tau = 0)
         for side, s in self._sides.items():
+            if side not in self._mismatch:   # a relaxation zone's columns: no gauge of their own
+                continue
             g = s.gauge
             if g is not None and not math.isfinite(eta_model[g]):
                 raise CouplingError(f"the {side.name.lower()} gauge {g} at SPH x = {gx[g]} m lies "

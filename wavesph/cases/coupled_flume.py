@@ -344,7 +344,7 @@ def _gauges_csv(path: Path) -> tuple[np.ndarray, dict[str, np.ndarray]]:
 def run_coupled(c: FlumeCase, dp: float, out: Path, two_way: bool = True,
                 transport: str = "ws", absorb: str | None = None,
                 constants: dict[str, Any] | None = None,
-                scheme: dict[str, Any] | None = None) -> dict[str, Any]:
+                scheme: dict[str, Any] | None = None, zone_nodes: bool = True) -> dict[str, Any]:
     """The coupled flume over a real socket: in-process server, the client as `wavesph couple
     --model boussinesq --config <out>/wave_scene.toml [--absorb]` runs it (its log beside it;
     the server's store is <out>/server, where a file of ours would be a stray entry). Figures
@@ -368,6 +368,8 @@ def run_coupled(c: FlumeCase, dp: float, out: Path, two_way: bool = True,
         at its gauge 2h inside: off by k 2h (0.18 rad at dp = 0.02) of the incident wave.
         Measured (dp = 0.02, two-way, so also doubled): the SPH wave led the reference by
         0.25 rad and was 9 % low, RMSE/H 12 %. Kept to show it (bench --absorb sph).
+    zone_nodes: the client sends the model's wave inside ISPH's relaxation zones too
+    (`CouplingOptions.zone_nodes`; False: the faces only, `wavesph couple --no-zone-nodes`).
     """
     absorb = absorb or ("incident" if two_way else "client")
     if c.end == "outlet" and (two_way or absorb == "sph"):
@@ -410,7 +412,8 @@ def run_coupled(c: FlumeCase, dp: float, out: Path, two_way: bool = True,
             try:
                 couple(url, lambda welcome: build_model(scene, base_dir=cfg.parent),
                        CouplingOptions(window=c.window, absorb=absorb in ("client", "incident"),
-                                       absorb_wave="incident" if absorb == "incident" else "total"),
+                                       absorb_wave="incident" if absorb == "incident" else "total",
+                                       zone_nodes=zone_nodes),
                        run_id=run["id"], scene_hash=bytes.fromhex(run["scene_hash"]),
                        timeout=600.0, log_path=out / "client_gauges.csv", progress=False)
                 code = 0

@@ -78,6 +78,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                    help="gauge index measuring the inlet (default: nearest to the inlet)")
     p.add_argument("--outlet-gauge", type=int, default=None,
                    help="gauge index measuring the outlet (default: nearest to the outlet)")
+    p.add_argument("--no-zone-nodes", action="store_true",
+                   help="send the wave at the open ends' faces only, not inside the run's "
+                        "relaxation zones (ISPH; protocol 1.2 ZONE_NODES): the zones then pull "
+                        "towards the face's profile")
     p.add_argument("--run-id", default=None, help="run to couple to (required with tcp://)")
     p.add_argument("--scene-hash", default=None,
                    help="SHA-256 (hex) of the scene the model was set up for; refused if it differs")
@@ -191,7 +195,8 @@ def main(args: argparse.Namespace) -> int:
         options = CouplingOptions(window=window, t_end=args.t_end, absorb=args.absorb,
                                   absorb_cutoff=args.absorb_cutoff, absorb_wave=args.absorb_wave,
                                   x_offset=args.x_offset, inlet_gauge=args.inlet_gauge,
-                                  outlet_gauge=args.outlet_gauge)
+                                  outlet_gauge=args.outlet_gauge,
+                                  zone_nodes=not args.no_zone_nodes)
         url = args.url
         if args.scene is not None:
             url = _create_run(args)
