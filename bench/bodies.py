@@ -1,4 +1,4 @@
-"""Rigid bodies in the SPH zone (issue 14): physics checks and the cost of a body.
+"""Rigid bodies in the SPH zone: physics checks and the cost of a body.
 
 Questions: does a floating box settle at its Archimedes draft; at what period does it heave and
 how fast does that decay; does a hinged flap stay at rest in still water; does a spring flap

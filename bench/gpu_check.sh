@@ -128,7 +128,7 @@ elif [ -n "${FLUMES:-}" ]; then
     wait
 fi
 if [ -n "${RUNUP:-}" ]; then
-    # issue 26 item 1 at the resolutions the CPU cannot reach: the non-breaking solitary run-up
+    # run-up at the resolutions the CPU cannot reach: the non-breaking solitary run-up
     # at d/dp 80 (H/dp 4; d/dp 40 on the CPU: 30k particles, 92k steps, 1,784 s on 2 threads),
     # Boussinesq far field 2 d before the toe, then the breaking wave at d/dp 40 (theory inlet),
     # both on the smooth bed (along_slope: -37 % at d/dp 40 against the staircase's -48 %).

@@ -1,4 +1,4 @@
-"""Why does the SPH floating box heave faster and more damped than linear theory? (issue 14)
+"""Why does the SPH floating box heave faster and more damped than linear theory?
 
 One factor at a time on bench/bodies.py's heave release (box 0.4 x 0.2 m, 500 kg/m^3, depth
 0.3 m, 3.2 m closed tank, released 0.02 m too deep), all in one process (one JIT compile):

@@ -1,4 +1,4 @@
-"""ISPH against WCSPH at the same dp (issue 13, item 1): one JSON object per line.
+"""ISPH against WCSPH at the same dp: one JSON object per line.
 
     PYTHONPATH=. NUMBA_NUM_THREADS=1 python bench/isph.py [--quick] [--solvers bicgstab,amg]
         [--cases still,dambreak,obstacle] [--schemes wcsph,isph] [--t-still 1.0]

@@ -20,7 +20,7 @@ three scenes, all built by the cases' builders with ``scheme=`` (sph_core.scene.
   ``loss_per_wavelength`` (1 - exp(-decay L)).
 
 Prints one JSON object per entry. Wall times on a shared machine are "under load" unless said.
-ISPH (issue 13) joins as more entries: ``(name, {"scheme": {...}, "constants": {...}})``.
+ISPH joins as more entries: ``(name, {"scheme": {...}, "constants": {...}})``.
 """
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Rigid bodies of boundary particles in the SPH zone (issue 14): fixed, prescribed, free, hinged.
+"""Rigid bodies of boundary particles in the SPH zone: fixed, prescribed, free, hinged.
 
     bodies = BodySet.from_scene(scene)         # shapes -> particles, mass, inertia, motion
     keep = bodies.fluid_outside(x, z, dp)      # fluid lattice points not inside a body

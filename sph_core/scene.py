@@ -143,7 +143,7 @@ class Structure(Rect):
 
 
 class Body(_Model):
-    """A rigid body of boundary particles (issue 14; physics in ``sph_core.bodies``).
+    """A rigid body of boundary particles (physics in ``sph_core.bodies``).
 
     Shape (scene coordinates at t_start): ``box`` and ``flap`` by their corners x0, x1, z0, z1
     (a flap is a box hinged by default at the centre of its bottom edge); ``wedge`` by its
@@ -336,9 +336,10 @@ class Scheme(_Model):
         "ISPH: length [m] of a relaxation zone inside each open end's face, where the fluid's "
         "velocity is pulled towards the wave's at the rate q^2 / isph_relaxation_time, q = 1 - "
         "s / length, s the distance from the face: the wave model at the particle when a model "
-        "drives the run in-process (the benches' theory flumes), else the face's profile (an end "
-        "fed over the protocol, a [source] included: its data stop at the face); 0: none (the "
-        "wave flume's inlet then breaks down within a few periods: docs/studies/schemes.md)"))
+        "drives the run in-process (the benches' theory flumes) or a coupling client sends the "
+        "wave inside the zone (protocol 1.2 ZONE_NODES: wave_client and a scene's [source] do), "
+        "else the face's profile; 0: none (the wave flume's inlet then breaks down within a few "
+        "periods: docs/studies/schemes.md)"))
     isph_relaxation_time: float = Field(0.2, gt=0, description=(
         "ISPH: time scale [s] of the relaxation zone's pull at the face"))
 
@@ -477,7 +478,7 @@ ISPH_INLET_PRESSURE = "extrapolated"
 
 
 class OpenBoundary(_Model):
-    """An open end of the tank (issue 3, seed 002): the tank wall on ``side`` is replaced by a
+    """An open end of the tank (seed 002): the tank wall on ``side`` is replaced by a
     buffer of particles outside the tank face (x0 or x1), at least one kernel support wide and
     wide enough that the wave's orbits do not carry its particles through it (``buffer_width``).
 

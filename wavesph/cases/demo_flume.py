@@ -59,7 +59,7 @@ FLAP_SPRING = 20.0     # N m/rad
 
 
 def demo_body(kind: str, dp: float) -> dict[str, Any]:
-    """The demo's optional rigid body (issue 14) at X_BODY: ``box``, 0.2 m wide, 0.1 m high,
+    """The demo's optional rigid body at X_BODY: ``box``, 0.2 m wide, 0.1 m high,
     500 kg/m^3, free in heave and pitch (draft 0.05 m); ``flap``, bottom-hinged on the bed,
     0.05 m above still water, 500 kg/m^3, with a torsion spring (k = FLAP_SPRING), FLAP_THICKNESS
     thick (4 dp at dp 0.02: thicker than the kernel support, BODIES.md)."""

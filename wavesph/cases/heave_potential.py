@@ -1,4 +1,4 @@
-"""Linear potential-flow reference for a box heaving in a closed 2D tank (issue 14, heave_period).
+"""Linear potential-flow reference for a box heaving in a closed 2D tank (heave_period).
 
 The same geometry as the SPH run (``rigid_bodies.floating_box_scene``): a tank of length L with
 water of depth h at rest (the level the closed tank's water has at the box's equilibrium), a box

@@ -1,4 +1,4 @@
-"""Rigid-body test problems (issue 14): scene builders and their analytic references.
+"""Rigid-body test problems: scene builders and their analytic references.
 
     floating_box_scene(dp, ...)    a 2D box of density rho_b floating in a tank (heave, Archimedes)
     box_draft(sim)                 its draft below the level the closed tank's water has now

@@ -1,4 +1,4 @@
-"""Wedge water entry (issue 14, seed 004): the drop test of Zhao, Faltinsen & Aarsnes (1996).
+"""Wedge water entry (seed 004): the drop test of Zhao, Faltinsen & Aarsnes (1996).
 
     scene = wedge_scene(dp)                   # the section dropped at 6.15 m/s on still water
     p = wagner_pressure(x, c, V, dV)          # Wagner's outer pressure along a wedge [Pa]

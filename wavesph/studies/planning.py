@@ -49,7 +49,7 @@ from .sweeps import METHODS, read_csv
 SWEEP_CSV = "data/accuracy_sweep.csv"
 WINDOWS_PER_PERIOD = 50
 MIN_DEPTH_ROWS = 4
-DEFAULT_TARGET = 0.05          # RMSE/H: seed 002's accuracy (<= 4.3 %), issue 3's goal (5 %)
+DEFAULT_TARGET = 0.05          # RMSE/H: seed 002's accuracy (<= 4.3 %), the project's goal (5 %)
 EXPENSIVE_FACTOR = 3.0         # `wavesph run` warns past this cost ratio to the plan
 # the pre-study defaults (sweeps.OLD_DEFAULTS: h/dp sqrt 2, wall artificial viscosity on), which
 # the wave-decay study replaced (docs/studies/wave_decay_study.md): kept in the sweep data to
