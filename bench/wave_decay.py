@@ -25,7 +25,9 @@ particle-steps of the default flume.
 ISPH carries this wave through its open ends with relaxation zones and its wave settings,
 `--scheme isph --h-over-dp 1.2 --isph-density-relaxation 0.05 --isph-wall-stop 100
 --isph-relaxation-zone 0.4` (docs/physics/isph.md; the first gauge then sits at the zone's end);
-with the scheme's defaults its flume breaks down at ~5 s, before the window.
+with the scheme's defaults its flume breaks down at ~5 s, before the window. At H/dp 4 add
+`--ramp-periods 2`: a wave started over one period breaks the inlet's face inside the window
+(docs/studies/schemes.md, "The start-up ramp: ISPH's flume at H/dp 4").
 
 A flume one wavelength long with open ends driven by second-order Stokes theory (the wave of the
 coupled flume, wavesph/cases/coupled_flume.py, by default), gauges from 2h past the inlet to 3/4 of the
