@@ -376,9 +376,12 @@ class CouplingCore:
                 front = getattr(self.model, "front_factor", None)
                 if key in (Side.INLET_ZONE, Side.OUTLET_ZONE) and front is not None:
                     # a theory's ramp holds at every x at once: a zone gets the wave as it
-                    # arrives, all its columns scaled by the factor nearest the wavemaker (as
-                    # in-process, sph_core.boundary_data.WaveModelBoundary.velocity_along)
-                    f = float(np.asarray(front(xs.min() + x_off), dtype=float))
+                    # arrives, all its columns scaled by the factor at the zone's x nearest the
+                    # wavemaker, its face included (as in-process,
+                    # sph_core.boundary_data.WaveModelBoundary.velocity_along)
+                    face = self._sides.get(Side(int(key) - 2))
+                    x_near = min(xs.min(), *(x for x, _ in face.columns)) if face else xs.min()
+                    f = float(np.asarray(front(x_near + x_off), dtype=float))
                     uc, wc = np.asarray(uc) * f, np.asarray(wc) * f
             except ValueError as exc:  # e.g. a node outside the model's grid
                 raise CouplingError(
