@@ -12,6 +12,7 @@ import time
 import numpy as np
 import pytest
 
+from protocol import Capability
 from wave_client.coupling import CouplingOptions, couple
 from wave_client.theories import build_theory
 
@@ -27,13 +28,20 @@ def rows(path) -> list[list[str]]:
         return list(csv.reader(f))
 
 
-def test_standalone_theory_run_equals_the_coupled_run(tmp_path):
+# ISPH with relaxation zones: both clients ask protocol 1.2's ZONE_NODES and send the theory's
+# wave inside the zones too (its front as in-process)
+ISPH_ZONES = {"kind": "isph", "isph_relaxation_zone": 0.15}
+
+
+@pytest.mark.parametrize("scheme", [None, ISPH_ZONES], ids=["wcsph", "isph_zones"])
+def test_standalone_theory_run_equals_the_coupled_run(tmp_path, scheme):
+    scene = FLUME if scheme is None else {**FLUME, "scheme": scheme}
     with live_server(tmp_path) as srv:
-        r = srv.http.post("/runs", json={"scene": FLUME, "mode": "standalone", "source": SOURCE})
+        r = srv.http.post("/runs", json={"scene": scene, "mode": "standalone", "source": SOURCE})
         assert r.status_code == 201, r.text
         alone = srv.wait_state(r.json()["id"], "finished", "failed", "unstable", timeout=120)
         assert alone["state"] == "finished", alone["status"]
-        r = srv.http.post("/runs", json={"scene": FLUME, "mode": "coupled"})
+        r = srv.http.post("/runs", json={"scene": scene, "mode": "coupled"})
         assert r.status_code == 201, r.text
         run = r.json()
         srv.wait_state(run["id"], "waiting_for_client", timeout=120)
@@ -41,6 +49,7 @@ def test_standalone_theory_run_equals_the_coupled_run(tmp_path):
         report = couple(f"ws://127.0.0.1:{srv.port}/runs/{run['id']}/couple", wave, CouplingOptions(),
                         timeout=60.0, progress=False, log_path=tmp_path / "client.csv")
         coupled = srv.wait_state(run["id"], "finished")
+    assert bool(report.welcome.capabilities & Capability.ZONE_NODES) == (scheme is not None)
     runs = tmp_path / "runs"
     a, b = rows(runs / alone["id"] / "gauges.csv"), rows(runs / run["id"] / "gauges.csv")
     # T/50 windows (the client's default, below window_max) up to t_end
