@@ -286,10 +286,11 @@ class OpenBoundaries:
         go_on = abs(self._zone_t - t0) <= 1e-9 * max(1.0, abs(t0))
         for b, side in enumerate(SIDES):
             src = self.sources.get(side)
+            dx = -self.ends.nx[b] * z.ds * k   # the stations' offsets from the face
             if side in given:
                 u1, w1 = given[side]
             elif side in self.sides and hasattr(src, "velocity_along"):
-                u1, w1 = src.velocity_along(t1, -self.ends.nx[b] * z.ds * k)
+                u1, w1 = src.velocity_along(t1, dx)
             else:
                 z.local[b] = False
                 continue
@@ -297,7 +298,7 @@ class OpenBoundaries:
                 z.u[b, :, 0] = z.u[b, :, 1]
                 z.w[b, :, 0] = z.w[b, :, 1]
             elif side not in given:
-                z.u[b, :, 0], z.w[b, :, 0] = src.velocity_along(t0, -self.ends.nx[b] * z.ds * k)
+                z.u[b, :, 0], z.w[b, :, 0] = src.velocity_along(t0, dx)
             else:
                 z.u[b, :, 0], z.w[b, :, 0] = u1, w1
             z.u[b, :, 1], z.w[b, :, 1] = u1, w1
@@ -356,13 +357,10 @@ class OpenBoundaries:
         if not self.active:
             return None
         z = self.zone
-        local = bool(z.local.any()) and math.isfinite(self._zone_t)
+        zone = ((z.local.copy(), z.u[:, :, 1].copy(), z.w[:, :, 1].copy(), float(self._zone_t))
+                if z.local.any() and math.isfinite(self._zone_t) else (None,) * 4)
         return OpenState(self.ends.eta_meas.copy(), self.ends.counters.copy(), dict(self.samples),
-                         self.ends.filt_x.copy(), self.ends.zs.copy(),
-                         z.local.copy() if local else None,
-                         z.u[:, :, 1].copy() if local else None,
-                         z.w[:, :, 1].copy() if local else None,
-                         float(self._zone_t) if local else None)
+                         self.ends.filt_x.copy(), self.ends.zs.copy(), *zone)
 
     def set_state(self, s: OpenState | None) -> None:
         if s is None:
