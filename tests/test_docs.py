@@ -57,12 +57,13 @@ def test_speed_accuracy_rows_are_the_shipped_sweeps() -> None:
     tool = _load("accuracy_chart")
     shipped = [json.loads(ln) for ln in tool.ROWS.read_text(encoding="utf-8").splitlines()]
     assert shipped == tool.all_rows(), "stale: run python docs/tools/accuracy_chart.py"
-    for data, figure, _ in tool.CHARTS:
-        meta = json.loads(data.with_suffix(".meta.json").read_text())
-        records = sweeps.read_csv(data)
-        rows = tool.result_rows(records, meta)
-        assert len(rows) == len({(r["case"], r["method"], r["dp"]) for r in records})
-        assert all(r["command"] == meta["made_by"] and r["date"] for r in rows)
+    for tables, figure, _ in tool.CHARTS:
+        for data in tables:
+            meta = json.loads(data.with_suffix(".meta.json").read_text())
+            records = sweeps.read_csv(data)
+            rows = tool.result_rows(records, meta)
+            assert len(rows) == len({(r["case"], r["method"], r["dp"]) for r in records})
+            assert all(r["command"] == meta["made_by"] and r["date"] for r in rows)
         assert figure.exists()
     merged = tool.result_rows([{"case": "flume_V", "method": "m", "dp": 0.02, "H_over_dp": 3.0,
                                 "error": e, "wall_s": w, "particles": 9, "status": s}

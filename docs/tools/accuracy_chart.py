@@ -4,10 +4,12 @@ speed-accuracy rows (bench/results/accuracy_sweep.jsonl) from the shipped sweep 
     python docs/tools/accuracy_chart.py
     python docs/tools/validation_tables.py > docs/validation.md    # then the page
 
-The data: wavesph/cases/data/accuracy_sweep.csv (the quick preset, every method, with repeats:
-what `wavesph plan` fits) and bench/results/accuracy_sweep_full_defaults.csv (the full preset's
-spacings and windows for today's WCSPH defaults, the cases a 2-core machine runs). Each is the
-records of the command in its .meta.json (``made_by``, with the date and machine);
+The data: wavesph/cases/data/accuracy_sweep.csv (the quick preset, with repeats: what `wavesph
+plan` fits) and bench/results/accuracy_sweep_quick_isph_waves.csv (ISPH's wave settings on the
+same points; one chart), bench/results/accuracy_sweep_full_defaults.csv and
+accuracy_sweep_full_isph_waves.csv (the full preset's spacings and windows for today's WCSPH
+defaults and for ISPH's wave settings, the cases a 2-core machine runs; one chart). Each table is
+the records of the command in its .meta.json (``made_by``, with the date and machine);
 `wavesph bench accuracy` writes the same chart beside its own CSV. Repeats of a point
 (``--repeats``) make one row: the mean error, its range and the mean wall time.
 """
@@ -23,18 +25,27 @@ from wavesph.studies import sweeps
 ROOT = Path(__file__).resolve().parents[2]
 DATA = ROOT / "wavesph" / "cases" / "data" / "accuracy_sweep.csv"
 FULL = ROOT / "bench" / "results" / "accuracy_sweep_full_defaults.csv"
-# (data, figure, what it shows): the validation page draws them first, in this order
-CHARTS = [(FULL, ROOT / "docs" / "figures" / "accuracy_full_defaults.png",
-           "Today's WCSPH defaults at the full preset's spacings (H/dp 3, 5, 8) and windows (3 "
-           "periods), the cases a 2-core machine runs"),
-          (DATA, ROOT / "docs" / "figures" / "accuracy_quick.png",
+FULL_ISPH = ROOT / "bench" / "results" / "accuracy_sweep_full_isph_waves.csv"
+QUICK_ISPH = ROOT / "bench" / "results" / "accuracy_sweep_quick_isph_waves.csv"
+# (tables, figure, what it shows): the validation page draws them first, in this order; a chart
+# of several tables (one sweep each) draws their records together
+CHARTS = [((FULL, FULL_ISPH), ROOT / "docs" / "figures" / "accuracy_full_defaults.png",
+           "Today's WCSPH defaults and ISPH's wave settings (`isph_waves`) at the full preset's "
+           "spacings (H/dp 3, 5, 8) and windows (3 periods), the cases a 2-core machine runs"),
+          ((DATA, QUICK_ISPH), ROOT / "docs" / "figures" / "accuracy_quick.png",
            "Four methods at the quick preset's coarse spacings, each point three times (the data "
-           "`wavesph plan` fits)")]
+           "`wavesph plan` fits), and ISPH's wave settings (`isph_waves`, not planned: its "
+           "relaxation zones are sized to each flume)")]
 ROWS = ROOT / "bench" / "results" / "accuracy_sweep.jsonl"
 
 SCORES = {"flume": "RMSE/H at mid-flume vs theory",
           "dambreak": "RMS front error vs Martin & Moyce (T ≤ 3)",
           "coupled": "RMSE/H at the flat-bed gauge vs Boussinesq-only"}
+
+
+def meta_of(table: Path) -> dict[str, str]:
+    """The command, date and machine that made ``table`` (its .meta.json)."""
+    return json.loads(table.with_suffix(".meta.json").read_text())
 
 
 def result_rows(records: list[dict[str, Any]], meta: dict[str, str]) -> list[dict[str, Any]]:
@@ -68,17 +79,17 @@ def result_rows(records: list[dict[str, Any]], meta: dict[str, str]) -> list[dic
 
 def all_rows() -> list[dict[str, Any]]:
     """The results rows of every chart's data, in CHARTS order."""
-    rows = []
-    for data, _, _ in CHARTS:
-        rows += result_rows(sweeps.read_csv(data), json.loads(data.with_suffix(".meta.json").read_text()))
-    return rows
+    return [row for tables, _, _ in CHARTS for data in tables
+            for row in result_rows(sweeps.read_csv(data), meta_of(data))]
 
 
 def main() -> None:
-    for data, figure, _ in CHARTS:
-        meta = json.loads(data.with_suffix(".meta.json").read_text())
-        sweeps.plot_accuracy(sweeps.read_csv(data), figure, title=sweeps.chart_title(meta))
-        print(f"wrote {figure.relative_to(ROOT)} from {data.relative_to(ROOT)}")
+    for tables, figure, _ in CHARTS:
+        records = [r for data in tables for r in sweeps.read_csv(data)]
+        title = "\n".join(sweeps.chart_title(meta_of(data)) for data in tables)
+        sweeps.plot_accuracy(records, figure, title=title)
+        print(f"wrote {figure.relative_to(ROOT)} from "
+              f"{', '.join(str(d.relative_to(ROOT)) for d in tables)}")
     ROWS.write_text("".join(json.dumps(r, ensure_ascii=False) + "\n" for r in all_rows()),
                     encoding="utf-8")
     print(f"wrote {ROWS.relative_to(ROOT)}")

@@ -23,7 +23,7 @@ PAGE = ROOT / "docs" / "validation.md"
 if str(Path(__file__).resolve().parent) not in sys.path:  # generated_page, beside this file
     sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from accuracy_chart import CHARTS  # noqa: E402  (data, figure, what): the speed-accuracy charts
+from accuracy_chart import CHARTS, meta_of  # noqa: E402  (tables, figure, what): the charts
 from generated_page import page_main  # noqa: E402
 
 # question -> (title, what it asks[, a figure]); tables appear in this order, unknown ones last
@@ -146,10 +146,12 @@ def chart_block() -> list[str]:
            "front; hollow: a refinement that cost more and erred more; bars: the run-to-run "
            "scatter of repeats; the rows and what each case scores are under [Speed against "
            "accuracy](#speed-against-accuracy) ([study](studies/speed_accuracy.md)).", ""]
-    for data, figure, what in CHARTS:
-        meta = json.loads(data.with_suffix(".meta.json").read_text())
-        when = ", ".join(meta[k] for k in ("date", "machine") if k in meta)
-        out += [f"{what}: `{meta['made_by']}`" + (f" ({when})." if when else "."), "",
+    for tables, figure, what in CHARTS:
+        made = []
+        for meta in map(meta_of, tables):
+            when = ", ".join(meta[k] for k in ("date", "machine") if k in meta)
+            made.append(f"`{meta['made_by']}`" + (f" ({when})" if when else ""))
+        out += [f"{what}: {'; '.join(made)}.", "",
                 f"![speed against accuracy: {figure.stem}]"
                 f"({figure.relative_to(PAGE.parent).as_posix()})", ""]
     return out

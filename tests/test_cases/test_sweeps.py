@@ -147,6 +147,11 @@ def test_repeats_are_other_realisations_and_the_chart_shows_their_scatter(tmp_pa
     png = tmp_path / "accuracy.png"
     sweeps.plot_accuracy(records + same, png)
     assert png.stat().st_size > 10_000
+    # a case none of whose points ran through (ISPH's wave settings on the dam break) is an
+    # empty panel beside the others: the sweep's chart is still drawn
+    failed = [{**rec(0.1, j, None, None, "unstable"), "case": "dambreak"} for j in range(2)]
+    sweeps.plot_accuracy(records + failed, png)
+    assert png.stat().st_size > 10_000
 
 
 def test_stability_unstable_run_has_a_reason_and_no_nan(tmp_path):
@@ -239,7 +244,7 @@ def test_plan_dp_divides_the_depth_and_counts_steps_at_the_scenes_c0(tmp_path):
     assert slow.steps / fast.steps == pytest.approx(math.sqrt(2), rel=0.03)
 
 
-def test_plan_of_a_scene_stays_inside_it_and_never_proposes_a_superseded_method(tmp_path):
+def test_plan_of_a_scene_stays_inside_it_and_proposes_no_superseded_or_flume_sized_method(tmp_path):
     from sph_core.scene import load_scene
 
     data = sweeps.read_csv(_synthetic(tmp_path))
@@ -248,7 +253,11 @@ def test_plan_of_a_scene_stays_inside_it_and_never_proposes_a_superseded_method(
     scene = load_scene(ROOT / "examples/scenes/demo_beach_flume.toml")
     short = scene.model_copy(update={"beds": [scene.beds[0].model_copy(update={
         "points": [(1.0, 0.0), (5.4, 0.44)]})]})      # only 1 m of flat: less than a wavelength
-    plan = planning.make_plan(planning.request_from_scene(short, 0.04, 1.4), data + old)
+    # ISPH's wave settings: its zones and ramp are sized to each flume, which the plan's zone
+    # scene does not do
+    isph = [{**r, "method": "isph_waves", "error": 0.5 * r["error"], "steps": 10 * r["steps"]}
+            for r in data]
+    plan = planning.make_plan(planning.request_from_scene(short, 0.04, 1.4), data + old + isph)
     assert plan.method == PLANNED
     assert plan.flat_m == pytest.approx(1.0) and plan.structures_m == pytest.approx(4.4)
     assert plan.zone_length_m <= short.tank.x1 - short.tank.x0 + plan.dp
@@ -465,3 +474,39 @@ def test_pareto_front_keeps_the_runs_worth_their_cost():
     pts = [(10.0, 0.05), (30.0, 0.03), (90.0, 0.04), (30.0, 0.035), (200.0, 0.01)]
     assert sweeps.pareto_front(pts) == [(10.0, 0.05), (30.0, 0.03), (200.0, 0.01)]
     assert sweeps.pareto_front([]) == []
+
+
+@pytest.mark.parametrize("case, flume_wavelengths", [("flume_IV", 1.0), ("flume_I", 0.5)])
+def test_isph_waves_flume_points_get_zones_sized_to_the_flume_and_a_longer_ramp(
+        monkeypatch, case, flume_wavelengths):
+    """The method that carries waves under ISPH sizes its relaxation zones to each flume (a fifth
+    of it at each end: the standing wave's flume is half a wavelength) and ramps over twice the
+    preset's periods; the scene those settings make is valid. Other methods are passed as they
+    are."""
+    import wavesph.cases.wave_flume as wave_flume
+
+    seen = []
+
+    def fake_flume_case(model, **kw):
+        seen.append((float(model.length), kw))
+        return {"rmse_over_H": 0.01, "wall_s": 1.0, "particles": 1, "steps": 1,
+                "reflection": None, "mean_level_m": 0.0}
+
+    monkeypatch.setattr(wave_flume, "flume_case", fake_flume_case)
+    opts = {"periods": 1.0, "ramp_periods": 1.0}
+    sweeps._flume(Point(case, "isph_waves", 0.05, opts))
+    sweeps._flume(Point(case, "wcsph_kdk_h2_wallav0", 0.05, opts))
+    (wl, isph), (_, wcsph) = seen
+    period = isph["period"]
+    assert isph["ramp"] == pytest.approx(2.0 * period) and wcsph["ramp"] == pytest.approx(period)
+    zone = isph["scheme"]["isph_relaxation_zone"]
+    assert zone == pytest.approx(0.2 * flume_wavelengths * wl, abs=1e-4)
+    assert isph["scheme"]["kind"] == "isph" and isph["h_over_dp"] == 1.2
+    assert "scheme" not in wcsph
+    assert sweeps.METHODS["isph_waves"]["scheme"].get("isph_relaxation_zone") is None  # untouched
+    scene = wave_flume.wave_flume_scene(depth=isph["depth"], wavelength=wl, height=isph["height"],
+                                        dp=0.05, t_end=0.1, probe_every=0.02,
+                                        length=flume_wavelengths * wl,
+                                        **{k: v for k, v in isph.items()
+                                           if k in ("h_over_dp", "alpha_wall_factor", "scheme")})
+    assert scene.scheme.isph_relaxation_zone == zone

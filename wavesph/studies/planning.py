@@ -18,7 +18,8 @@ What is proposed and why:
              of the depth, then rounded down to a divisor of the depth (the particles must fill
              to the still-water level, sph_core.scene.datum_mismatch); then the method of the
              smallest predicted wall time. Methods of the pre-study defaults (h/dp sqrt 2 and
-             artificial viscosity against walls, SUPERSEDED) are not proposed unless asked for.
+             artificial viscosity against walls, SUPERSEDED) and ISPH's wave settings (sized to
+             each flume: NOT_PLANNED) are not proposed unless asked for.
   window     T/50 (what `wavesph couple` takes), in SPH steps of dt = cfl h / (c0 + u_orbital),
              c0 the scene's (c0_factor sqrt(2 g d) by default), else 10 sqrt(g d).
   wall       particles x steps / throughput: particles counted on the zone's own lattice
@@ -44,7 +45,7 @@ import numpy as np
 from sph_core.scene import divisor_text
 from wave_client import G
 
-from .sweeps import METHODS, read_csv
+from .sweeps import FLUME_WAVE_SETTINGS, METHODS, read_csv
 
 SWEEP_CSV = "data/accuracy_sweep.csv"
 WINDOWS_PER_PERIOD = 50
@@ -55,6 +56,10 @@ EXPENSIVE_FACTOR = 3.0         # `wavesph run` warns past this cost ratio to the
 # the wave-decay study replaced (docs/studies/wave_decay_study.md): kept in the sweep data to
 # compare against, never proposed by default
 SUPERSEDED = tuple(m for m, o in METHODS.items() if o.get("alpha_wall_factor") == 1.0)
+# methods whose flumes take settings sized to the wave (sweeps.FLUME_WAVE_SETTINGS: ISPH's
+# relaxation zones, its ramp): the planned zone's scene does not apply them and the step
+# estimate is WCSPH's (c0), so the plan does not propose them
+NOT_PLANNED = SUPERSEDED + tuple(FLUME_WAVE_SETTINGS)
 
 
 @dataclass(frozen=True)
@@ -276,7 +281,7 @@ def make_plan(req: PlanRequest, data: list[dict[str, Any]] | None = None,
     flat, structures = zone_parts(req)
     c0 = req.c0 or 10.0 * math.sqrt(G * req.depth)
     best: Plan | None = None
-    for m in methods or [m for m in METHODS if m not in SUPERSEDED]:
+    for m in methods or [m for m in METHODS if m not in NOT_PLANNED]:
         fit = fit_error(rows, m, (req.height, req.period, req.depth))
         tp = throughput or median_throughput(rows, m)
         if fit is None or tp is None or fit["p"] <= 0 or _unstable_flumes(rows, m):

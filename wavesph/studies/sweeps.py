@@ -68,13 +68,23 @@ METHODS: dict[str, dict[str, Any]] = {
        for name, sch in RIEMANN_VARIANTS.items()},
     # ISPH at its defaults (h/dp sqrt 2): its quick flume points run through one scored period
     # at 3-30 % RMSE/H, and some realisations stop unstable (docs/studies/speed_accuracy.md), so
-    # the plan keeps it out of wave runs. The settings that carry waves (relaxation zones,
-    # docs/physics/isph.md) are not a method here: a zone's length follows each case's wavelength
+    # the plan keeps it out of wave runs
     "isph_amg": {"h_over_dp": ISPH_H_OVER_DP, "alpha_wall_factor": 0.0,
                  "scheme": {"kind": "isph", "ppe_solver": "amg"}},
     "isph_bicgstab": {"h_over_dp": ISPH_H_OVER_DP, "alpha_wall_factor": 0.0,
                       "scheme": {"kind": "isph", "ppe_solver": "bicgstab"}},  # ISPH's default
+    # ISPH with the settings that carry waves (docs/physics/isph.md), its flumes' relaxation
+    # zones and ramp in FLUME_WAVE_SETTINGS
+    "isph_waves": {"h_over_dp": 1.2, "alpha_wall_factor": 0.0,
+                   "scheme": {"kind": "isph", "ppe_solver": "bicgstab",
+                              "isph_density_relaxation": 0.05, "isph_wall_stop": 100.0}},
 }
+# a method's flume settings that follow the case: relaxation zones of this fraction of the
+# flume's length at each end (the wave-decay bench's 0.4 m of its 2 m flume; the mid-flume gauge
+# stays 0.3 lengths from either), and a start-up ramp this many times the preset's (at H/dp 4 a
+# one-period start breaks ISPH's inlet face: docs/studies/schemes.md, "The start-up ramp")
+FLUME_WAVE_SETTINGS: dict[str, dict[str, float]] = {
+    "isph_waves": {"zone_flume_fraction": 0.2, "ramp_factor": 2.0}}
 # the coupled case's two ways to compute the same flume
 COUPLED_METHODS = ("coupled", "sph_only")
 
@@ -154,6 +164,17 @@ def _repeat(point: Point, j: int) -> Point:
     return Point(point.case, point.method, point.dp, opts, repeat=j)
 
 
+def flume_constants(method: str, flume_length: float) -> dict[str, Any]:
+    """``method``'s scene overrides for a flume ``flume_length`` [m] long: METHODS' entry with
+    its relaxation zones (FLUME_WAVE_SETTINGS) sized to the flume."""
+    consts = dict(METHODS.get(method, {}))   # the coupled case's methods: the scene's own
+    frac = FLUME_WAVE_SETTINGS.get(method, {}).get("zone_flume_fraction")
+    if frac:
+        consts["scheme"] = {**consts["scheme"],
+                            "isph_relaxation_zone": round(frac * flume_length, 4)}
+    return consts
+
+
 def _data_text(name: str) -> str:
     from importlib import resources
 
@@ -212,7 +233,8 @@ def warm_up_method(method: str) -> float:
     sim.advance_to(0.01)
     model = build_theory("linear", height=0.02, period=1.0, depth=0.2, ramp_time=1.0)
     scene = wave_flume_scene(depth=0.2, wavelength=float(model.length), height=0.02, dp=0.05,
-                             t_end=0.1, probe_every=0.02, **consts)
+                             t_end=0.1, probe_every=0.02,
+                             **flume_constants(method, float(model.length)))
     run_wave_flume(scene, model, window=0.02, t_end=0.04)
     _WARM.add(sig)
     return time.perf_counter() - tic
@@ -234,12 +256,15 @@ def _flume(point: Point) -> dict[str, Any]:
 
     row = read_cases()[point.case.split("_", 1)[1]]
     h, t, d = float(row["H"]), float(row["T"]), float(row["d"])
-    ramp = point.options.get("ramp_periods", 1.0) * t
+    wave = FLUME_WAVE_SETTINGS.get(point.method, {})
+    ramp = point.options.get("ramp_periods", 1.0) * wave.get("ramp_factor", 1.0) * t
     model = case_theory(row["theory"], height=h, period=t, depth=d, ramp_time=ramp)
+    standing = row["theory"] == "standing"
+    length = float(model.length) * (0.5 if standing else 1.0)   # flume_case's flume
     res = flume_case(model, height=h, period=t, depth=d, wavelength=float(model.length),
                      dp=point.dp, periods=point.options.get("periods", 1.0), ramp=ramp,
-                     standing=row["theory"] == "standing", name=point.key,
-                     **METHODS[point.method])
+                     standing=standing, name=point.key,
+                     **flume_constants(point.method, length))
     return {"H_over_dp": h / point.dp, "error": res["rmse_over_H"], "wall_s": res["wall_s"],
             "particles": res["particles"], "steps": res["steps"],
             "extra": {"reflection": res["reflection"], "H": h, "T": t, "d": d,
@@ -507,7 +532,7 @@ def plot_accuracy(records: list[dict[str, Any]], path: Path, title: str = "") ->
     Pareto front (pareto_front over the means: the points that buy accuracy with time) is drawn
     filled, its dominated points hollow (a refinement that cost more and erred more); the
     case's front over all methods is the dashed grey line. Unstable/failed points are not drawn
-    (see the CSV)."""
+    (see the CSV); a case none of whose points ran through is an empty panel that says so."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -552,6 +577,14 @@ def plot_accuracy(records: list[dict[str, Any]], path: Path, title: str = "") ->
                 ax.annotate(f"{g['dp']:.3g}" + (f" ×{g['n']}" if g["n"] > 1 else ""),
                             (g["wall_s"], g["error"]), fontsize=7, xytext=(3, 3),
                             textcoords="offset points")
+        ax.set_title(case, fontsize=10)
+        if not any(g["case"] == case for g in groups):   # no point ran through: no log axes
+            ax.text(0.5, 0.5, "no point ran through\n(the CSV says why)", ha="center",
+                    va="center", transform=ax.transAxes, fontsize=8)
+            ax.set_xticks([])
+            ax.set_yticks([])
+            ax.legend(fontsize=7)
+            continue
         best = pareto_front((g["wall_s"], g["error"]) for g in groups if g["case"] == case)
         if len(best) > 1:
             ax.step(*zip(*best), where="post", ls="--", color="0.5", lw=1, label="front, all methods")
@@ -563,7 +596,6 @@ def plot_accuracy(records: list[dict[str, Any]], path: Path, title: str = "") ->
         ax.xaxis.set_minor_locator(LogLocator(base=10.0, subs=(2.0, 5.0)))
         ax.xaxis.set_major_formatter(plain)
         ax.xaxis.set_minor_formatter(plain)
-        ax.set_title(case, fontsize=10)
         ax.set_xlabel("wall time [s]")
         ax.set_ylabel("error (relative)")
         ax.grid(True, which="both", alpha=0.3)
