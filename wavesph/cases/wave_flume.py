@@ -159,6 +159,12 @@ def run_wave_flume(scene: Scene, model: Any, *, window: float, x_model_left: flo
     return run
 
 
+def flume_length(wavelength: float, standing: bool = False) -> float:
+    """The length [m] of flume_case's flume: one wavelength, half for a standing wave (its faces
+    at the nodes of eta)."""
+    return 0.5 * wavelength if standing else wavelength
+
+
 def flume_case(model: Any, *, height: float, period: float, depth: float, wavelength: float,
                dp: float, periods: float, ramp: float, standing: bool = False,
                absorb: tuple[bool, bool] = (True, True), window_per_period: int = 50,
@@ -187,7 +193,7 @@ def flume_case(model: Any, *, height: float, period: float, depth: float, wavele
     the outlet is told a wave that is not there: its correction answers a mismatch of the whole
     wave, and what it emits then crosses the gauges during the standard window (at kd 2, H/dp 4:
     6.2 % there, 0.5-2 % once it has passed; docs/studies/absorption.md, 2026-11-23)."""
-    length = 0.5 * wavelength if standing else wavelength
+    length = flume_length(wavelength, standing)
     # the ramp starts the model everywhere at once, SPH's wave front travels from the inlet:
     # compare once the fully ramped wave has reached mid-flume at the (linear) group velocity
     k = 2.0 * math.pi / wavelength

@@ -252,7 +252,7 @@ def _assert_finite(rec: dict[str, Any]) -> None:
 
 def _flume(point: Point) -> dict[str, Any]:
     from ..cases.seed002_waves import case_theory
-    from ..cases.wave_flume import flume_case
+    from ..cases.wave_flume import flume_case, flume_length
 
     row = read_cases()[point.case.split("_", 1)[1]]
     h, t, d = float(row["H"]), float(row["T"]), float(row["d"])
@@ -260,7 +260,7 @@ def _flume(point: Point) -> dict[str, Any]:
     ramp = point.options.get("ramp_periods", 1.0) * wave.get("ramp_factor", 1.0) * t
     model = case_theory(row["theory"], height=h, period=t, depth=d, ramp_time=ramp)
     standing = row["theory"] == "standing"
-    length = float(model.length) * (0.5 if standing else 1.0)   # flume_case's flume
+    length = flume_length(float(model.length), standing)
     res = flume_case(model, height=h, period=t, depth=d, wavelength=float(model.length),
                      dp=point.dp, periods=point.options.get("periods", 1.0), ramp=ramp,
                      standing=standing, name=point.key,
