@@ -6,9 +6,10 @@ speed-accuracy rows (bench/results/accuracy_sweep.jsonl) from the shipped sweep 
 
 The data: wavesph/cases/data/accuracy_sweep.csv (the quick preset, with repeats: what `wavesph
 plan` fits) and bench/results/accuracy_sweep_quick_isph_waves.csv (ISPH's wave settings on the
-same points; one chart), bench/results/accuracy_sweep_full_defaults.csv and
-accuracy_sweep_full_isph_waves.csv (the full preset's spacings and windows for today's WCSPH
-defaults and for ISPH's wave settings, the cases a 2-core machine runs; one chart). Each table is
+same points; one chart), bench/results/accuracy_sweep_full_defaults.csv,
+accuracy_sweep_full_isph_waves.csv and accuracy_sweep_full_riemann_muscl.csv (the full preset's
+spacings and windows for today's WCSPH defaults, ISPH's wave settings and Riemann SPH, the cases
+a 2-core machine runs; one chart). Each table is
 the records of the command in its .meta.json (``made_by``, with the date and machine);
 `wavesph bench accuracy` writes the same chart beside its own CSV. Repeats of a point
 (``--repeats``) make one row: the mean error, its range and the mean wall time.
@@ -26,12 +27,15 @@ ROOT = Path(__file__).resolve().parents[2]
 DATA = ROOT / "wavesph" / "cases" / "data" / "accuracy_sweep.csv"
 FULL = ROOT / "bench" / "results" / "accuracy_sweep_full_defaults.csv"
 FULL_ISPH = ROOT / "bench" / "results" / "accuracy_sweep_full_isph_waves.csv"
+FULL_RIEMANN = ROOT / "bench" / "results" / "accuracy_sweep_full_riemann_muscl.csv"
 QUICK_ISPH = ROOT / "bench" / "results" / "accuracy_sweep_quick_isph_waves.csv"
 # (tables, figure, what it shows): the validation page draws them first, in this order; a chart
 # of several tables (one sweep each) draws their records together
-CHARTS = [((FULL, FULL_ISPH), ROOT / "docs" / "figures" / "accuracy_full_defaults.png",
-           "Today's WCSPH defaults and ISPH's wave settings (`isph_waves`) at the full preset's "
-           "spacings (H/dp 3, 5, 8) and windows (3 periods), the cases a 2-core machine runs"),
+CHARTS = [((FULL, FULL_ISPH, FULL_RIEMANN),
+           ROOT / "docs" / "figures" / "accuracy_full_defaults.png",
+           "Today's WCSPH defaults, ISPH's wave settings (`isph_waves`) and Riemann SPH "
+           "(`riemann_muscl`) at the full preset's spacings (H/dp 3, 5, 8) and windows "
+           "(3 periods), the cases a 2-core machine runs"),
           ((DATA, QUICK_ISPH), ROOT / "docs" / "figures" / "accuracy_quick.png",
            "Four methods at the quick preset's coarse spacings, each point three times (the data "
            "`wavesph plan` fits), and ISPH's wave settings (`isph_waves`, not planned: its "
