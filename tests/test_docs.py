@@ -59,7 +59,7 @@ def test_speed_accuracy_rows_are_the_shipped_sweeps() -> None:
     assert shipped == tool.all_rows(), "stale: run python docs/tools/accuracy_chart.py"
     for tables, figure, _ in tool.CHARTS:
         for data in tables:
-            meta = json.loads(data.with_suffix(".meta.json").read_text())
+            meta = tool.meta_of(data)
             records = sweeps.read_csv(data)
             rows = tool.result_rows(records, meta)
             assert len(rows) == len({(r["case"], r["method"], r["dp"]) for r in records})

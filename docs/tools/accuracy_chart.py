@@ -9,8 +9,8 @@ plan` fits) and bench/results/accuracy_sweep_quick_isph_waves.csv (ISPH's wave s
 same points; one chart), bench/results/accuracy_sweep_full_defaults.csv,
 accuracy_sweep_full_isph_waves.csv and accuracy_sweep_full_riemann_muscl.csv (the full preset's
 spacings and windows for today's WCSPH defaults, ISPH's wave settings and Riemann SPH, the cases
-a 2-core machine runs; one chart). Each table is
-the records of the command in its .meta.json (``made_by``, with the date and machine);
+a 2-core machine runs; one chart). Each table is the records of the command in its .meta.json
+(``made_by``, with the date and machine);
 `wavesph bench accuracy` writes the same chart beside its own CSV. Repeats of a point
 (``--repeats``) make one row: the mean error, its range and the mean wall time.
 """
